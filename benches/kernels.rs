@@ -1,0 +1,93 @@
+//! Criterion benches: CPU kernels the techniques lean on (BVH ray casts) and one whole frame of
+//! each registered technique on the Cornell box (GPU, flushed per frame).
+//!
+//! `cargo bench` runs them; `cargo bench -- rays` runs a subset.
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use gibench_harness::assets::AssetPaths;
+use gibench_harness::glam::Vec3;
+use gibench_harness::gpu::{GpuContext, GpuOptions};
+use gibench_harness::profiler::{ProfileMode, Profiler};
+use gibench_harness::runner::{Harness, RunConfig, TimingMode};
+use gibench_harness::scene::Scene;
+
+#[path = "../src/registry.rs"]
+mod registry;
+
+/// Deterministic directions spread over the sphere (Fibonacci lattice).
+fn directions(n: usize) -> Vec<Vec3> {
+    let golden = std::f32::consts::PI * (3.0 - 5f32.sqrt());
+    (0..n)
+        .map(|i| {
+            let z = 1.0 - 2.0 * (i as f32 + 0.5) / n as f32;
+            let r = (1.0 - z * z).sqrt();
+            let phi = golden * i as f32;
+            Vec3::new(r * phi.cos(), z, r * phi.sin())
+        })
+        .collect()
+}
+
+fn rays(c: &mut Criterion) {
+    let assets = AssetPaths::standard(None);
+    for name in ["cornell", "sibenik"] {
+        let Ok(scene) = Scene::load_named(name, &assets) else {
+            eprintln!("skipping rays/{name}: scene not found");
+            continue;
+        };
+        let bvh = gibench_harness::bvh::SceneBvh::new(&scene.mesh);
+        let origin = gibench_harness::anim::FrameClock::new(&scene.descriptor)
+            .frame(0)
+            .light
+            .position;
+        let dirs = directions(1024);
+        c.bench_function(&format!("rays/closest-hit-1024/{name}"), |b| {
+            b.iter(|| {
+                dirs.iter()
+                    .filter(|d| bvh.closest_hit(origin, **d, 0.0, f32::INFINITY).is_some())
+                    .count()
+            })
+        });
+    }
+}
+
+fn frames(c: &mut Criterion) {
+    let Ok(gpu) = GpuContext::new(&GpuOptions::default()) else {
+        eprintln!("skipping frame benches: no GPU adapter");
+        return;
+    };
+    let scene =
+        Scene::load_named("cornell", &AssetPaths::standard(None)).expect("cornell is generated");
+    let config = RunConfig {
+        resolution: [256, 192],
+        frames: 1,
+        warmup: 0,
+        first_frame: 0,
+        timing: TimingMode::Stages,
+        seed: 1,
+        shadow_size: 256,
+    };
+    let h = Harness::new(&gpu, &scene, &config).expect("harness");
+    for info in registry::all() {
+        let params = gibench_harness::technique::Params::parse(info.name, info.params, &[])
+            .expect("defaults");
+        let (mut technique, compose) = h.build(&info, &params, &config).expect("technique");
+        let mut profiler = Profiler::new(&gpu, ProfileMode::Frame);
+        let mut i = 0;
+        c.bench_function(&format!("frame/cornell-256x192/{}", info.name), |b| {
+            b.iter(|| {
+                let frame = h.clock.frame(i);
+                i += 1;
+                h.render_frame(technique.as_mut(), &compose, &mut profiler, &frame, true)
+                    .expect("frame");
+                gpu.flush().expect("flush");
+            })
+        });
+    }
+}
+
+criterion_group! {
+    name = benches;
+    config = Criterion::default().sample_size(20);
+    targets = rays, frames
+}
+criterion_main!(benches);

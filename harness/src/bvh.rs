@@ -1,0 +1,407 @@
+//! CPU ray casting over the static geometry with an `obvhs` compressed wide BVH: closest-hit
+//! (triangle, barycentrics, position, normals, material) and any-hit (occlusion) queries. The
+//! techniques use it to place and validate VPLs; the reference renderer traces paths with it.
+
+use std::time::Duration;
+
+use glam::{Vec2, Vec3, Vec3A};
+use obvhs::cwbvh::builder::build_cwbvh_from_tris;
+use obvhs::cwbvh::CwBvh;
+use obvhs::ray::{Ray, RayHit};
+use obvhs::triangle::Triangle;
+use obvhs::BvhBuildParams;
+
+use crate::scene::Mesh;
+
+/// A closest-hit result.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    /// Ray parameter (distance when the direction is unit length).
+    pub t: f32,
+    pub triangle: u32,
+    /// Barycentrics (u, v) of corners 1 and 2; corner 0 has 1 − u − v.
+    pub barycentrics: Vec2,
+    pub position: Vec3,
+    /// Unit geometric normal, facing against the ray (towards the ray origin).
+    pub geometric_normal: Vec3,
+    /// Unit interpolated shading normal, flipped to the same side as `geometric_normal`.
+    pub shading_normal: Vec3,
+    pub uv: Vec2,
+    pub material: u32,
+}
+
+/// A BVH over one mesh (the scene's static mesh). It keeps its own copies of the triangles,
+/// normals, texture coordinates and per-triangle materials, so it does not borrow the mesh.
+/// Triangles with no area are never hit. An empty mesh gives a BVH that never hits.
+pub struct SceneBvh {
+    /// `None` for a mesh without triangles.
+    bvh: Option<CwBvh>,
+    /// Corner positions per triangle, in mesh order.
+    tris: Vec<[Vec3; 3]>,
+    /// Corner shading normals per triangle.
+    normals: Vec<[Vec3; 3]>,
+    /// Corner texture coordinates per triangle.
+    uvs: Vec<[Vec2; 3]>,
+    /// Material per triangle.
+    materials: Vec<u32>,
+}
+
+/// Möller–Trumbore: `(t, u, v)` of the hit of `origin + t·dir` with triangle `tri` for `t` in
+/// the open interval `(t_min, t_max)`, where `(u, v)` weight corners 1 and 2. Both sides hit.
+#[inline]
+fn intersect(
+    tri: &[Vec3; 3],
+    origin: Vec3,
+    dir: Vec3,
+    t_min: f32,
+    t_max: f32,
+) -> Option<(f32, f32, f32)> {
+    let e1 = tri[1] - tri[0];
+    let e2 = tri[2] - tri[0];
+    let p = dir.cross(e2);
+    let det = e1.dot(p);
+    if det == 0.0 || !det.is_finite() {
+        return None;
+    }
+    let inv_det = 1.0 / det;
+    let s = origin - tri[0];
+    let u = s.dot(p) * inv_det;
+    if !(0.0..=1.0).contains(&u) {
+        return None;
+    }
+    let q = s.cross(e1);
+    let v = dir.dot(q) * inv_det;
+    if !(v >= 0.0 && u + v <= 1.0) {
+        return None;
+    }
+    let t = e2.dot(q) * inv_det;
+    (t > t_min && t < t_max).then_some((t, u, v))
+}
+
+impl SceneBvh {
+    /// Builds the BVH over `mesh` (copied; the BVH does not borrow it). Indices out of range
+    /// are treated as degenerate triangles at the origin, which are never hit.
+    pub fn new(mesh: &Mesh) -> Self {
+        let count = mesh.triangle_count();
+        let mut tris = Vec::with_capacity(count);
+        let mut normals = Vec::with_capacity(count);
+        let mut uvs = Vec::with_capacity(count);
+        let mut materials = Vec::with_capacity(count);
+        for t in 0..count {
+            let idx = &mesh.indices[3 * t..3 * t + 3];
+            let in_range = idx.iter().all(|&i| (i as usize) < mesh.positions.len());
+            let at = |k: usize| idx[k] as usize;
+            let p = if in_range {
+                [0, 1, 2].map(|k| mesh.positions[at(k)])
+            } else {
+                [Vec3::ZERO; 3]
+            };
+            let p = if p.iter().all(|v| v.is_finite()) {
+                p
+            } else {
+                [Vec3::ZERO; 3]
+            };
+            let face = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or(Vec3::Y);
+            let n = [0, 1, 2].map(|k| {
+                mesh.normals
+                    .get(at(k))
+                    .copied()
+                    .filter(|n| n.is_finite())
+                    .unwrap_or(face)
+            });
+            let uv = [0, 1, 2].map(|k| mesh.uvs.get(at(k)).copied().unwrap_or(Vec2::ZERO));
+            tris.push(p);
+            normals.push(n);
+            uvs.push(uv);
+            materials.push(mesh.materials.get(at(0)).copied().unwrap_or(0));
+        }
+        let bvh = (!tris.is_empty()).then(|| {
+            let obvhs_tris: Vec<Triangle> = tris
+                .iter()
+                .map(|t| Triangle {
+                    v0: Vec3A::from(t[0]),
+                    v1: Vec3A::from(t[1]),
+                    v2: Vec3A::from(t[2]),
+                })
+                .collect();
+            let mut build_time = Duration::ZERO;
+            build_cwbvh_from_tris(&obvhs_tris, BvhBuildParams::medium_build(), &mut build_time)
+        });
+        SceneBvh {
+            bvh,
+            tris,
+            normals,
+            uvs,
+            materials,
+        }
+    }
+
+    /// Number of triangles in the BVH.
+    pub fn triangle_count(&self) -> usize {
+        self.tris.len()
+    }
+
+    /// Whether the ray's values can be traced (finite origin, finite non-zero direction and a
+    /// non-empty, non-NaN interval).
+    fn usable(origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> bool {
+        origin.is_finite()
+            && dir.is_finite()
+            && dir != Vec3::ZERO
+            && !t_min.is_nan()
+            && !t_max.is_nan()
+            && t_max > t_min
+    }
+
+    fn ray(origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> Ray {
+        // `-0.0 + 0.0 == +0.0`: obvhs's traversal mis-handles negative-zero direction components
+        // (e.g. `-Vec3::Y` is (−0, −1, −0)) and would miss everything.
+        let dir = dir + Vec3::ZERO;
+        Ray::new(Vec3A::from(origin), Vec3A::from(dir), t_min, t_max)
+    }
+
+    /// Closest hit along `origin + t·dir` for `t` in `(t_min, t_max)` (a negative `t_min` acts
+    /// as 0). Both sides of every triangle are hit. Non-finite or zero rays hit nothing.
+    pub fn closest_hit(&self, origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> Option<Hit> {
+        let bvh = self.bvh.as_ref()?;
+        let t_min = t_min.max(0.0);
+        if !Self::usable(origin, dir, t_min, t_max) {
+            return None;
+        }
+        let mut best: Option<(u32, f32, f32, f32)> = None;
+        let mut hit = RayHit::none();
+        bvh.ray_traverse(Self::ray(origin, dir, t_min, t_max), &mut hit, |ray, id| {
+            let tri = bvh.primitive_indices[id] as usize;
+            match intersect(&self.tris[tri], origin, dir, t_min, ray.tmax) {
+                Some((t, u, v)) => {
+                    best = Some((tri as u32, t, u, v));
+                    t
+                }
+                None => f32::INFINITY,
+            }
+        });
+        let (tri, t, u, v) = best?;
+        let i = tri as usize;
+        let w = 1.0 - u - v;
+        let [p0, p1, p2] = self.tris[i];
+        let [n0, n1, n2] = self.normals[i];
+        let [uv0, uv1, uv2] = self.uvs[i];
+        let mut geometric_normal = (p1 - p0).cross(p2 - p0).normalize_or(Vec3::Y);
+        if geometric_normal.dot(dir) > 0.0 {
+            geometric_normal = -geometric_normal;
+        }
+        let mut shading_normal = (w * n0 + u * n1 + v * n2).normalize_or(geometric_normal);
+        if shading_normal.dot(geometric_normal) < 0.0 {
+            shading_normal = -shading_normal;
+        }
+        Some(Hit {
+            t,
+            triangle: tri,
+            barycentrics: Vec2::new(u, v),
+            position: origin + t * dir,
+            geometric_normal,
+            shading_normal,
+            uv: w * uv0 + u * uv1 + v * uv2,
+            material: self.materials[i],
+        })
+    }
+
+    /// Whether anything blocks the open segment from `a` to `b` (both ends shrunk by `eps`
+    /// relative to the segment length, to avoid self-intersection at the endpoints).
+    pub fn occluded(&self, a: Vec3, b: Vec3, eps: f32) -> bool {
+        let eps = if eps.is_finite() {
+            eps.clamp(0.0, 0.5)
+        } else {
+            0.0
+        };
+        self.any_hit(a, b - a, eps, 1.0 - eps)
+    }
+
+    /// Whether any triangle is hit along the ray for `t` in `(t_min, t_max)` (a negative
+    /// `t_min` acts as 0).
+    pub fn any_hit(&self, origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> bool {
+        let Some(bvh) = self.bvh.as_ref() else {
+            return false;
+        };
+        let t_min = t_min.max(0.0);
+        if !Self::usable(origin, dir, t_min, t_max) {
+            return false;
+        }
+        !bvh.ray_traverse_miss(Self::ray(origin, dir, t_min, t_max), |_, id| {
+            let tri = bvh.primitive_indices[id] as usize;
+            intersect(&self.tris[tri], origin, dir, t_min, t_max)
+                .map_or(f32::INFINITY, |(t, _, _)| t)
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::cornell::{cornell_box, BOX};
+
+    /// A small deterministic generator (xorshift) so the tests need no dependency.
+    struct Rng(u64);
+    impl Rng {
+        fn next(&mut self) -> f32 {
+            self.0 ^= self.0 << 13;
+            self.0 ^= self.0 >> 7;
+            self.0 ^= self.0 << 17;
+            (self.0 >> 40) as f32 / (1u64 << 24) as f32
+        }
+        fn unit_vector(&mut self) -> Vec3 {
+            loop {
+                let v = Vec3::new(self.next(), self.next(), self.next()) * 2.0 - 1.0;
+                if v.length_squared() > 1e-4 && v.length_squared() <= 1.0 {
+                    return v.normalize();
+                }
+            }
+        }
+    }
+
+    fn brute_force(mesh: &Mesh, origin: Vec3, dir: Vec3) -> Option<(f32, u32)> {
+        (0..mesh.triangle_count())
+            .filter_map(|t| {
+                intersect(&mesh.triangle(t), origin, dir, 0.0, f32::INFINITY)
+                    .map(|(d, _, _)| (d, t as u32))
+            })
+            .min_by(|a, b| a.0.total_cmp(&b.0))
+    }
+
+    #[test]
+    fn bvh_camera_ray_hits_block_with_consistent_barycentrics() {
+        let (mesh, _) = cornell_box(None);
+        let bvh = SceneBvh::new(&mesh);
+        assert_eq!(bvh.triangle_count(), 32);
+        let origin = Vec3::new(278.0, 273.0, -800.0);
+        let dir = (Vec3::new(278.0, 273.0, 280.0) - origin).normalize();
+        let hit = bvh
+            .closest_hit(origin, dir, 0.0, f32::INFINITY)
+            .expect("the camera sees the box");
+        // Straight ahead is the front face of the tall block (z ≈ 292 at x = 278).
+        assert_eq!(hit.material, BOX);
+        assert!((hit.position.z - 292.0).abs() < 1.0, "{}", hit.position);
+        assert!(hit.position.abs_diff_eq(origin + hit.t * dir, 1e-3));
+        let [a, b, c] = mesh.triangle(hit.triangle as usize);
+        let (u, v) = (hit.barycentrics.x, hit.barycentrics.y);
+        let p = (1.0 - u - v) * a + u * b + v * c;
+        assert!(p.abs_diff_eq(hit.position, 1e-3), "{p} vs {}", hit.position);
+        assert!(hit.geometric_normal.dot(dir) < 0.0);
+        assert!(hit.shading_normal.dot(hit.geometric_normal) > 0.99);
+        assert!((hit.geometric_normal.length() - 1.0).abs() < 1e-5);
+        // t_max before the block: nothing.
+        assert!(bvh.closest_hit(origin, dir, 0.0, hit.t * 0.99).is_none());
+        // The back wall is behind it.
+        let back = bvh.closest_hit(origin, dir, hit.t * 1.01, f32::INFINITY);
+        assert!(back.is_some());
+    }
+
+    #[test]
+    fn bvh_occlusion() {
+        let (mesh, _) = cornell_box(Some(30.0));
+        let bvh = SceneBvh::new(&mesh);
+        // Through the short block.
+        assert!(bvh.occluded(
+            Vec3::new(186.0, 80.0, 10.0),
+            Vec3::new(186.0, 80.0, 400.0),
+            1e-4
+        ));
+        // Across open space above the blocks.
+        assert!(!bvh.occluded(
+            Vec3::new(278.0, 400.0, 100.0),
+            Vec3::new(278.0, 400.0, 500.0),
+            1e-4
+        ));
+        // Endpoints on surfaces do not occlude themselves: floor to ceiling, straight up in the open.
+        assert!(!bvh.occluded(
+            Vec3::new(500.0, 0.0, 100.0),
+            Vec3::new(500.0, 548.8, 100.0),
+            1e-4
+        ));
+        assert!(bvh.any_hit(Vec3::new(278.0, 273.0, 279.0), Vec3::Y, 0.0, 1000.0));
+        assert!(!bvh.any_hit(Vec3::new(278.0, 273.0, 279.0), Vec3::Y, 0.0, 200.0));
+        // Axis directions, including ones with negative-zero components such as `-Vec3::Y`
+        // (not −Z: the front of the box is open).
+        let centre = Vec3::new(278.0, 273.0, 279.0);
+        for d in [
+            Vec3::X,
+            -Vec3::X,
+            Vec3::Y,
+            -Vec3::Y,
+            Vec3::Z,
+            Vec3::NEG_Y,
+            Vec3::new(-0.0, -1.0, -0.0),
+        ] {
+            let hit = bvh.closest_hit(centre, d, 0.0, f32::INFINITY);
+            assert!(hit.is_some(), "{d:?} misses");
+            assert!(
+                bvh.any_hit(centre, d, 0.0, f32::INFINITY),
+                "{d:?} any-hit misses"
+            );
+        }
+    }
+
+    #[test]
+    fn bvh_matches_brute_force() {
+        let (mesh, _) = cornell_box(Some(30.0));
+        let bvh = SceneBvh::new(&mesh);
+        let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+        let mut hits = 0;
+        for _ in 0..1000 {
+            let origin = Vec3::new(
+                rng.next() * 556.0,
+                rng.next() * 548.0,
+                rng.next() * 900.0 - 300.0,
+            );
+            let dir = rng.unit_vector();
+            let expected = brute_force(&mesh, origin, dir);
+            let got = bvh.closest_hit(origin, dir, 0.0, f32::INFINITY);
+            match (expected, got) {
+                (None, None) => {}
+                (Some((t, _)), Some(h)) => {
+                    hits += 1;
+                    assert!(
+                        (h.t - t).abs() <= 1e-3 * t.max(1.0),
+                        "t {} vs brute force {t}",
+                        h.t
+                    );
+                }
+                (e, g) => panic!("origin {origin} dir {dir}: brute force {e:?}, bvh {g:?}"),
+            }
+            assert_eq!(
+                expected.is_some(),
+                bvh.any_hit(origin, dir, 0.0, f32::INFINITY)
+            );
+        }
+        assert!(hits > 500, "{hits}");
+    }
+
+    #[test]
+    fn bvh_degenerate_inputs_never_panic() {
+        let empty = SceneBvh::new(&Mesh::default());
+        assert!(empty
+            .closest_hit(Vec3::ZERO, Vec3::X, 0.0, f32::INFINITY)
+            .is_none());
+        assert!(!empty.any_hit(Vec3::ZERO, Vec3::X, 0.0, f32::INFINITY));
+        assert!(!empty.occluded(Vec3::ZERO, Vec3::ONE, 1e-3));
+
+        let (mesh, _) = cornell_box(None);
+        let bvh = SceneBvh::new(&mesh);
+        let o = Vec3::new(278.0, 273.0, 279.0);
+        assert!(bvh.closest_hit(o, Vec3::ZERO, 0.0, f32::INFINITY).is_none());
+        assert!(bvh
+            .closest_hit(o, Vec3::new(f32::NAN, 0.0, 1.0), 0.0, f32::INFINITY)
+            .is_none());
+        assert!(bvh
+            .closest_hit(Vec3::splat(f32::INFINITY), Vec3::X, 0.0, f32::INFINITY)
+            .is_none());
+        assert!(bvh.closest_hit(o, Vec3::X, 10.0, 5.0).is_none());
+        assert!(!bvh.occluded(o, o, 1e-3));
+
+        // Bad indices and a zero-area triangle.
+        let mut broken = mesh.clone();
+        broken.indices.extend_from_slice(&[0, 1, 9999, 0, 0, 0]);
+        broken.normals.truncate(3);
+        let bvh = SceneBvh::new(&broken);
+        assert!(bvh.closest_hit(o, Vec3::X, 0.0, f32::INFINITY).is_some());
+    }
+}

@@ -1,0 +1,75 @@
+//! One error type for the whole harness. Every variant names what was wrong (a file, a field, a
+//! parameter) and what was expected, so the CLI can print it as is and exit non-zero.
+
+use std::path::PathBuf;
+
+/// Errors reported to the user. Messages are complete sentences fragments meant to be printed
+/// after `error: `.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// An asset (glTF file) was not found anywhere on the search path.
+    #[error("asset '{name}' not found; looked in: {searched}")]
+    AssetNotFound { name: String, searched: String },
+    /// A file exists but its content is not what was expected.
+    #[error("{}: {message}", path.display())]
+    BadFile { path: PathBuf, message: String },
+    /// A command-line or technique parameter is wrong.
+    #[error("parameter '{name}': {message}")]
+    Param { name: String, message: String },
+    /// Any other invalid input (unknown scene or technique name, bad resolution, ...).
+    #[error("{0}")]
+    Invalid(String),
+    /// The GPU could not be set up or reported an error.
+    #[error("GPU: {0}")]
+    Gpu(String),
+    /// Reading or writing a file failed.
+    #[error("{}: {source}", path.display())]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+}
+
+/// Result with the harness [`Error`].
+pub type Result<T> = std::result::Result<T, Error>;
+
+impl Error {
+    /// Shorthand for [`Error::BadFile`].
+    pub fn bad_file(path: impl Into<PathBuf>, message: impl Into<String>) -> Self {
+        Error::BadFile {
+            path: path.into(),
+            message: message.into(),
+        }
+    }
+    /// Shorthand for [`Error::Param`].
+    pub fn param(name: impl Into<String>, message: impl Into<String>) -> Self {
+        Error::Param {
+            name: name.into(),
+            message: message.into(),
+        }
+    }
+    /// Shorthand for [`Error::Io`].
+    pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
+        Error::Io {
+            path: path.into(),
+            source,
+        }
+    }
+}
+
+/// Writes `bytes` to `path` atomically: a temporary file in the same directory, then a rename,
+/// so a reader never sees a half-written file and a failed run leaves nothing behind.
+pub fn write_atomic(path: &std::path::Path, bytes: &[u8]) -> Result<()> {
+    use std::io::Write;
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(std::path::Path::new("."));
+    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+    let mut tmp = tempfile::NamedTempFile::new_in(dir).map_err(|e| Error::io(dir, e))?;
+    tmp.write_all(bytes).map_err(|e| Error::io(path, e))?;
+    tmp.as_file().sync_all().map_err(|e| Error::io(path, e))?;
+    tmp.persist(path).map_err(|e| Error::io(path, e.error))?;
+    Ok(())
+}

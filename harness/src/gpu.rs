@@ -1,0 +1,237 @@
+//! Headless wgpu context: adapter choice, device creation with optional features, and an error
+//! sink so that GPU validation errors become [`Error::Gpu`] instead of panics.
+//!
+//! Adapter choice: `--backend` (vulkan, gl, metal, dx12) restricts the backends;
+//! `--adapter NAME` keeps adapters whose name contains NAME (case-insensitive). Among what is
+//! left the harness prefers a hardware adapter (discrete, integrated, virtual), then a CPU Vulkan
+//! adapter (Mesa lavapipe), then GL (Mesa llvmpipe), then anything else.
+
+use std::sync::{Arc, Mutex};
+
+use crate::results::DeviceInfo;
+use crate::{Error, Result};
+
+/// How to choose the adapter.
+#[derive(Clone, Debug, Default)]
+pub struct GpuOptions {
+    /// `vulkan`, `gl`, `metal`, `dx12`, or `None` for all.
+    pub backend: Option<String>,
+    /// Case-insensitive substring of the adapter name.
+    pub adapter: Option<String>,
+}
+
+/// Optional features the harness uses when the adapter has them.
+const OPTIONAL_FEATURES: wgpu::Features =
+    wgpu::Features::TIMESTAMP_QUERY.union(wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS);
+
+/// The device and what it can do.
+pub struct GpuContext {
+    pub instance: wgpu::Instance,
+    pub adapter: wgpu::Adapter,
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+    pub info: DeviceInfo,
+    /// Timestamp queries can be written between passes (`write_timestamp` on encoders).
+    pub timestamps: bool,
+    errors: Arc<Mutex<Vec<String>>>,
+}
+
+fn parse_backend(name: &str) -> Result<wgpu::Backends> {
+    Ok(match name.to_ascii_lowercase().as_str() {
+        "vulkan" | "vk" => wgpu::Backends::VULKAN,
+        "gl" | "gles" | "opengl" => wgpu::Backends::GL,
+        "metal" => wgpu::Backends::METAL,
+        "dx12" | "d3d12" => wgpu::Backends::DX12,
+        "all" | "" => wgpu::Backends::all(),
+        other => {
+            return Err(Error::param(
+                "backend",
+                format!("unknown backend '{other}'; expected one of vulkan, gl, metal, dx12"),
+            ))
+        }
+    })
+}
+
+/// Lower is better: hardware, then CPU Vulkan, then GL, then the rest.
+fn preference(info: &wgpu::AdapterInfo) -> u32 {
+    use wgpu::{Backend, DeviceType};
+    match (info.backend, info.device_type) {
+        (Backend::Gl, _) => 2,
+        (_, DeviceType::DiscreteGpu) => 0,
+        (_, DeviceType::IntegratedGpu | DeviceType::VirtualGpu) => 0,
+        (Backend::Vulkan, DeviceType::Cpu) => 1,
+        _ => 3,
+    }
+}
+
+const NO_ADAPTER_HELP: &str = "no GPU adapter found. gibench needs a Vulkan driver or OpenGL; \
+on a machine without a GPU install Mesa's CPU drivers (Debian/Ubuntu: \
+`apt-get install mesa-vulkan-drivers` for lavapipe; llvmpipe GL comes with libgl1-mesa-dri)";
+
+impl GpuContext {
+    /// Picks an adapter and creates the device.
+    pub fn new(opts: &GpuOptions) -> Result<GpuContext> {
+        let backends = match &opts.backend {
+            Some(b) => parse_backend(b)?,
+            None => wgpu::Backends::all(),
+        };
+        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
+        desc.backends = backends;
+        let instance = wgpu::Instance::new(desc);
+        // GL is asked only when no other backend offers an adapter (or when it is asked for):
+        // probing EGL prints noise on headless machines.
+        let mut adapters =
+            pollster::block_on(instance.enumerate_adapters(backends - wgpu::Backends::GL));
+        let wants_named = |a: &wgpu::Adapter| match &opts.adapter {
+            Some(sub) => a
+                .get_info()
+                .name
+                .to_lowercase()
+                .contains(&sub.to_lowercase()),
+            None => true,
+        };
+        if backends.contains(wgpu::Backends::GL) && !adapters.iter().any(wants_named) {
+            adapters.extend(pollster::block_on(
+                instance.enumerate_adapters(wgpu::Backends::GL),
+            ));
+        }
+        if adapters.is_empty() {
+            let which = opts
+                .backend
+                .as_deref()
+                .map(|b| format!(" for backend '{b}'"))
+                .unwrap_or_default();
+            return Err(Error::Gpu(format!("{NO_ADAPTER_HELP}{which}")));
+        }
+        let names: Vec<String> = adapters
+            .iter()
+            .map(|a| format!("{} ({:?})", a.get_info().name, a.get_info().backend))
+            .collect();
+        let mut candidates: Vec<wgpu::Adapter> = adapters.into_iter().filter(wants_named).collect();
+        if candidates.is_empty() {
+            return Err(Error::param(
+                "adapter",
+                format!(
+                    "no adapter name contains '{}'; available: {}",
+                    opts.adapter.as_deref().unwrap_or(""),
+                    names.join(", ")
+                ),
+            ));
+        }
+        candidates.sort_by_key(|a| preference(&a.get_info()));
+        let adapter = candidates.remove(0);
+        let ai = adapter.get_info();
+        let features = adapter.features() & OPTIONAL_FEATURES;
+        let timestamps = features.contains(OPTIONAL_FEATURES);
+        let features = if timestamps {
+            features
+        } else {
+            wgpu::Features::empty()
+        };
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("gibench"),
+            required_features: features,
+            required_limits: adapter.limits(),
+            ..Default::default()
+        }))
+        .map_err(|e| Error::Gpu(format!("could not create a device on '{}': {e}", ai.name)))?;
+        let errors = Arc::new(Mutex::new(Vec::new()));
+        let sink = errors.clone();
+        device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
+            if let Ok(mut v) = sink.lock() {
+                v.push(e.to_string());
+            }
+        }));
+        let period = if timestamps {
+            queue.get_timestamp_period()
+        } else {
+            0.0
+        };
+        let info = DeviceInfo {
+            adapter: ai.name.clone(),
+            backend: format!("{:?}", ai.backend).to_lowercase(),
+            device_type: format!("{:?}", ai.device_type),
+            driver: ai.driver.clone(),
+            driver_info: ai.driver_info.clone(),
+            timestamp_queries: timestamps,
+            timestamp_period_ns: period,
+        };
+        Ok(GpuContext {
+            instance,
+            adapter,
+            device,
+            queue,
+            info,
+            timestamps,
+            errors,
+        })
+    }
+
+    /// Blocks until all submitted GPU work has finished. Only the profiler and explicit
+    /// readbacks call this.
+    pub fn flush(&self) -> Result<()> {
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| Error::Gpu(format!("waiting for the GPU failed: {e}")))?;
+        self.check_errors()
+    }
+
+    /// Blocks until the given submission has finished.
+    pub fn wait_for(&self, index: wgpu::SubmissionIndex) -> Result<()> {
+        self.device
+            .poll(wgpu::PollType::Wait {
+                submission_index: Some(index),
+                timeout: None,
+            })
+            .map_err(|e| Error::Gpu(format!("waiting for the GPU failed: {e}")))?;
+        Ok(())
+    }
+
+    /// Turns GPU validation errors collected so far into an error.
+    pub fn check_errors(&self) -> Result<()> {
+        let mut v = self
+            .errors
+            .lock()
+            .map_err(|_| Error::Gpu("error sink poisoned".into()))?;
+        if v.is_empty() {
+            Ok(())
+        } else {
+            let msg = v.join("; ");
+            v.clear();
+            Err(Error::Gpu(msg))
+        }
+    }
+
+    /// Whether the device has `features` and at least `limits`; the error names what is missing.
+    pub fn check_requirements(
+        &self,
+        who: &str,
+        features: wgpu::Features,
+        limits: &wgpu::Limits,
+    ) -> Result<()> {
+        let missing = features - self.device.features();
+        if !missing.is_empty() {
+            return Err(Error::Gpu(format!(
+                "{who} needs GPU features {missing:?} which '{}' lacks",
+                self.info.adapter
+            )));
+        }
+        let mut failed = Vec::new();
+        limits.check_limits_with_fail_fn(&self.device.limits(), false, |name, want, have| {
+            failed.push(format!("{name} (needs {want}, has {have})"))
+        });
+        if !failed.is_empty() {
+            return Err(Error::Gpu(format!(
+                "{who} needs limits that '{}' lacks: {}",
+                self.info.adapter,
+                failed.join(", ")
+            )));
+        }
+        Ok(())
+    }
+
+    /// The largest square 2D texture the device supports.
+    pub fn max_texture_2d(&self) -> u32 {
+        self.device.limits().max_texture_dimension_2d
+    }
+}

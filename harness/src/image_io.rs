@@ -1,0 +1,149 @@
+//! Reading textures back from the GPU and writing images: PNG for what a person looks at,
+//! OpenEXR (32-bit float RGB) for irradiance buffers. Both are written atomically.
+
+use std::path::Path;
+
+use crate::gpu::GpuContext;
+use crate::{Error, Result};
+
+/// Copies a 2D texture to the CPU, tightly packed rows (flushes the queue).
+pub fn read_texture(gpu: &GpuContext, texture: &wgpu::Texture) -> Result<Vec<u8>> {
+    let (w, h) = (texture.width(), texture.height());
+    let bpp = texture
+        .format()
+        .block_copy_size(None)
+        .ok_or_else(|| Error::Gpu(format!("cannot read back a {:?} texture", texture.format())))?;
+    let row = w * bpp;
+    let padded =
+        row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+    let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("readback"),
+        size: (padded * h) as u64,
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let mut enc = gpu.device.create_command_encoder(&Default::default());
+    enc.copy_texture_to_buffer(
+        texture.as_image_copy(),
+        wgpu::TexelCopyBufferInfo {
+            buffer: &buffer,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(padded),
+                rows_per_image: Some(h),
+            },
+        },
+        wgpu::Extent3d {
+            width: w,
+            height: h,
+            depth_or_array_layers: 1,
+        },
+    );
+    gpu.queue.submit([enc.finish()]);
+    let slice = buffer.slice(..);
+    slice.map_async(wgpu::MapMode::Read, |_| {});
+    gpu.flush()?;
+    let mapped = slice
+        .get_mapped_range()
+        .map_err(|e| Error::Gpu(format!("mapping a readback buffer failed: {e}")))?;
+    let mut out = Vec::with_capacity((row * h) as usize);
+    for y in 0..h {
+        let start = (y * padded) as usize;
+        out.extend_from_slice(&mapped[start..start + row as usize]);
+    }
+    drop(mapped);
+    buffer.unmap();
+    Ok(out)
+}
+
+/// IEEE half → f32.
+pub fn f16_to_f32(bits: u16) -> f32 {
+    let sign = if bits & 0x8000 != 0 { -1.0 } else { 1.0 };
+    let exp = ((bits >> 10) & 0x1f) as i32;
+    let mant = (bits & 0x3ff) as f32;
+    sign * match exp {
+        0 => mant * 2f32.powi(-24),
+        31 => {
+            if mant == 0.0 {
+                f32::INFINITY
+            } else {
+                f32::NAN
+            }
+        }
+        _ => (1.0 + mant / 1024.0) * 2f32.powi(exp - 15),
+    }
+}
+
+/// Reads an Rgba16Float texture back as RGB f32 triples.
+pub fn read_rgb_f32(gpu: &GpuContext, texture: &wgpu::Texture) -> Result<Vec<[f32; 3]>> {
+    if texture.format() != wgpu::TextureFormat::Rgba16Float {
+        return Err(Error::Gpu(format!(
+            "expected an Rgba16Float texture, got {:?}",
+            texture.format()
+        )));
+    }
+    let bytes = read_texture(gpu, texture)?;
+    Ok(bytes
+        .chunks_exact(8)
+        .map(|c| {
+            let h = |i: usize| f16_to_f32(u16::from_le_bytes([c[2 * i], c[2 * i + 1]]));
+            [h(0), h(1), h(2)]
+        })
+        .collect())
+}
+
+/// Writes an RGBA8 image as PNG.
+pub fn write_png(path: &Path, size: [u32; 2], rgba8: &[u8]) -> Result<()> {
+    let img = image::RgbaImage::from_raw(size[0], size[1], rgba8.to_vec()).ok_or_else(|| {
+        Error::Invalid(format!(
+            "{}: image data does not match {}x{}",
+            path.display(),
+            size[0],
+            size[1]
+        ))
+    })?;
+    let mut bytes = Vec::new();
+    img.write_to(
+        &mut std::io::Cursor::new(&mut bytes),
+        image::ImageFormat::Png,
+    )
+    .map_err(|e| Error::bad_file(path, format!("PNG encoding failed: {e}")))?;
+    crate::error::write_atomic(path, &bytes)
+}
+
+/// Writes RGB floats as a 32-bit float OpenEXR file.
+pub fn write_exr(path: &Path, size: [u32; 2], rgb: &[[f32; 3]]) -> Result<()> {
+    use exr::prelude::{Image, SpecificChannels, Vec2, WritableImage};
+    let (w, h) = (size[0] as usize, size[1] as usize);
+    if rgb.len() != w * h {
+        return Err(Error::Invalid(format!(
+            "{}: image data does not match {w}x{h}",
+            path.display()
+        )));
+    }
+    let channels = SpecificChannels::rgb(|p: Vec2<usize>| {
+        let c = rgb[p.y() * w + p.x()];
+        (c[0], c[1], c[2])
+    });
+    let image = Image::from_channels((w, h), channels);
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    image
+        .write()
+        .to_buffered(&mut bytes)
+        .map_err(|e| Error::bad_file(path, format!("EXR encoding failed: {e}")))?;
+    crate::error::write_atomic(path, bytes.get_ref())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn half_conversion() {
+        assert_eq!(f16_to_f32(0x3c00), 1.0);
+        assert_eq!(f16_to_f32(0xc000), -2.0);
+        assert_eq!(f16_to_f32(0x7bff), 65504.0);
+        assert_eq!(f16_to_f32(0x0001), 2f32.powi(-24));
+        assert!(f16_to_f32(0x7c00).is_infinite());
+    }
+}

@@ -1,0 +1,182 @@
+//! Shared GPU passes, written once and used by every technique (Falcor-style: each pass says
+//! what it reads and writes in its docs, and the runner scopes each one as a profiler stage).
+//!
+//! * [`GpuScene`]: the scene's meshes, materials and textures on the GPU, and how to draw them.
+//! * [`FrameUniforms`]: per-frame camera, cube-face, object and light uniforms.
+//! * [`GBuffer`]: reversed-Z depth, normal and albedo of the camera view; world positions are
+//!   reconstructed from depth (Rgba32Float is not renderable on GL).
+//! * [`DirectLight`]: cube shadow map of the primary light and direct irradiance with 16-tap PCF.
+//! * [`Compose`]: outgoing radiance and its display encoding.
+
+mod compose;
+mod direct;
+mod gbuffer;
+mod scene_gpu;
+
+pub use compose::Compose;
+pub use direct::{needed_cube_faces, DirectLight, CUBE_FACES};
+pub use gbuffer::{GBuffer, GBufferTexels};
+pub use scene_gpu::{
+    cube_face_matrix, light_axis_intensity, FrameUniforms, GpuScene, Vertex, MAX_MATERIALS,
+};
+
+/// WGSL declared once and prepended to every shader (View, Light, helpers).
+pub const COMMON_WGSL: &str = include_str!("shaders/common.wgsl");
+
+/// Creates a shader module from `source` with [`COMMON_WGSL`] prepended.
+pub fn shader_module(device: &wgpu::Device, label: &str, source: &str) -> wgpu::ShaderModule {
+    let full = format!("{COMMON_WGSL}\n{source}");
+    device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(label),
+        source: wgpu::ShaderSource::Wgsl(full.into()),
+    })
+}
+
+/// Format of every irradiance and radiance buffer (renderable on Vulkan and GL).
+pub const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+
+/// A uniform-buffer layout entry.
+pub fn uniform_entry(
+    binding: u32,
+    visibility: wgpu::ShaderStages,
+    dynamic: bool,
+) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: dynamic,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+/// A sampled-texture layout entry.
+pub fn texture_entry(
+    binding: u32,
+    visibility: wgpu::ShaderStages,
+    sample_type: wgpu::TextureSampleType,
+    dim: wgpu::TextureViewDimension,
+) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Texture {
+            sample_type,
+            view_dimension: dim,
+            multisampled: false,
+        },
+        count: None,
+    }
+}
+
+/// A full-resolution 2D render target.
+pub fn render_target(
+    device: &wgpu::Device,
+    label: &str,
+    size: [u32; 2],
+    format: wgpu::TextureFormat,
+) -> wgpu::Texture {
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d {
+            width: size[0],
+            height: size[1],
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+            | wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::COPY_SRC,
+        view_formats: &[],
+    })
+}
+
+/// A fullscreen-triangle render pipeline (vertex `vs_main`, fragment `fs_main`).
+pub fn fullscreen_pipeline(
+    device: &wgpu::Device,
+    label: &str,
+    module: &wgpu::ShaderModule,
+    layouts: &[&wgpu::BindGroupLayout],
+    targets: &[wgpu::TextureFormat],
+) -> wgpu::RenderPipeline {
+    let layouts: Vec<Option<&wgpu::BindGroupLayout>> = layouts.iter().map(|l| Some(*l)).collect();
+    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(label),
+        bind_group_layouts: &layouts,
+        immediate_size: 0,
+    });
+    let targets: Vec<Option<wgpu::ColorTargetState>> = targets
+        .iter()
+        .map(|f| {
+            Some(wgpu::ColorTargetState {
+                format: *f,
+                blend: None,
+                write_mask: wgpu::ColorWrites::ALL,
+            })
+        })
+        .collect();
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(label),
+        layout: Some(&layout),
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some("vs_main"),
+            compilation_options: Default::default(),
+            buffers: &[],
+        },
+        primitive: wgpu::PrimitiveState::default(),
+        depth_stencil: None,
+        multisample: wgpu::MultisampleState::default(),
+        fragment: Some(wgpu::FragmentState {
+            module,
+            entry_point: Some("fs_main"),
+            compilation_options: Default::default(),
+            targets: &targets,
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
+/// Runs a fullscreen pass writing `targets` (cleared to zero first).
+pub fn draw_fullscreen(
+    encoder: &mut wgpu::CommandEncoder,
+    label: &str,
+    pipeline: &wgpu::RenderPipeline,
+    bind_groups: &[&wgpu::BindGroup],
+    targets: &[&wgpu::TextureView],
+) {
+    let attachments: Vec<Option<wgpu::RenderPassColorAttachment>> = targets
+        .iter()
+        .map(|view| {
+            Some(wgpu::RenderPassColorAttachment {
+                view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                    store: wgpu::StoreOp::Store,
+                },
+            })
+        })
+        .collect();
+    let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some(label),
+        color_attachments: &attachments,
+        depth_stencil_attachment: None,
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    });
+    pass.set_pipeline(pipeline);
+    for (i, bg) in bind_groups.iter().enumerate() {
+        pass.set_bind_group(i as u32, *bg, &[]);
+    }
+    pass.draw(0..3, 0..1);
+}

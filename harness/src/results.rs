@@ -1,0 +1,141 @@
+//! The results schema: one JSON file per (scene, technique) run, versioned, written atomically.
+//! Tables and plots are rendered from these files only ([`crate::report`]).
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use crate::stats::Stats;
+use crate::{Error, Result};
+
+/// Bumped whenever a field changes meaning or is removed.
+pub const SCHEMA_VERSION: u32 = 1;
+
+/// How a stage was run and timed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum StageKind {
+    /// GPU work, timed by timestamps and by flushed CPU wall time.
+    Gpu,
+    /// CPU work, timed by wall time.
+    Cpu,
+}
+
+/// Timings of one named stage over the measured frames (milliseconds).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct StageResult {
+    pub name: String,
+    pub kind: StageKind,
+    /// GPU timestamps (end − start) per frame; absent when the adapter has no timestamp queries
+    /// or the run did not time stages.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gpu_ms: Option<Stats>,
+    /// CPU wall time with the queue flushed before and after the stage (Laine et al. 2007's
+    /// per-task method); for CPU stages, plain wall time.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub wall_ms: Option<Stats>,
+}
+
+/// Whole-frame timings with no added synchronisation (Laine's FPS column).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FrameResult {
+    /// Time between consecutive frame starts, with at most `frames_in_flight` frames queued.
+    pub frame_ms: Stats,
+    /// 1000 / mean frame time.
+    pub fps: f64,
+    pub frames_in_flight: u32,
+}
+
+/// What the run was run on.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct DeviceInfo {
+    pub adapter: String,
+    pub backend: String,
+    pub device_type: String,
+    pub driver: String,
+    pub driver_info: String,
+    pub timestamp_queries: bool,
+    /// Nanoseconds per timestamp tick.
+    pub timestamp_period_ns: f32,
+}
+
+/// Frames: how many were measured, how many warm-up frames were dropped before them.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct FrameRange {
+    pub warmup: u32,
+    pub measured: u32,
+    /// Frame index of the first measured frame in the animation.
+    pub first: u32,
+}
+
+/// One run of one technique on one scene.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RunResult {
+    pub schema_version: u32,
+    pub gibench_version: String,
+    /// `git describe --always --dirty` of the checkout, if known.
+    pub git_commit: String,
+    /// Seconds since the Unix epoch when the run finished.
+    pub timestamp: u64,
+    pub scene: String,
+    pub technique: String,
+    /// The technique's parameters after defaults were applied.
+    pub parameters: BTreeMap<String, serde_json::Value>,
+    /// Harness settings shared by all techniques (shadow-map size, PCF taps, ...).
+    pub settings: BTreeMap<String, serde_json::Value>,
+    pub resolution: [u32; 2],
+    pub frames: FrameRange,
+    pub seed: u64,
+    /// `stages`, `frame` or `both`.
+    pub timing_mode: String,
+    pub device: DeviceInfo,
+    /// In execution order.
+    pub stages: Vec<StageResult>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub frame: Option<FrameResult>,
+    /// Per-stage counters averaged over measured frames (e.g. shadow maps rendered).
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub counters: BTreeMap<String, Stats>,
+    /// Images written next to the results file (relative paths).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub images: Vec<String>,
+}
+
+impl RunResult {
+    /// Writes the result as pretty JSON, atomically.
+    pub fn write(&self, path: &Path) -> Result<()> {
+        let json =
+            serde_json::to_vec_pretty(self).map_err(|e| Error::bad_file(path, e.to_string()))?;
+        crate::error::write_atomic(path, &json)
+    }
+
+    /// Reads and checks a results file.
+    pub fn read(path: &Path) -> Result<RunResult> {
+        let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+        let r: RunResult = serde_json::from_slice(&bytes)
+            .map_err(|e| Error::bad_file(path, format!("not a gibench results file: {e}")))?;
+        if r.schema_version != SCHEMA_VERSION {
+            return Err(Error::bad_file(
+                path,
+                format!(
+                    "results schema version {} (this gibench reads version {SCHEMA_VERSION})",
+                    r.schema_version
+                ),
+            ));
+        }
+        Ok(r)
+    }
+
+    /// The stage named `name`, if any.
+    pub fn stage(&self, name: &str) -> Option<&StageResult> {
+        self.stages.iter().find(|s| s.name == name)
+    }
+}
+
+impl StageResult {
+    /// The best available per-stage time: median GPU timestamp time, else median flushed wall time.
+    pub fn best_ms(&self) -> Option<f64> {
+        self.gpu_ms.or(self.wall_ms).map(|s| s.median)
+    }
+}

@@ -1,0 +1,367 @@
+//! The frame loop every technique runs through: the same frames, the same shared passes and
+//! the same profiler.
+//!
+//! Per frame: upload uniforms → `gbuffer` → `direct-shadow-map` → `direct-light` → the
+//! technique's own stages → `compose`. With [`TimingMode::Both`] the whole animation is run
+//! twice with a freshly built technique: once timing every stage (flushes between stages), once
+//! timing whole frames with no added synchronisation.
+
+use std::collections::BTreeMap;
+
+use serde_json::Value;
+
+use crate::anim::{FrameClock, FrameState};
+use crate::bvh::SceneBvh;
+use crate::gpu::GpuContext;
+use crate::passes::{Compose, DirectLight, FrameUniforms, GBuffer, GpuScene};
+use crate::profiler::{ProfileMode, Profiler};
+use crate::results::{FrameRange, RunResult, SCHEMA_VERSION};
+use crate::scene::Scene;
+use crate::technique::{FrameContext, Params, PrepareContext, Technique, TechniqueInfo};
+use crate::{Error, Result};
+
+/// Which timings a run takes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TimingMode {
+    /// Per-stage times only (GPU timestamps and flushed wall time).
+    Stages,
+    /// Whole-frame times only (no added synchronisation).
+    Frame,
+    /// Both, in two passes over the same frames.
+    Both,
+}
+
+impl TimingMode {
+    pub fn parse(s: &str) -> Result<TimingMode> {
+        match s {
+            "stages" => Ok(TimingMode::Stages),
+            "frame" => Ok(TimingMode::Frame),
+            "both" => Ok(TimingMode::Both),
+            _ => Err(Error::param(
+                "timing",
+                format!("expected stages, frame or both (got '{s}')"),
+            )),
+        }
+    }
+    pub fn name(self) -> &'static str {
+        match self {
+            TimingMode::Stages => "stages",
+            TimingMode::Frame => "frame",
+            TimingMode::Both => "both",
+        }
+    }
+    fn passes(self) -> &'static [ProfileMode] {
+        match self {
+            TimingMode::Stages => &[ProfileMode::Stages],
+            TimingMode::Frame => &[ProfileMode::Frame],
+            TimingMode::Both => &[ProfileMode::Stages, ProfileMode::Frame],
+        }
+    }
+}
+
+/// Largest width or height accepted before asking the device.
+pub const MAX_RESOLUTION: u32 = 16384;
+
+/// Settings of one run.
+#[derive(Clone, Debug)]
+pub struct RunConfig {
+    pub resolution: [u32; 2],
+    /// Measured frames.
+    pub frames: u32,
+    /// Warm-up frames run before the measured ones and dropped.
+    pub warmup: u32,
+    /// Animation frame of the first warm-up frame.
+    pub first_frame: u32,
+    pub timing: TimingMode,
+    pub seed: u64,
+    /// Edge length of each face of the direct light's cube shadow map.
+    pub shadow_size: u32,
+}
+
+impl RunConfig {
+    /// Checks the settings that need no GPU.
+    pub fn validate(&self) -> Result<()> {
+        let [w, h] = self.resolution;
+        if w == 0 || h == 0 {
+            return Err(Error::param(
+                "resolution",
+                format!("width and height must be at least 1 (got {w}x{h})"),
+            ));
+        }
+        if w > MAX_RESOLUTION || h > MAX_RESOLUTION {
+            return Err(Error::param(
+                "resolution",
+                format!("{w}x{h} exceeds the limit of {MAX_RESOLUTION} per side"),
+            ));
+        }
+        if self.frames == 0 {
+            return Err(Error::param(
+                "frames",
+                "at least one measured frame is needed (got 0)",
+            ));
+        }
+        if !(16..=MAX_RESOLUTION).contains(&self.shadow_size) {
+            return Err(Error::param(
+                "shadow-size",
+                format!("expected 16..={MAX_RESOLUTION} (got {})", self.shadow_size),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Harness settings recorded in every result.
+    pub fn settings(&self) -> BTreeMap<String, Value> {
+        let mut m = BTreeMap::new();
+        m.insert(
+            "direct_shadow_map".into(),
+            Value::from(format!("cube {0}x{0} Depth32Float", self.shadow_size)),
+        );
+        m.insert("direct_pcf_taps".into(), Value::from(16));
+        m.insert(
+            "frames_in_flight".into(),
+            Value::from(crate::profiler::FRAMES_IN_FLIGHT),
+        );
+        m
+    }
+}
+
+/// The last frame's images.
+pub struct FrameImages {
+    pub size: [u32; 2],
+    /// sRGB RGBA8 of the composed image.
+    pub display: Vec<u8>,
+    pub indirect: Vec<[f32; 3]>,
+    pub direct: Vec<[f32; 3]>,
+}
+
+/// Everything that is shared by all techniques on one scene.
+pub struct Harness<'a> {
+    pub gpu: &'a GpuContext,
+    pub scene: &'a Scene,
+    pub bvh: SceneBvh,
+    pub gpu_scene: GpuScene,
+    pub uniforms: FrameUniforms,
+    pub gbuffer: GBuffer,
+    pub direct: DirectLight,
+    pub clock: FrameClock,
+}
+
+impl<'a> Harness<'a> {
+    /// Uploads the scene and builds the shared passes for `config`.
+    pub fn new(gpu: &'a GpuContext, scene: &'a Scene, config: &RunConfig) -> Result<Harness<'a>> {
+        config.validate()?;
+        let max = gpu.max_texture_2d();
+        let [w, h] = config.resolution;
+        if w > max || h > max {
+            return Err(Error::param(
+                "resolution",
+                format!("{w}x{h} exceeds the adapter's limit of {max} per side"),
+            ));
+        }
+        if config.shadow_size > max {
+            return Err(Error::param(
+                "shadow-size",
+                format!(
+                    "{} exceeds the adapter's limit of {max}",
+                    config.shadow_size
+                ),
+            ));
+        }
+        let gpu_scene = GpuScene::new(&gpu.device, &gpu.queue, scene)?;
+        let uniforms = FrameUniforms::new(
+            &gpu.device,
+            &gpu_scene,
+            config.resolution,
+            config.shadow_size,
+            scene.descriptor.settings.shadow_bias,
+        );
+        let gbuffer = GBuffer::new(gpu, &gpu_scene, &uniforms);
+        let direct = DirectLight::new(gpu, &gpu_scene, &uniforms, &gbuffer);
+        gpu.check_errors()?;
+        Ok(Harness {
+            gpu,
+            scene,
+            bvh: SceneBvh::new(&scene.mesh),
+            gpu_scene,
+            uniforms,
+            gbuffer,
+            direct,
+            clock: FrameClock::new(&scene.descriptor),
+        })
+    }
+
+    fn prepare_context(&self, config: &RunConfig) -> PrepareContext<'_> {
+        PrepareContext {
+            gpu: self.gpu,
+            scene: self.scene,
+            bvh: &self.bvh,
+            gpu_scene: &self.gpu_scene,
+            gbuffer: &self.gbuffer,
+            uniforms: &self.uniforms,
+            resolution: config.resolution,
+            seed: config.seed,
+        }
+    }
+
+    /// Records one frame: shared passes, the technique's stages, compose.
+    pub fn render_frame(
+        &self,
+        technique: &mut dyn Technique,
+        compose: &Compose,
+        profiler: &mut Profiler,
+        frame: &FrameState,
+        measured: bool,
+    ) -> Result<()> {
+        let gpu = self.gpu;
+        profiler.begin_frame(measured);
+        self.uniforms.write(&gpu.queue, frame);
+        profiler.gpu_stage(gpu, "gbuffer", |enc| {
+            self.gbuffer.encode(enc, &self.gpu_scene, &self.uniforms)
+        })?;
+        let faces = profiler.gpu_stage(gpu, "direct-shadow-map", |enc| {
+            self.direct
+                .encode_shadow_map(enc, &self.gpu_scene, &self.uniforms, &frame.light)
+        })?;
+        profiler.count("direct-shadow-faces", faces as f64);
+        profiler.gpu_stage(gpu, "direct-light", |enc| {
+            self.direct.encode_lighting(enc, &self.gbuffer)
+        })?;
+        technique.render(&mut FrameContext {
+            gpu,
+            scene: self.scene,
+            bvh: &self.bvh,
+            gpu_scene: &self.gpu_scene,
+            gbuffer: &self.gbuffer,
+            uniforms: &self.uniforms,
+            frame,
+            profiler,
+        })?;
+        profiler.gpu_stage(gpu, "compose", |enc| compose.encode(enc, &self.gbuffer))?;
+        profiler.end_frame(gpu)
+    }
+
+    /// Builds a fresh technique and the compose pass bound to its output.
+    pub fn build(
+        &self,
+        info: &TechniqueInfo,
+        params: &Params,
+        config: &RunConfig,
+    ) -> Result<(Box<dyn Technique>, Compose)> {
+        self.gpu.check_requirements(
+            &format!("technique '{}'", info.name),
+            info.required_features,
+            &(info.required_limits)(),
+        )?;
+        let technique = (info.create)(params, &self.prepare_context(config))?;
+        let compose = Compose::new(
+            self.gpu,
+            &self.gbuffer,
+            &self.direct.irradiance_view,
+            technique.output(),
+            self.scene.descriptor.settings.exposure,
+        );
+        self.gpu.check_errors()?;
+        Ok((technique, compose))
+    }
+
+    /// Runs `info` with `params` over the configured frames and returns its result (without
+    /// image paths) and the last frame's images. `progress` is called after every frame.
+    pub fn run(
+        &self,
+        info: &TechniqueInfo,
+        params: &Params,
+        config: &RunConfig,
+        progress: &mut dyn FnMut(),
+    ) -> Result<(RunResult, FrameImages)> {
+        let mut stages = Vec::new();
+        let mut counters = BTreeMap::new();
+        let mut frame_result = None;
+        let mut images = None;
+        for &mode in config.timing.passes() {
+            let (mut technique, compose) = self.build(info, params, config)?;
+            let mut profiler = Profiler::new(self.gpu, mode);
+            let total = config.warmup + config.frames;
+            for i in 0..total {
+                let frame = self.clock.frame(config.first_frame + i);
+                self.render_frame(
+                    technique.as_mut(),
+                    &compose,
+                    &mut profiler,
+                    &frame,
+                    i >= config.warmup,
+                )?;
+                progress();
+            }
+            profiler.finish(self.gpu)?;
+            match mode {
+                ProfileMode::Stages => {
+                    stages = profiler.stage_results();
+                    counters = profiler.counter_results();
+                }
+                ProfileMode::Frame => {
+                    frame_result = profiler.frame_result();
+                    if stages.is_empty() {
+                        // Frame-only runs still report CPU stages and counters.
+                        stages = profiler.stage_results();
+                        counters = profiler.counter_results();
+                    }
+                }
+            }
+            images = Some(FrameImages {
+                size: config.resolution,
+                display: crate::image_io::read_texture(self.gpu, &compose.display)?,
+                indirect: self.read_technique_output(technique.as_ref())?,
+                direct: crate::image_io::read_rgb_f32(self.gpu, &self.direct.irradiance)?,
+            });
+        }
+        let result = RunResult {
+            schema_version: SCHEMA_VERSION,
+            gibench_version: env!("CARGO_PKG_VERSION").to_string(),
+            git_commit: git_commit(),
+            timestamp: std::time::SystemTime::now()
+                .duration_since(std::time::UNIX_EPOCH)
+                .map(|d| d.as_secs())
+                .unwrap_or(0),
+            scene: self.scene.descriptor.name.clone(),
+            technique: info.name.to_string(),
+            parameters: params.to_map(),
+            settings: config.settings(),
+            resolution: config.resolution,
+            frames: FrameRange {
+                warmup: config.warmup,
+                measured: config.frames,
+                first: config.first_frame + config.warmup,
+            },
+            seed: config.seed,
+            timing_mode: config.timing.name().to_string(),
+            device: self.gpu.info.clone(),
+            stages,
+            frame: frame_result,
+            counters,
+            images: Vec::new(),
+        };
+        Ok((result, images.expect("at least one timing pass")))
+    }
+
+    fn read_technique_output(&self, technique: &dyn Technique) -> Result<Vec<[f32; 3]>> {
+        let tex = technique.output().texture();
+        crate::image_io::read_rgb_f32(self.gpu, tex)
+    }
+}
+
+/// `git describe --always --dirty` of the source checkout gibench was built from, or "unknown".
+pub fn git_commit() -> String {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .unwrap_or(std::path::Path::new("."));
+    std::process::Command::new("git")
+        .arg("-C")
+        .arg(dir)
+        .args(["describe", "--always", "--dirty"])
+        .output()
+        .ok()
+        .filter(|o| o.status.success())
+        .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
+        .filter(|s| !s.is_empty())
+        .unwrap_or_else(|| "unknown".into())
+}

@@ -1,0 +1,814 @@
+//! Scene descriptors: JSON files in `scenes/` that say which mesh to load, how the camera, the
+//! primary light and the movers move, and per-scene settings. Unknown fields are errors that
+//! name the field (serde `deny_unknown_fields`).
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use crate::{Error, Result};
+
+/// The only name `generated` mesh sources accept.
+pub const GENERATED_CORNELL_BOX: &str = "cornell-box";
+
+/// Where a mesh comes from: exactly one of `file` (a glTF binary on the asset search path) or
+/// `generated` (a scene built in code, e.g. `"cornell-box"`).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeshSource {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub file: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub generated: Option<String>,
+    /// Generated meshes only: split every quad into cells of about this edge length.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tessellate: Option<f32>,
+}
+
+/// One keyframe of a path: where the object is and what it looks at.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Key {
+    /// Seconds from the start of the animation.
+    pub time: f32,
+    pub position: [f32; 3],
+    /// Camera and lights: the point looked at (spot/area direction). Movers: the point the
+    /// object's +Z axis faces (horizontal component only); omitted → no rotation.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub target: Option<[f32; 3]>,
+}
+
+/// What happens after the last key.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Wrap {
+    /// Jump back to the first key (the path should end where it starts).
+    #[default]
+    Loop,
+    /// Run the path backwards, then forwards again.
+    PingPong,
+    /// Stay at the last key.
+    Clamp,
+}
+
+/// A keyframed path, interpolated with centripetal-free uniform Catmull–Rom splines.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PathDesc {
+    pub keys: Vec<Key>,
+    #[serde(default)]
+    pub wrap: Wrap,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraDesc {
+    /// Vertical field of view in degrees.
+    pub fov_y_deg: f32,
+    /// Near plane distance (scene units).
+    pub near: f32,
+    pub path: PathDesc,
+}
+
+/// Kinds of primary light.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum LightKind {
+    /// 180° spot light with cosine falloff (Laine et al. 2007).
+    Spot,
+    /// Omnidirectional point light.
+    Omni,
+    /// One-sided Lambertian rectangle of `size`, facing its target.
+    Area,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LightDesc {
+    pub kind: LightKind,
+    /// Total emitted flux Φ, linear RGB (see the harness's radiometric convention).
+    pub power: [f32; 3],
+    /// Area lights: width and height in scene units.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub size: Option<[f32; 2]>,
+    pub path: PathDesc,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MoverDesc {
+    pub name: String,
+    pub mesh: MeshSource,
+    /// Uniform scale applied to the mesh before the path's transform.
+    #[serde(default = "one")]
+    pub scale: f32,
+    pub path: PathDesc,
+}
+
+/// Per-scene settings that depend on the scene's scale or look.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneSettings {
+    /// Laine's α: the geometry-aware filter's distance threshold (scene units).
+    pub filter_distance: f32,
+    /// Laine's β: the filter's normal threshold (cosine).
+    #[serde(default = "default_beta")]
+    pub filter_normal: f32,
+    /// Multiplier applied to radiance before PNG encoding.
+    #[serde(default = "one")]
+    pub exposure: f32,
+    /// Shadow-map depth bias as a fraction of the distance to the light.
+    #[serde(default = "default_bias")]
+    pub shadow_bias: f32,
+}
+
+fn one() -> f32 {
+    1.0
+}
+fn default_beta() -> f32 {
+    0.8
+}
+fn default_bias() -> f32 {
+    0.01
+}
+
+impl Default for SceneSettings {
+    fn default() -> Self {
+        SceneSettings {
+            filter_distance: 1.0,
+            filter_normal: default_beta(),
+            exposure: 1.0,
+            shadow_bias: default_bias(),
+        }
+    }
+}
+
+/// A whole scene descriptor.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneDescriptor {
+    pub name: String,
+    #[serde(default)]
+    pub description: String,
+    pub mesh: MeshSource,
+    /// Tessellated copy of the static mesh for paraboloid VPL shadow maps.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shadow_mesh: Option<MeshSource>,
+    pub camera: CameraDesc,
+    pub light: LightDesc,
+    #[serde(default)]
+    pub movers: Vec<MoverDesc>,
+    pub settings: SceneSettings,
+    /// Animation frames per second: frame i is at time i / fps.
+    #[serde(default = "default_fps")]
+    pub fps: f32,
+}
+
+fn default_fps() -> f32 {
+    30.0
+}
+
+/// Built-in descriptors (the JSON files in the workspace's `scenes/` directory), embedded at
+/// compile time: (name, JSON text).
+const BUILTINS: &[(&str, &str)] = &[
+    ("cornell", include_str!("../../../scenes/cornell.json")),
+    (
+        "cornell-gltf",
+        include_str!("../../../scenes/cornell-gltf.json"),
+    ),
+    (
+        "cornell-bunny",
+        include_str!("../../../scenes/cornell-bunny.json"),
+    ),
+    ("sibenik", include_str!("../../../scenes/sibenik.json")),
+    ("sponza", include_str!("../../../scenes/sponza.json")),
+    (
+        "conference",
+        include_str!("../../../scenes/conference.json"),
+    ),
+];
+
+/// Names of the built-in scene descriptors, in a fixed order.
+pub fn builtin_names() -> Vec<&'static str> {
+    BUILTINS.iter().map(|(name, _)| *name).collect()
+}
+
+/// A validation failure: `field: message`, reported against the descriptor's file.
+fn invalid(path: &Path, field: &str, message: impl std::fmt::Display) -> Error {
+    Error::bad_file(path, format!("{field}: {message}"))
+}
+
+fn check_finite3(path: &Path, field: &str, v: &[f32; 3]) -> Result<()> {
+    if v.iter().all(|c| c.is_finite()) {
+        Ok(())
+    } else {
+        Err(invalid(
+            path,
+            field,
+            format!("every component must be a finite number, got {v:?}"),
+        ))
+    }
+}
+
+impl SceneDescriptor {
+    /// Parses a descriptor from JSON `text`. Syntax errors, missing or unknown fields and wrong
+    /// types become [`Error::BadFile`] with serde's message (which names the field and gives
+    /// the line and column) reported against `path_for_errors`. Does not [`validate`](Self::validate).
+    pub fn from_json(path_for_errors: &Path, text: &str) -> Result<Self> {
+        serde_json::from_str(text).map_err(|e| Error::bad_file(path_for_errors, e.to_string()))
+    }
+
+    /// Checks the values serde cannot: mesh sources, key times, camera and light parameters and
+    /// settings. The first problem found is returned as [`Error::BadFile`] against
+    /// `path_for_errors`, with a message that starts with the offending field, e.g.
+    /// `light.size: area lights need a [width, height] size`.
+    pub fn validate(&self, path_for_errors: &Path) -> Result<()> {
+        let p = path_for_errors;
+        validate_mesh_source(p, "mesh", &self.mesh)?;
+        if let Some(shadow) = &self.shadow_mesh {
+            validate_mesh_source(p, "shadow_mesh", shadow)?;
+        }
+
+        let cam = &self.camera;
+        if !(cam.fov_y_deg.is_finite() && cam.fov_y_deg > 0.0 && cam.fov_y_deg < 180.0) {
+            return Err(invalid(
+                p,
+                "camera.fov_y_deg",
+                format!("must be in (0, 180) degrees, got {}", cam.fov_y_deg),
+            ));
+        }
+        if !(cam.near.is_finite() && cam.near > 0.0) {
+            return Err(invalid(
+                p,
+                "camera.near",
+                format!("must be a positive distance, got {}", cam.near),
+            ));
+        }
+        validate_path(
+            p,
+            "camera.path",
+            &cam.path,
+            TargetRule::Required("the camera needs a point to look at"),
+        )?;
+
+        let light = &self.light;
+        if light.power.iter().any(|c| !c.is_finite() || *c < 0.0) {
+            return Err(invalid(
+                p,
+                "light.power",
+                format!(
+                    "every component must be a finite flux >= 0, got {:?}",
+                    light.power
+                ),
+            ));
+        }
+        if light.power.iter().all(|c| *c == 0.0) {
+            return Err(invalid(
+                p,
+                "light.power",
+                "is zero; the light would emit nothing",
+            ));
+        }
+        match (light.kind, light.size) {
+            (LightKind::Area, None) => {
+                return Err(invalid(
+                    p,
+                    "light.size",
+                    "area lights need a [width, height] size",
+                ));
+            }
+            (LightKind::Area, Some(size)) if size.iter().any(|s| !s.is_finite() || *s <= 0.0) => {
+                return Err(invalid(
+                    p,
+                    "light.size",
+                    format!("width and height must be positive, got {size:?}"),
+                ));
+            }
+            (LightKind::Spot | LightKind::Omni, Some(_)) => {
+                return Err(invalid(p, "light.size", "only area lights have a size"));
+            }
+            _ => {}
+        }
+        let rule = match light.kind {
+            LightKind::Omni => TargetRule::Optional,
+            LightKind::Spot => TargetRule::Required("spot lights point at their target"),
+            LightKind::Area => TargetRule::Required("area lights face their target"),
+        };
+        validate_path(p, "light.path", &light.path, rule)?;
+
+        for (i, mover) in self.movers.iter().enumerate() {
+            let field = format!("movers[{i}]");
+            if mover.name.trim().is_empty() {
+                return Err(invalid(p, &format!("{field}.name"), "must not be empty"));
+            }
+            validate_mesh_source(p, &format!("{field}.mesh"), &mover.mesh)?;
+            if !(mover.scale.is_finite() && mover.scale > 0.0) {
+                return Err(invalid(
+                    p,
+                    &format!("{field}.scale"),
+                    format!("must be positive, got {}", mover.scale),
+                ));
+            }
+            validate_path(
+                p,
+                &format!("{field}.path"),
+                &mover.path,
+                TargetRule::Optional,
+            )?;
+        }
+
+        let s = &self.settings;
+        if !(s.filter_distance.is_finite() && s.filter_distance > 0.0) {
+            return Err(invalid(
+                p,
+                "settings.filter_distance",
+                format!("must be a positive distance, got {}", s.filter_distance),
+            ));
+        }
+        if !(s.filter_normal.is_finite() && (-1.0..=1.0).contains(&s.filter_normal)) {
+            return Err(invalid(
+                p,
+                "settings.filter_normal",
+                format!(
+                    "is a cosine and must be in [-1, 1], got {}",
+                    s.filter_normal
+                ),
+            ));
+        }
+        if !(s.exposure.is_finite() && s.exposure > 0.0) {
+            return Err(invalid(
+                p,
+                "settings.exposure",
+                format!("must be positive, got {}", s.exposure),
+            ));
+        }
+        if !(s.shadow_bias.is_finite() && s.shadow_bias >= 0.0) {
+            return Err(invalid(
+                p,
+                "settings.shadow_bias",
+                format!("must be >= 0, got {}", s.shadow_bias),
+            ));
+        }
+        if !(self.fps.is_finite() && self.fps > 0.0) {
+            return Err(invalid(
+                p,
+                "fps",
+                format!("must be positive, got {}", self.fps),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Finds a descriptor by built-in name (see [`builtin_names`]) or as a path to a JSON file,
+    /// then parses and validates it.
+    ///
+    /// A built-in name wins over a file of the same name in the current directory. Anything
+    /// that is not a built-in name but ends in `.json` or contains a path separator is read as
+    /// a file ([`Error::Io`] if it cannot be read). Anything else is [`Error::Invalid`] listing
+    /// the built-in names.
+    pub fn resolve(name_or_path: &str) -> Result<Self> {
+        if let Some((name, text)) = BUILTINS.iter().find(|(name, _)| *name == name_or_path) {
+            let path = PathBuf::from(format!("scenes/{name}.json"));
+            let desc = Self::from_json(&path, text)?;
+            desc.validate(&path)?;
+            return Ok(desc);
+        }
+        let path = Path::new(name_or_path);
+        let looks_like_path = name_or_path.ends_with(".json")
+            || name_or_path.contains('/')
+            || name_or_path.contains(std::path::MAIN_SEPARATOR)
+            || path.is_file();
+        if !looks_like_path {
+            return Err(Error::Invalid(format!(
+                "unknown scene '{name_or_path}'; built-in scenes are: {}; or give the path of a .json scene descriptor",
+                builtin_names().join(", ")
+            )));
+        }
+        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        let desc = Self::from_json(path, &text)?;
+        desc.validate(path)?;
+        Ok(desc)
+    }
+}
+
+/// Whether the keys of a path must, may or must not carry a `target`.
+enum TargetRule {
+    /// Every key needs a target; the string says why.
+    Required(&'static str),
+    /// Either every key has a target or none has.
+    Optional,
+}
+
+fn validate_mesh_source(p: &Path, field: &str, src: &MeshSource) -> Result<()> {
+    match (&src.file, &src.generated) {
+        (Some(_), Some(_)) => {
+            return Err(invalid(
+                p,
+                field,
+                "give either `file` or `generated`, not both",
+            ));
+        }
+        (None, None) => {
+            return Err(invalid(
+                p,
+                field,
+                "needs a `file` (a glTF binary) or a `generated` mesh name",
+            ));
+        }
+        (Some(file), None) => {
+            if file.trim().is_empty() {
+                return Err(invalid(p, &format!("{field}.file"), "must not be empty"));
+            }
+            if src.tessellate.is_some() {
+                return Err(invalid(
+                    p,
+                    &format!("{field}.tessellate"),
+                    "only generated meshes can be tessellated",
+                ));
+            }
+        }
+        (None, Some(name)) => {
+            if name != GENERATED_CORNELL_BOX {
+                return Err(invalid(
+                    p,
+                    &format!("{field}.generated"),
+                    format!("unknown generated mesh '{name}'; the only one is '{GENERATED_CORNELL_BOX}'"),
+                ));
+            }
+        }
+    }
+    if let Some(cell) = src.tessellate {
+        if !(cell.is_finite() && cell > 0.0) {
+            return Err(invalid(
+                p,
+                &format!("{field}.tessellate"),
+                format!("must be a positive cell size, got {cell}"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+fn validate_path(p: &Path, field: &str, path: &PathDesc, rule: TargetRule) -> Result<()> {
+    if path.keys.is_empty() {
+        return Err(invalid(
+            p,
+            &format!("{field}.keys"),
+            "needs at least one key",
+        ));
+    }
+    let with_target = path.keys.iter().filter(|k| k.target.is_some()).count();
+    for (i, key) in path.keys.iter().enumerate() {
+        let kf = format!("{field}.keys[{i}]");
+        if !key.time.is_finite() {
+            return Err(invalid(
+                p,
+                &format!("{kf}.time"),
+                format!("must be a finite number, got {}", key.time),
+            ));
+        }
+        if i == 0 && key.time != 0.0 {
+            return Err(invalid(
+                p,
+                &format!("{kf}.time"),
+                format!("the first key must be at time 0, got {}", key.time),
+            ));
+        }
+        if i > 0 && key.time <= path.keys[i - 1].time {
+            return Err(invalid(
+                p,
+                &format!("{kf}.time"),
+                format!(
+                    "key times must be strictly increasing ({} follows {})",
+                    key.time,
+                    path.keys[i - 1].time
+                ),
+            ));
+        }
+        check_finite3(p, &format!("{kf}.position"), &key.position)?;
+        match (&key.target, &rule) {
+            (None, TargetRule::Required(why)) => {
+                return Err(invalid(
+                    p,
+                    &format!("{kf}.target"),
+                    format!("is missing; {why}"),
+                ));
+            }
+            (None, TargetRule::Optional) if with_target > 0 => {
+                return Err(invalid(
+                    p,
+                    &format!("{kf}.target"),
+                    "is missing; give a target on every key or on none",
+                ));
+            }
+            (Some(target), _) => {
+                check_finite3(p, &format!("{kf}.target"), target)?;
+                if target == &key.position {
+                    return Err(invalid(
+                        p,
+                        &format!("{kf}.target"),
+                        "must differ from the key's position",
+                    ));
+                }
+            }
+            _ => {}
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn cornell() -> SceneDescriptor {
+        SceneDescriptor::resolve("cornell").expect("built-in cornell")
+    }
+
+    fn message(e: Error) -> String {
+        match e {
+            Error::BadFile { message, .. } => message,
+            other => panic!("expected BadFile, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn descriptor_builtins_parse_and_validate() {
+        let names = builtin_names();
+        assert!(names.len() >= 6);
+        for name in names {
+            let d = SceneDescriptor::resolve(name).unwrap_or_else(|e| panic!("{name}: {e}"));
+            assert_eq!(d.name, name);
+            // Both the camera and the light move (Laine measured with both moving).
+            assert!(
+                d.camera.path.keys.len() >= 2 && d.light.path.keys.len() >= 2,
+                "{name}"
+            );
+        }
+    }
+
+    #[test]
+    fn descriptor_roundtrips_through_json() {
+        let d = cornell();
+        let text = serde_json::to_string(&d).unwrap();
+        assert_eq!(
+            SceneDescriptor::from_json(Path::new("x.json"), &text).unwrap(),
+            d
+        );
+    }
+
+    #[test]
+    fn descriptor_unknown_fields_are_named() {
+        let mut v: serde_json::Value = serde_json::to_value(cornell()).unwrap();
+        v["colour"] = serde_json::json!(1);
+        let text = serde_json::to_string_pretty(&v).unwrap();
+        let e = SceneDescriptor::from_json(Path::new("top.json"), &text).unwrap_err();
+        let shown = e.to_string();
+        assert!(shown.starts_with("top.json: "), "{shown}");
+        assert!(
+            shown.contains("unknown field `colour`") && shown.contains("line"),
+            "{shown}"
+        );
+
+        let mut v: serde_json::Value = serde_json::to_value(cornell()).unwrap();
+        v["light"]["colour"] = serde_json::json!([1, 1, 1]);
+        let e = SceneDescriptor::from_json(Path::new("nested.json"), &v.to_string()).unwrap_err();
+        assert!(message(e).contains("unknown field `colour`"));
+
+        let mut v: serde_json::Value = serde_json::to_value(cornell()).unwrap();
+        v["camera"]["path"]["keys"][0]["rotation"] = serde_json::json!(0);
+        assert!(message(
+            SceneDescriptor::from_json(Path::new("k.json"), &v.to_string()).unwrap_err()
+        )
+        .contains("unknown field `rotation`"));
+
+        let e = SceneDescriptor::from_json(Path::new("bad.json"), "{ not json").unwrap_err();
+        assert!(matches!(e, Error::BadFile { .. }));
+        let mut v: serde_json::Value = serde_json::to_value(cornell()).unwrap();
+        v["light"]["kind"] = serde_json::json!("laser");
+        assert!(message(
+            SceneDescriptor::from_json(Path::new("k.json"), &v.to_string()).unwrap_err()
+        )
+        .contains("unknown variant `laser`"));
+    }
+
+    #[test]
+    fn descriptor_resolve_errors() {
+        match SceneDescriptor::resolve("atlantis") {
+            Err(Error::Invalid(m)) => {
+                assert!(
+                    m.contains("atlantis") && m.contains("cornell") && m.contains("sponza"),
+                    "{m}"
+                )
+            }
+            other => panic!("{other:?}"),
+        }
+        assert!(matches!(
+            SceneDescriptor::resolve("/no/such/dir/scene.json"),
+            Err(Error::Io { .. })
+        ));
+
+        let dir = tempfile::tempdir().unwrap();
+        let good = dir.path().join("mine.json");
+        let mut d = cornell();
+        d.name = "mine".into();
+        std::fs::write(&good, serde_json::to_string(&d).unwrap()).unwrap();
+        assert_eq!(SceneDescriptor::resolve(good.to_str().unwrap()).unwrap(), d);
+
+        d.fps = 0.0;
+        let bad = dir.path().join("bad.json");
+        std::fs::write(&bad, serde_json::to_string(&d).unwrap()).unwrap();
+        match SceneDescriptor::resolve(bad.to_str().unwrap()) {
+            Err(Error::BadFile { path, message }) => {
+                assert_eq!(path, bad);
+                assert!(message.starts_with("fps:"), "{message}");
+            }
+            other => panic!("{other:?}"),
+        }
+    }
+
+    #[test]
+    fn descriptor_validation_rules() {
+        type Edit = Box<dyn Fn(&mut SceneDescriptor)>;
+        let with_mover = |d: &mut SceneDescriptor| {
+            d.movers = SceneDescriptor::resolve("cornell-bunny").unwrap().movers;
+        };
+        let cases: Vec<(&str, Edit)> = vec![
+            (
+                "mesh: give either",
+                Box::new(|d| d.mesh.file = Some("a.glb".into())),
+            ),
+            (
+                "mesh: needs a `file`",
+                Box::new(|d| d.mesh.generated = None),
+            ),
+            (
+                "mesh.generated: unknown generated mesh 'teapot'",
+                Box::new(|d| d.mesh.generated = Some("teapot".into())),
+            ),
+            (
+                "mesh.file: must not be empty",
+                Box::new(|d| {
+                    d.mesh = MeshSource {
+                        file: Some(" ".into()),
+                        ..Default::default()
+                    }
+                }),
+            ),
+            (
+                "mesh.tessellate: only generated",
+                Box::new(|d| {
+                    d.mesh = MeshSource {
+                        file: Some("a.glb".into()),
+                        generated: None,
+                        tessellate: Some(3.0),
+                    }
+                }),
+            ),
+            (
+                "shadow_mesh.tessellate: must be a positive",
+                Box::new(|d| d.shadow_mesh.as_mut().unwrap().tessellate = Some(0.0)),
+            ),
+            (
+                "camera.fov_y_deg:",
+                Box::new(|d| d.camera.fov_y_deg = 180.0),
+            ),
+            ("camera.fov_y_deg:", Box::new(|d| d.camera.fov_y_deg = 0.0)),
+            ("camera.near:", Box::new(|d| d.camera.near = 0.0)),
+            (
+                "camera.path.keys: needs at least one key",
+                Box::new(|d| d.camera.path.keys.clear()),
+            ),
+            (
+                "camera.path.keys[0].time: the first key must be at time 0",
+                Box::new(|d| d.camera.path.keys[0].time = 0.5),
+            ),
+            (
+                "camera.path.keys[1].time: must be a finite",
+                Box::new(|d| d.camera.path.keys[1].time = f32::NAN),
+            ),
+            (
+                "light.path.keys[2].time: key times must be strictly increasing",
+                Box::new(|d| d.light.path.keys[2].time = 1.5),
+            ),
+            (
+                "light.path.keys[1].position:",
+                Box::new(|d| d.light.path.keys[1].position[0] = f32::INFINITY),
+            ),
+            (
+                "camera.path.keys[0].target: is missing",
+                Box::new(|d| d.camera.path.keys[0].target = None),
+            ),
+            (
+                "light.path.keys[3].target: is missing",
+                Box::new(|d| d.light.path.keys[3].target = None),
+            ),
+            (
+                "light.path.keys[0].target: must differ",
+                Box::new(|d| d.light.path.keys[0].target = Some(d.light.path.keys[0].position)),
+            ),
+            (
+                "light.power: every component",
+                Box::new(|d| d.light.power[1] = -1.0),
+            ),
+            (
+                "light.power: every component",
+                Box::new(|d| d.light.power[2] = f32::NAN),
+            ),
+            (
+                "light.power: is zero",
+                Box::new(|d| d.light.power = [0.0; 3]),
+            ),
+            (
+                "light.size: area lights need a [width, height] size",
+                Box::new(|d| d.light.kind = LightKind::Area),
+            ),
+            (
+                "light.size: width and height must be positive",
+                Box::new(|d| {
+                    d.light.kind = LightKind::Area;
+                    d.light.size = Some([100.0, 0.0]);
+                }),
+            ),
+            (
+                "light.size: only area lights",
+                Box::new(|d| d.light.size = Some([1.0, 1.0])),
+            ),
+            (
+                "movers[0].scale: must be positive",
+                Box::new(move |d| {
+                    with_mover(d);
+                    d.movers[0].scale = 0.0;
+                }),
+            ),
+            (
+                "movers[0].name: must not be empty",
+                Box::new(move |d| {
+                    with_mover(d);
+                    d.movers[0].name.clear();
+                }),
+            ),
+            (
+                "movers[0].mesh: needs a `file`",
+                Box::new(move |d| {
+                    with_mover(d);
+                    d.movers[0].mesh.file = None;
+                }),
+            ),
+            (
+                "movers[0].path.keys[1].target: is missing; give a target on every key or on none",
+                Box::new(move |d| {
+                    with_mover(d);
+                    d.movers[0].path.keys[1].target = None;
+                }),
+            ),
+            (
+                "settings.filter_distance:",
+                Box::new(|d| d.settings.filter_distance = 0.0),
+            ),
+            (
+                "settings.filter_normal:",
+                Box::new(|d| d.settings.filter_normal = 1.5),
+            ),
+            (
+                "settings.exposure:",
+                Box::new(|d| d.settings.exposure = -1.0),
+            ),
+            (
+                "settings.shadow_bias:",
+                Box::new(|d| d.settings.shadow_bias = f32::NAN),
+            ),
+            ("fps:", Box::new(|d| d.fps = 0.0)),
+        ];
+        for (expected, edit) in cases {
+            let mut d = cornell();
+            edit(&mut d);
+            let e = d
+                .validate(Path::new("scenes/edited.json"))
+                .expect_err(expected);
+            let shown = e.to_string();
+            assert!(shown.starts_with("scenes/edited.json: "), "{shown}");
+            let m = message(e);
+            assert!(m.starts_with(expected), "expected '{expected}…', got '{m}'");
+        }
+        // Optional things that are fine: an omni light without targets, a mover without targets,
+        // a single-key path, an area light with a size.
+        let mut d = cornell();
+        d.light.kind = LightKind::Omni;
+        for k in &mut d.light.path.keys {
+            k.target = None;
+        }
+        d.camera.path.keys.truncate(1);
+        with_mover(&mut d);
+        for k in &mut d.movers[0].path.keys {
+            k.target = None;
+        }
+        d.validate(Path::new("ok.json")).unwrap();
+        d.light.kind = LightKind::Area;
+        d.light.size = Some([100.0, 50.0]);
+        for k in &mut d.light.path.keys {
+            k.target = Some([278.0, 0.0, 280.0]);
+        }
+        d.validate(Path::new("ok.json")).unwrap();
+    }
+}

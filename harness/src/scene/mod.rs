@@ -1,0 +1,322 @@
+//! The one in-memory scene model every technique and the reference renderer use.
+//!
+//! A [`Scene`] is built from a [`descriptor::SceneDescriptor`] (JSON in `scenes/`): the static
+//! mesh (from a glTF file found on the asset search path, or generated in code such as the
+//! Cornell box), an optional tessellated copy of it for paraboloid shadow maps, the movers
+//! (dynamic meshes with a path), the primary light and per-scene settings.
+//!
+//! All geometry is in world space (node transforms applied) and in the source's own units.
+//! Vertices are never shared between materials, so a triangle's material is the material of
+//! any of its vertices.
+
+pub mod cornell;
+pub mod descriptor;
+pub mod gltf_load;
+
+use std::path::Path;
+
+use glam::{Vec2, Vec3};
+
+use crate::assets::AssetPaths;
+use crate::Result;
+
+pub use descriptor::SceneDescriptor;
+use descriptor::{MeshSource, GENERATED_CORNELL_BOX};
+
+/// A diffuse material.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    pub name: String,
+    /// Linear RGB base colour factor (the diffuse albedo when untextured).
+    pub base_color: Vec3,
+    /// Index into [`Scene::textures`] of the base-colour texture, if any.
+    pub texture: Option<usize>,
+    /// The albedo a VPL or the reference uses for this material: the base colour times the
+    /// mean linear colour of its texture (Laine §4.6 uses a heavily blurred texture; the mean is
+    /// the limit of that blur).
+    pub average_color: Vec3,
+}
+
+/// A base-colour texture, decoded to RGBA8 with sRGB-encoded colour channels.
+#[derive(Clone, Debug)]
+pub struct Texture {
+    pub name: String,
+    pub width: u32,
+    pub height: u32,
+    pub rgba8: Vec<u8>,
+}
+
+/// An indexed triangle mesh with per-vertex attributes.
+#[derive(Clone, Debug, Default)]
+pub struct Mesh {
+    pub positions: Vec<Vec3>,
+    /// Unit shading normals.
+    pub normals: Vec<Vec3>,
+    /// Texture coordinates (zero where the source has none).
+    pub uvs: Vec<Vec2>,
+    /// Material index (into [`Scene::materials`]) per vertex.
+    pub materials: Vec<u32>,
+    /// Three indices per triangle.
+    pub indices: Vec<u32>,
+}
+
+impl Mesh {
+    /// Number of triangles.
+    pub fn triangle_count(&self) -> usize {
+        self.indices.len() / 3
+    }
+    /// The three corner positions of triangle `t`.
+    pub fn triangle(&self, t: usize) -> [Vec3; 3] {
+        let i = &self.indices[3 * t..3 * t + 3];
+        [
+            self.positions[i[0] as usize],
+            self.positions[i[1] as usize],
+            self.positions[i[2] as usize],
+        ]
+    }
+    /// Material index of triangle `t`.
+    pub fn triangle_material(&self, t: usize) -> u32 {
+        self.materials[self.indices[3 * t] as usize]
+    }
+    /// Axis-aligned bounds (min, max); `(0, 0)` for an empty mesh.
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        if self.positions.is_empty() {
+            return (Vec3::ZERO, Vec3::ZERO);
+        }
+        self.positions.iter().fold(
+            (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
+            |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+        )
+    }
+    /// Appends `other`, offsetting its indices and its material indices by `material_offset`.
+    pub fn append(&mut self, other: &Mesh, material_offset: u32) {
+        let base = self.positions.len() as u32;
+        self.positions.extend_from_slice(&other.positions);
+        self.normals.extend_from_slice(&other.normals);
+        self.uvs.extend_from_slice(&other.uvs);
+        self.materials
+            .extend(other.materials.iter().map(|m| m + material_offset));
+        self.indices.extend(other.indices.iter().map(|i| i + base));
+    }
+}
+
+/// A `KHR_lights_punctual` light read from a glTF file (world space).
+#[derive(Clone, Debug, PartialEq)]
+pub struct PunctualLight {
+    pub name: String,
+    pub kind: PunctualKind,
+    pub position: Vec3,
+    /// Unit direction the light points at (−Z of its node); meaningful for spots.
+    pub direction: Vec3,
+    /// Linear RGB colour.
+    pub color: Vec3,
+    /// Intensity as stored in glTF (candela for point and spot lights).
+    pub intensity: f32,
+}
+
+/// Kinds of glTF punctual lights.
+#[derive(Clone, Debug, PartialEq)]
+pub enum PunctualKind {
+    Point,
+    Spot {
+        inner_cone_angle: f32,
+        outer_cone_angle: f32,
+    },
+    Directional,
+}
+
+/// A dynamic object: a mesh in its own local space, already scaled by the descriptor's
+/// `scale`, and the index of its path in the descriptor (`descriptor.movers[i]`). Its
+/// per-frame transform (rigid: translation and rotation about +Y) comes from [`crate::anim`].
+#[derive(Clone, Debug)]
+pub struct Mover {
+    pub name: String,
+    pub mesh: Mesh,
+}
+
+/// The whole scene.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// The descriptor it was built from (name, paths, light, settings).
+    pub descriptor: SceneDescriptor,
+    /// Static geometry, world space. Indirect light bounces off this only (as in Laine 2007).
+    pub mesh: Mesh,
+    /// A finely tessellated copy of the static geometry for rendering paraboloid shadow maps
+    /// (`shadow_mesh` in the descriptor); `None` means use [`Scene::mesh`].
+    pub shadow_mesh: Option<Mesh>,
+    pub materials: Vec<Material>,
+    pub textures: Vec<Texture>,
+    /// One per `descriptor.movers` entry, same order.
+    pub movers: Vec<Mover>,
+    /// Punctual lights found in the static mesh's glTF file.
+    pub gltf_lights: Vec<PunctualLight>,
+}
+
+/// A mesh built from a [`MeshSource`], with materials and textures indexed from zero.
+struct BuiltMesh {
+    mesh: Mesh,
+    materials: Vec<Material>,
+    textures: Vec<Texture>,
+    lights: Vec<PunctualLight>,
+}
+
+fn build_mesh(src: &MeshSource, assets: &AssetPaths) -> Result<BuiltMesh> {
+    match (&src.file, &src.generated) {
+        (Some(file), _) => {
+            let path = assets.find(file)?;
+            let g = gltf_load::load_gltf(&path, 0)?;
+            Ok(BuiltMesh {
+                mesh: g.mesh,
+                materials: g.materials,
+                textures: g.textures,
+                lights: g.lights,
+            })
+        }
+        (None, Some(name)) if name == GENERATED_CORNELL_BOX => {
+            let (mesh, materials) = cornell::cornell_box(src.tessellate);
+            Ok(BuiltMesh {
+                mesh,
+                materials,
+                textures: Vec::new(),
+                lights: Vec::new(),
+            })
+        }
+        (None, Some(name)) => Err(crate::Error::Invalid(format!(
+            "unknown generated mesh '{name}'; the only one is '{GENERATED_CORNELL_BOX}'"
+        ))),
+        (None, None) => Err(crate::Error::Invalid(
+            "a mesh source needs a `file` or a `generated` name".into(),
+        )),
+    }
+}
+
+/// Appends `textures` to `scene_textures` and returns `materials` with their texture indices
+/// shifted accordingly.
+fn append_textures(
+    scene_textures: &mut Vec<Texture>,
+    textures: Vec<Texture>,
+    materials: Vec<Material>,
+) -> Vec<Material> {
+    let offset = scene_textures.len();
+    scene_textures.extend(textures);
+    materials
+        .into_iter()
+        .map(|m| Material {
+            texture: m.texture.map(|t| t + offset),
+            ..m
+        })
+        .collect()
+}
+
+impl Scene {
+    /// Builds the scene a descriptor describes (validating it first): the static mesh (a glTF
+    /// file found with `assets`, or a generated mesh), the optional shadow mesh, the movers and
+    /// the glTF punctual lights of the static mesh's file.
+    ///
+    /// * The static mesh's materials and textures come first in [`Scene::materials`] and
+    ///   [`Scene::textures`].
+    /// * The shadow mesh's materials are matched by name to the static mesh's (they are
+    ///   normally copies of the same scene); unmatched ones are appended.
+    /// * Each mover's mesh is loaded in its local space, scaled by the mover's `scale`, and its
+    ///   materials and textures are appended (per-vertex indices refer to the scene's lists).
+    ///
+    /// Errors: a missing asset is [`crate::Error::AssetNotFound`]; a bad file or descriptor is
+    /// [`crate::Error::BadFile`].
+    pub fn load(desc: &SceneDescriptor, assets: &AssetPaths) -> Result<Scene> {
+        desc.validate(Path::new(&format!("scene '{}'", desc.name)))?;
+
+        let main = build_mesh(&desc.mesh, assets)?;
+        let mut textures = Vec::new();
+        let mut materials = append_textures(&mut textures, main.textures, main.materials);
+        let mesh = main.mesh;
+
+        let shadow_mesh = match &desc.shadow_mesh {
+            None => None,
+            Some(src) => {
+                let shadow = build_mesh(src, assets)?;
+                let texture_offset = textures.len();
+                let mut needs_textures = false;
+                let mut remap = Vec::with_capacity(shadow.materials.len());
+                for m in shadow.materials {
+                    match materials.iter().position(|s| s.name == m.name) {
+                        Some(i) => remap.push(i as u32),
+                        None => {
+                            needs_textures |= m.texture.is_some();
+                            materials.push(Material {
+                                texture: m.texture.map(|t| t + texture_offset),
+                                ..m
+                            });
+                            remap.push(materials.len() as u32 - 1);
+                        }
+                    }
+                }
+                if needs_textures {
+                    textures.extend(shadow.textures);
+                }
+                let mut shadow_mesh = shadow.mesh;
+                for m in &mut shadow_mesh.materials {
+                    *m = remap.get(*m as usize).copied().unwrap_or(0);
+                }
+                Some(shadow_mesh)
+            }
+        };
+
+        let mut movers = Vec::with_capacity(desc.movers.len());
+        for mover in &desc.movers {
+            let built = build_mesh(&mover.mesh, assets)?;
+            let offset = materials.len() as u32;
+            materials.extend(append_textures(
+                &mut textures,
+                built.textures,
+                built.materials,
+            ));
+            let mut local = Mesh::default();
+            local.append(&built.mesh, offset);
+            for p in &mut local.positions {
+                *p *= mover.scale;
+            }
+            movers.push(Mover {
+                name: mover.name.clone(),
+                mesh: local,
+            });
+        }
+
+        Ok(Scene {
+            descriptor: desc.clone(),
+            mesh,
+            shadow_mesh,
+            materials,
+            textures,
+            movers,
+            gltf_lights: main.lights,
+        })
+    }
+
+    /// [`SceneDescriptor::resolve`]s `name_or_path` (a built-in scene name or a JSON file) and
+    /// [`load`](Self::load)s it.
+    pub fn load_named(name_or_path: &str, assets: &AssetPaths) -> Result<Scene> {
+        Scene::load(&SceneDescriptor::resolve(name_or_path)?, assets)
+    }
+
+    /// The mesh to render paraboloid or cube VPL shadow maps from.
+    pub fn shadow_caster_mesh(&self) -> &Mesh {
+        self.shadow_mesh.as_ref().unwrap_or(&self.mesh)
+    }
+    /// Area-weighted mean of the materials' average colours over the static mesh (Keller's
+    /// average reflectance ρ̄).
+    pub fn average_reflectance(&self) -> Vec3 {
+        let mut sum = Vec3::ZERO;
+        let mut area = 0.0;
+        for t in 0..self.mesh.triangle_count() {
+            let [a, b, c] = self.mesh.triangle(t);
+            let w = 0.5 * (b - a).cross(c - a).length();
+            sum += w * self.materials[self.mesh.triangle_material(t) as usize].average_color;
+            area += w;
+        }
+        if area > 0.0 {
+            sum / area
+        } else {
+            Vec3::ZERO
+        }
+    }
+}

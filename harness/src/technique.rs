@@ -1,0 +1,290 @@
+//! The technique interface: plain structs built from named, typed parameters (in the spirit of
+//! Mitsuba's plugin properties: a parameter nobody declared is an error that names it), that
+//! declare the GPU features and limits they need, prepare once per scene, and then each frame
+//! record named stages and return the indirect irradiance texture.
+
+use std::collections::BTreeMap;
+
+use serde_json::Value;
+
+use crate::anim::FrameState;
+use crate::bvh::SceneBvh;
+use crate::gpu::GpuContext;
+use crate::passes::{FrameUniforms, GBuffer, GpuScene};
+use crate::profiler::Profiler;
+use crate::scene::Scene;
+use crate::{Error, Result};
+
+/// The type of a parameter, with its valid range.
+#[derive(Clone, Copy, Debug)]
+pub enum ParamKind {
+    /// An integer in `[min, max]`.
+    Int { min: i64, max: i64 },
+    /// A finite number in `[min, max]`.
+    Float { min: f64, max: f64 },
+    /// `true` / `false`.
+    Bool,
+    /// A tile layout `NxM`, each in `[1, 64]`.
+    Tiles,
+    /// One of the given words.
+    Choice(&'static [&'static str]),
+}
+
+/// One declared parameter.
+#[derive(Clone, Copy, Debug)]
+pub struct ParamSpec {
+    pub name: &'static str,
+    pub kind: ParamKind,
+    /// The default, written as on the command line.
+    pub default: &'static str,
+    pub doc: &'static str,
+}
+
+/// Parsed parameter values (defaults applied), keyed by name.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Params {
+    values: BTreeMap<String, Value>,
+}
+
+fn parse_value(technique: &str, spec: &ParamSpec, raw: &str) -> Result<Value> {
+    let bad = |what: String| {
+        Error::param(
+            format!("{technique}.{}", spec.name),
+            format!("{what} (got '{raw}')"),
+        )
+    };
+    let raw = raw.trim();
+    Ok(match spec.kind {
+        ParamKind::Int { min, max } => {
+            let v: i64 = raw.parse().map_err(|_| bad("expected an integer".into()))?;
+            if v < min || v > max {
+                return Err(bad(format!("expected an integer in [{min}, {max}]")));
+            }
+            Value::from(v)
+        }
+        ParamKind::Float { min, max } => {
+            let v: f64 = raw.parse().map_err(|_| bad("expected a number".into()))?;
+            if !v.is_finite() || v < min || v > max {
+                return Err(bad(format!("expected a number in [{min}, {max}]")));
+            }
+            Value::from(v)
+        }
+        ParamKind::Bool => Value::from(match raw {
+            "true" | "1" | "yes" | "on" => true,
+            "false" | "0" | "no" | "off" => false,
+            _ => return Err(bad("expected true or false".into())),
+        }),
+        ParamKind::Tiles => {
+            let (n, m) = parse_tiles(raw)
+                .ok_or_else(|| bad("expected tiles as NxM with N, M in [1, 64]".into()))?;
+            Value::from(format!("{n}x{m}"))
+        }
+        ParamKind::Choice(words) => {
+            if !words.contains(&raw) {
+                return Err(bad(format!("expected one of {}", words.join(", "))));
+            }
+            Value::from(raw)
+        }
+    })
+}
+
+/// Parses `NxM` (N, M in 1..=64).
+pub fn parse_tiles(s: &str) -> Option<(u32, u32)> {
+    let (a, b) = s.split_once(['x', 'X'])?;
+    let (n, m): (u32, u32) = (a.trim().parse().ok()?, b.trim().parse().ok()?);
+    ((1..=64).contains(&n) && (1..=64).contains(&m)).then_some((n, m))
+}
+
+impl Params {
+    /// Parses `key=value` pairs for `technique` against its declared `specs`. Every key must be
+    /// declared (otherwise the error names the key and lists the declared ones); missing keys
+    /// take their defaults.
+    pub fn parse(
+        technique: &str,
+        specs: &[ParamSpec],
+        given: &[(String, String)],
+    ) -> Result<Params> {
+        let mut values = BTreeMap::new();
+        for spec in specs {
+            values.insert(
+                spec.name.to_string(),
+                parse_value(technique, spec, spec.default)?,
+            );
+        }
+        for (k, v) in given {
+            let spec = specs.iter().find(|s| s.name == k).ok_or_else(|| {
+                let known: Vec<&str> = specs.iter().map(|s| s.name).collect();
+                Error::param(
+                    k.clone(),
+                    format!(
+                        "technique '{technique}' has no such parameter; it has: {}",
+                        if known.is_empty() {
+                            "none".to_string()
+                        } else {
+                            known.join(", ")
+                        }
+                    ),
+                )
+            })?;
+            values.insert(k.clone(), parse_value(technique, spec, v)?);
+        }
+        Ok(Params { values })
+    }
+
+    /// All values, for the results file.
+    pub fn to_map(&self) -> BTreeMap<String, Value> {
+        self.values.clone()
+    }
+
+    fn get(&self, name: &str) -> &Value {
+        self.values
+            .get(name)
+            .unwrap_or_else(|| panic!("parameter '{name}' was not declared by the technique"))
+    }
+    /// An integer parameter (declared with [`ParamKind::Int`]).
+    pub fn int(&self, name: &str) -> i64 {
+        self.get(name).as_i64().expect("declared as Int")
+    }
+    /// A number parameter (declared with [`ParamKind::Float`]).
+    pub fn float(&self, name: &str) -> f64 {
+        self.get(name).as_f64().expect("declared as Float")
+    }
+    /// A boolean parameter.
+    pub fn bool(&self, name: &str) -> bool {
+        self.get(name).as_bool().expect("declared as Bool")
+    }
+    /// A tiles parameter as (columns, rows).
+    pub fn tiles(&self, name: &str) -> (u32, u32) {
+        parse_tiles(self.get(name).as_str().expect("declared as Tiles")).expect("validated")
+    }
+    /// A choice parameter.
+    pub fn choice(&self, name: &str) -> &str {
+        self.get(name).as_str().expect("declared as Choice")
+    }
+}
+
+/// What a technique gets once per scene.
+pub struct PrepareContext<'a> {
+    pub gpu: &'a GpuContext,
+    pub scene: &'a Scene,
+    pub bvh: &'a SceneBvh,
+    pub gpu_scene: &'a GpuScene,
+    pub gbuffer: &'a GBuffer,
+    pub uniforms: &'a FrameUniforms,
+    pub resolution: [u32; 2],
+    pub seed: u64,
+}
+
+/// What a technique gets every frame.
+pub struct FrameContext<'a> {
+    pub gpu: &'a GpuContext,
+    pub scene: &'a Scene,
+    pub bvh: &'a SceneBvh,
+    pub gpu_scene: &'a GpuScene,
+    pub gbuffer: &'a GBuffer,
+    pub uniforms: &'a FrameUniforms,
+    pub frame: &'a FrameState,
+    /// Record stages through this: `profiler.gpu_stage(gpu, "name", |encoder| ...)` and
+    /// `profiler.cpu_stage("name", || ...)`.
+    pub profiler: &'a mut Profiler,
+}
+
+/// A real-time indirect-illumination technique.
+pub trait Technique {
+    /// Records this frame's stages. The indirect irradiance (see the harness's radiometric
+    /// convention) must be in [`Technique::output`] once the recorded stages have run.
+    fn render(&mut self, ctx: &mut FrameContext) -> Result<()>;
+    /// Full-resolution `Rgba16Float` indirect irradiance.
+    fn output(&self) -> &wgpu::TextureView;
+}
+
+/// A registry entry: how to list and build a technique.
+pub struct TechniqueInfo {
+    pub name: &'static str,
+    pub description: &'static str,
+    pub params: &'static [ParamSpec],
+    /// GPU features the technique cannot run without.
+    pub required_features: wgpu::Features,
+    /// Limits the technique needs (checked before it is built).
+    pub required_limits: fn() -> wgpu::Limits,
+    /// Builds the technique for one scene.
+    pub create: fn(&Params, &PrepareContext) -> Result<Box<dyn Technique>>,
+}
+
+impl TechniqueInfo {
+    /// Finds `name` in `registry`; the error lists the known names.
+    pub fn find<'r>(registry: &'r [TechniqueInfo], name: &str) -> Result<&'r TechniqueInfo> {
+        registry.iter().find(|t| t.name == name).ok_or_else(|| {
+            let known: Vec<&str> = registry.iter().map(|t| t.name).collect();
+            Error::Invalid(format!(
+                "unknown technique '{name}'; known techniques: {}",
+                known.join(", ")
+            ))
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const SPECS: &[ParamSpec] = &[
+        ParamSpec {
+            name: "vpls",
+            kind: ParamKind::Int { min: 1, max: 4096 },
+            default: "256",
+            doc: "",
+        },
+        ParamSpec {
+            name: "tiles",
+            kind: ParamKind::Tiles,
+            default: "4x4",
+            doc: "",
+        },
+        ParamSpec {
+            name: "clamp",
+            kind: ParamKind::Float { min: 0.0, max: 1e9 },
+            default: "0.5",
+            doc: "",
+        },
+    ];
+
+    fn kv(k: &str, v: &str) -> (String, String) {
+        (k.into(), v.into())
+    }
+
+    #[test]
+    fn defaults_and_overrides() {
+        let p = Params::parse("t", SPECS, &[kv("vpls", "64")]).unwrap();
+        assert_eq!(p.int("vpls"), 64);
+        assert_eq!(p.tiles("tiles"), (4, 4));
+        assert_eq!(p.float("clamp"), 0.5);
+    }
+
+    #[test]
+    fn unknown_parameter_is_named() {
+        let e = Params::parse("t", SPECS, &[kv("vlps", "64")])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("vlps") && e.contains("vpls, tiles, clamp"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn bad_values_are_rejected() {
+        for (k, v) in [
+            ("vpls", "0"),
+            ("vpls", "x"),
+            ("tiles", "4x0"),
+            ("tiles", "44"),
+            ("clamp", "nan"),
+        ] {
+            let e = Params::parse("t", SPECS, &[kv(k, v)])
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains(k) && e.contains(v), "{e}");
+        }
+    }
+}

@@ -1,0 +1,394 @@
+//! `gibench`: run real-time indirect-illumination techniques side by side on the same scenes,
+//! frames and timing harness, and render their per-stage timing tables.
+
+mod registry;
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use clap::{Args, Parser, Subcommand};
+use gibench_harness::assets::AssetPaths;
+use gibench_harness::gpu::{GpuContext, GpuOptions};
+use gibench_harness::report;
+use gibench_harness::results::RunResult;
+use gibench_harness::runner::{Harness, RunConfig, TimingMode};
+use gibench_harness::scene::{descriptor, Scene, SceneDescriptor};
+use gibench_harness::technique::{Params, TechniqueInfo};
+use gibench_harness::{Error, Result};
+
+#[derive(Parser)]
+#[command(
+    name = "gibench",
+    version,
+    about = "Benchmark suite for real-time indirect illumination"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Run techniques on a scene and write results, images and tables.
+    Run(RunArgs),
+    /// List the scenes and techniques (with their parameters and defaults).
+    List,
+    /// Render tables (Markdown, CSV, LaTeX) and a stacked-bar SVG from results files.
+    Report(ReportArgs),
+}
+
+#[derive(Args, Clone)]
+struct GpuArgs {
+    /// Restrict the adapter to one backend: vulkan, gl, metal or dx12.
+    #[arg(long, env = "GIBENCH_BACKEND")]
+    backend: Option<String>,
+    /// Use the adapter whose name contains this (case-insensitive).
+    #[arg(long, env = "GIBENCH_ADAPTER")]
+    adapter: Option<String>,
+}
+
+#[derive(Args, Clone)]
+struct RunArgs {
+    /// Scene: a built-in name (see `gibench list`) or a path to a descriptor JSON.
+    #[arg(long, default_value = "cornell")]
+    scene: String,
+    /// Techniques, comma-separated (default: every registered technique).
+    #[arg(long, value_delimiter = ',')]
+    technique: Vec<String>,
+    /// Technique parameter `name=value` (applies to every selected technique that declares it)
+    /// or `technique.name=value`. Repeatable.
+    #[arg(long = "param", short = 'p')]
+    params: Vec<String>,
+    /// Measured frames.
+    #[arg(long, default_value_t = 60)]
+    frames: u32,
+    /// Warm-up frames run first and dropped from the statistics.
+    #[arg(long, default_value_t = 5)]
+    warmup: u32,
+    /// Animation frame to start at.
+    #[arg(long, default_value_t = 0)]
+    first_frame: u32,
+    /// Image size WIDTHxHEIGHT (the papers used 1024x768 and 1600x1200).
+    #[arg(long, default_value = "256x192")]
+    resolution: String,
+    /// Edge length of each face of the primary light's cube shadow map (Laine: 1024).
+    #[arg(long, default_value_t = 256)]
+    shadow_size: u32,
+    /// `stages` (per-stage, flushed), `frame` (whole frames, no added sync) or `both`.
+    #[arg(long, default_value = "both")]
+    timing: String,
+    /// Seed for every random choice a technique makes.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Directory for results JSON, images and tables.
+    #[arg(long, default_value = "results/local")]
+    out: PathBuf,
+    /// Extra directory searched first for scene assets (glTF files).
+    #[arg(long, env = "GIBENCH_ASSETS_DIR")]
+    assets: Option<PathBuf>,
+    /// Do not write images.
+    #[arg(long)]
+    no_images: bool,
+    /// Do not show a progress bar.
+    #[arg(long)]
+    quiet: bool,
+    #[command(flatten)]
+    gpu: GpuArgs,
+}
+
+#[derive(Args)]
+struct ReportArgs {
+    /// Results JSON files (or directories holding them).
+    #[arg(required = true)]
+    inputs: Vec<PathBuf>,
+    /// Output directory for the tables and the plot.
+    #[arg(long, default_value = "results/local")]
+    out: PathBuf,
+    /// File name stem of the outputs.
+    #[arg(long, default_value = "report")]
+    stem: String,
+    /// Also print full statistics (median, mean, p5, p95, min, max) per stage.
+    #[arg(long)]
+    detailed: bool,
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let outcome = match cli.command {
+        None => run(&RunArgs::parse_default()),
+        Some(Command::Run(args)) => run(&args),
+        Some(Command::List) => list(),
+        Some(Command::Report(args)) => report_cmd(&args),
+    };
+    match outcome {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+impl RunArgs {
+    /// The defaults of `gibench run`, for `gibench` with no arguments.
+    fn parse_default() -> RunArgs {
+        #[derive(Parser)]
+        struct Only {
+            #[command(flatten)]
+            run: RunArgs,
+        }
+        Only::parse_from(["gibench"]).run
+    }
+}
+
+fn parse_resolution(s: &str) -> Result<[u32; 2]> {
+    let bad = || {
+        Error::param(
+            "resolution",
+            format!("expected WIDTHxHEIGHT, e.g. 256x192 (got '{s}')"),
+        )
+    };
+    let (w, h) = s.split_once(['x', 'X']).ok_or_else(bad)?;
+    Ok([
+        w.trim().parse().map_err(|_| bad())?,
+        h.trim().parse().map_err(|_| bad())?,
+    ])
+}
+
+/// Splits `--param` values among the selected techniques. A bare `name=value` goes to every
+/// technique that declares `name`; it is an error if none does.
+fn assign_params(techniques: &[&TechniqueInfo], raw: &[String]) -> Result<Vec<Params>> {
+    let mut given: Vec<Vec<(String, String)>> = vec![Vec::new(); techniques.len()];
+    for p in raw {
+        let (key, value) = p.split_once('=').ok_or_else(|| {
+            Error::param(p.clone(), "expected name=value or technique.name=value")
+        })?;
+        let targets: Vec<(usize, &str)> = match key.split_once('.') {
+            Some((t, name)) => {
+                let i = techniques
+                    .iter()
+                    .position(|info| info.name == t)
+                    .ok_or_else(|| {
+                        Error::param(
+                            key,
+                            format!("technique '{t}' is not among the selected techniques"),
+                        )
+                    })?;
+                vec![(i, name)]
+            }
+            None => techniques
+                .iter()
+                .enumerate()
+                .filter(|(_, info)| info.params.iter().any(|s| s.name == key))
+                .map(|(i, _)| (i, key))
+                .collect(),
+        };
+        if targets.is_empty() {
+            let known: Vec<String> = techniques
+                .iter()
+                .map(|t| {
+                    let names: Vec<&str> = t.params.iter().map(|s| s.name).collect();
+                    format!(
+                        "{}: {}",
+                        t.name,
+                        if names.is_empty() {
+                            "none".into()
+                        } else {
+                            names.join(", ")
+                        }
+                    )
+                })
+                .collect();
+            return Err(Error::param(
+                key,
+                format!(
+                    "no selected technique has this parameter ({})",
+                    known.join("; ")
+                ),
+            ));
+        }
+        for (i, name) in targets {
+            given[i].push((name.to_string(), value.to_string()));
+        }
+    }
+    techniques
+        .iter()
+        .zip(given)
+        .map(|(t, g)| Params::parse(t.name, t.params, &g))
+        .collect()
+}
+
+fn run(args: &RunArgs) -> Result<()> {
+    // Everything that can be checked without running is checked before anything is written.
+    let config = RunConfig {
+        resolution: parse_resolution(&args.resolution)?,
+        frames: args.frames,
+        warmup: args.warmup,
+        first_frame: args.first_frame,
+        timing: TimingMode::parse(&args.timing)?,
+        seed: args.seed,
+        shadow_size: args.shadow_size,
+    };
+    config.validate()?;
+    let registry = registry::all();
+    let names: Vec<String> = if args.technique.is_empty() {
+        registry.iter().map(|t| t.name.to_string()).collect()
+    } else {
+        args.technique.clone()
+    };
+    let techniques: Vec<&TechniqueInfo> = names
+        .iter()
+        .map(|n| TechniqueInfo::find(&registry, n.trim()))
+        .collect::<Result<_>>()?;
+    let params = assign_params(&techniques, &args.params)?;
+    let desc = SceneDescriptor::resolve(&args.scene)?;
+    let assets = AssetPaths::standard(args.assets.as_deref());
+    let scene = Scene::load(&desc, &assets)?;
+    let gpu = GpuContext::new(&GpuOptions {
+        backend: args.gpu.backend.clone(),
+        adapter: args.gpu.adapter.clone(),
+    })?;
+    let harness = Harness::new(&gpu, &scene, &config)?;
+
+    let passes = if config.timing == TimingMode::Both {
+        2
+    } else {
+        1
+    };
+    let total = (techniques.len() as u64) * passes * (config.frames + config.warmup) as u64;
+    let bar = if args.quiet {
+        indicatif::ProgressBar::hidden()
+    } else {
+        indicatif::ProgressBar::new(total)
+    };
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{msg:>24} [{bar:30}] {pos}/{len} frames ({elapsed})",
+        )
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    eprintln!(
+        "gibench: scene '{}' ({} triangles) at {}x{} on {} ({}), {} measured + {} warm-up frames, timing '{}'",
+        desc.name,
+        scene.mesh.triangle_count(),
+        config.resolution[0],
+        config.resolution[1],
+        gpu.info.adapter,
+        gpu.info.backend,
+        config.frames,
+        config.warmup,
+        config.timing.name()
+    );
+    let mut results = Vec::new();
+    for (info, p) in techniques.iter().zip(&params) {
+        bar.set_message(info.name.to_string());
+        let (mut result, images) = harness.run(info, p, &config, &mut || bar.inc(1))?;
+        let stem = format!("{}-{}", desc.name, info.name);
+        if !args.no_images {
+            let png = args.out.join(format!("{stem}.png"));
+            gibench_harness::image_io::write_png(&png, images.size, &images.display)?;
+            let exr = args.out.join(format!("{stem}-indirect.exr"));
+            gibench_harness::image_io::write_exr(&exr, images.size, &images.indirect)?;
+            let direct = args.out.join(format!("{stem}-direct.exr"));
+            gibench_harness::image_io::write_exr(&direct, images.size, &images.direct)?;
+            result.images = vec![file_name(&png), file_name(&exr), file_name(&direct)];
+        }
+        result.write(&args.out.join(format!("{stem}.json")))?;
+        results.push(result);
+    }
+    bar.finish_and_clear();
+    let table = report::stage_table(&results);
+    println!("{}", table.to_terminal());
+    let stem = format!("{}-summary", desc.name);
+    let written = report::write_tables(&table, &args.out, &stem)?;
+    report::stacked_bar_svg(
+        &results,
+        &args.out.join(format!("{stem}.svg")),
+        &format!("Per-stage times on {}", desc.name),
+    )?;
+    eprintln!(
+        "wrote {} results, images and tables ({}, {stem}.svg) to {}",
+        results.len(),
+        written
+            .iter()
+            .map(|p| file_name(p))
+            .collect::<Vec<_>>()
+            .join(", "),
+        args.out.display()
+    );
+    Ok(())
+}
+
+fn file_name(p: &Path) -> String {
+    p.file_name()
+        .map(|f| f.to_string_lossy().into_owned())
+        .unwrap_or_default()
+}
+
+fn list() -> Result<()> {
+    println!("Scenes (built-in descriptors; any descriptor JSON path also works):");
+    for name in descriptor::builtin_names() {
+        let d = SceneDescriptor::resolve(name)?;
+        let mesh = d
+            .mesh
+            .file
+            .clone()
+            .or(d.mesh.generated.clone().map(|g| format!("generated {g}")))
+            .unwrap_or_default();
+        println!(
+            "  {name:<16} {mesh:<28} {:?} light. {}",
+            d.light.kind, d.description
+        );
+    }
+    println!("\nTechniques:");
+    for t in registry::all() {
+        println!("  {:<16} {}", t.name, t.description);
+        if t.params.is_empty() {
+            println!("      (no parameters)");
+        }
+        for p in t.params {
+            println!("      {:<14} default {:<8} {}", p.name, p.default, p.doc);
+        }
+    }
+    Ok(())
+}
+
+fn report_cmd(args: &ReportArgs) -> Result<()> {
+    let mut files = Vec::new();
+    for input in &args.inputs {
+        if input.is_dir() {
+            let mut found: Vec<PathBuf> = std::fs::read_dir(input)
+                .map_err(|e| Error::io(input, e))?
+                .filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| p.extension().is_some_and(|x| x == "json"))
+                .collect();
+            found.sort();
+            files.extend(found);
+        } else {
+            files.push(input.clone());
+        }
+    }
+    let results: Vec<RunResult> = files
+        .iter()
+        .map(|f| RunResult::read(f))
+        .collect::<Result<_>>()?;
+    if results.is_empty() {
+        return Err(Error::Invalid(
+            "no results files found in the given inputs".into(),
+        ));
+    }
+    let table = report::stage_table(&results);
+    println!("{}", table.to_terminal());
+    if args.detailed {
+        for r in &results {
+            println!("{}", report::stage_table_detailed(r).to_terminal());
+        }
+    }
+    report::write_tables(&table, &args.out, &args.stem)?;
+    report::stacked_bar_svg(
+        &results,
+        &args.out.join(format!("{}.svg", args.stem)),
+        "Per-stage times",
+    )?;
+    Ok(())
+}

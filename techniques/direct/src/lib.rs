@@ -1,0 +1,62 @@
+//! `direct`: the baseline. Direct light only (the harness's shared shadow-mapped direct pass);
+//! the indirect irradiance it returns is zero everywhere. Every other technique's cost and
+//! error is measured against this floor.
+//!
+//! Needs: no optional GPU features, WebGL2-level limits.
+
+use gibench_harness::technique::{FrameContext, Params, PrepareContext, Technique, TechniqueInfo};
+use gibench_harness::wgpu;
+use gibench_harness::Result;
+
+/// Registry entry.
+pub const INFO: TechniqueInfo = TechniqueInfo {
+    name: "direct",
+    description: "direct light only (shadow-mapped primary light); indirect irradiance is zero",
+    params: &[],
+    required_features: wgpu::Features::empty(),
+    required_limits: wgpu::Limits::downlevel_webgl2_defaults,
+    create,
+};
+
+/// The technique: one zero texture, made once.
+pub struct Direct {
+    view: wgpu::TextureView,
+}
+
+fn create(_params: &Params, ctx: &PrepareContext) -> Result<Box<dyn Technique>> {
+    use gibench_harness::wgpu::util::DeviceExt;
+    let [w, h] = ctx.resolution;
+    let texture = ctx.gpu.device.create_texture_with_data(
+        &ctx.gpu.queue,
+        &wgpu::TextureDescriptor {
+            label: Some("direct: zero indirect"),
+            size: wgpu::Extent3d {
+                width: w,
+                height: h,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: gibench_harness::passes::HDR_FORMAT,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_SRC
+                | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        },
+        wgpu::util::TextureDataOrder::LayerMajor,
+        &vec![0u8; (w * h * 8) as usize],
+    );
+    Ok(Box::new(Direct {
+        view: texture.create_view(&Default::default()),
+    }))
+}
+
+impl Technique for Direct {
+    fn render(&mut self, _ctx: &mut FrameContext) -> Result<()> {
+        Ok(())
+    }
+    fn output(&self) -> &wgpu::TextureView {
+        &self.view
+    }
+}

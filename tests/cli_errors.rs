@@ -1,0 +1,157 @@
+//! Bad input gets a clear error, a non-zero exit and no results file.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// Runs `gibench run ARGS --out <tmp>/out`, expects failure whose stderr contains `expect`, and
+/// checks nothing was written.
+fn fails(args: &[&str], expect: &str) {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    let o = Command::new(env!("CARGO_BIN_EXE_gibench"))
+        .arg("run")
+        .args(args)
+        .arg("--out")
+        .arg(&out)
+        .arg("--quiet")
+        .arg("--frames=2")
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success(),
+        "expected failure for {args:?}, stderr: {stderr}"
+    );
+    assert!(
+        stderr.contains(expect),
+        "stderr for {args:?} does not mention '{expect}':\n{stderr}"
+    );
+    assert!(
+        !stderr.contains("panicked"),
+        "panic for {args:?}:\n{stderr}"
+    );
+    let leftovers: Vec<_> = std::fs::read_dir(&out)
+        .map(|d| d.flatten().map(|e| e.path()).collect())
+        .unwrap_or_default();
+    assert!(
+        leftovers.is_empty(),
+        "files left behind for {args:?}: {leftovers:?}"
+    );
+}
+
+/// The Cornell descriptor with `edit` applied, written to `dir/name`.
+fn descriptor(dir: &Path, name: &str, edit: impl FnOnce(&mut serde_json::Value)) -> PathBuf {
+    let text = std::fs::read_to_string(root().join("scenes/cornell-gltf.json")).unwrap();
+    let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    edit(&mut v);
+    let p = dir.join(name);
+    std::fs::write(&p, serde_json::to_string_pretty(&v).unwrap()).unwrap();
+    p
+}
+
+fn shared_scene(name: &str) -> PathBuf {
+    root().join("../shared/scenes").join(name)
+}
+
+#[test]
+fn missing_asset() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = descriptor(tmp.path(), "missing.json", |v| {
+        v["mesh"] = serde_json::json!({"file": "no-such-mesh.glb"})
+    });
+    fails(
+        &["--scene", d.to_str().unwrap()],
+        "asset 'no-such-mesh.glb' not found",
+    );
+}
+
+#[test]
+fn truncated_gltf() {
+    let tmp = tempfile::tempdir().unwrap();
+    let bytes = std::fs::read(shared_scene("cornell.glb")).expect("../shared/scenes/cornell.glb");
+    let glb = tmp.path().join("truncated.glb");
+    std::fs::write(&glb, &bytes[..bytes.len() / 2]).unwrap();
+    let d = descriptor(tmp.path(), "truncated.json", |v| {
+        v["mesh"] = serde_json::json!({"file": glb.to_str().unwrap()});
+        v.as_object_mut().unwrap().remove("shadow_mesh");
+    });
+    fails(&["--scene", d.to_str().unwrap()], "truncated.glb");
+}
+
+#[test]
+fn malformed_gltf() {
+    let tmp = tempfile::tempdir().unwrap();
+    let glb = tmp.path().join("garbage.glb");
+    std::fs::write(
+        &glb,
+        b"glTF\x02\x00\x00\x00this is not a glTF binary at all",
+    )
+    .unwrap();
+    let d = descriptor(tmp.path(), "garbage.json", |v| {
+        v["mesh"] = serde_json::json!({"file": glb.to_str().unwrap()});
+        v.as_object_mut().unwrap().remove("shadow_mesh");
+    });
+    fails(&["--scene", d.to_str().unwrap()], "garbage.glb");
+}
+
+#[test]
+fn descriptor_with_unknown_field() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = descriptor(tmp.path(), "unknown.json", |v| {
+        v["light"]["colour"] = serde_json::json!([1, 1, 1])
+    });
+    fails(&["--scene", d.to_str().unwrap()], "colour");
+}
+
+#[test]
+fn unknown_scene() {
+    fails(&["--scene", "atlantis"], "atlantis");
+}
+
+#[test]
+fn unknown_technique() {
+    fails(&["--technique", "direct,nope"], "unknown technique 'nope'");
+}
+
+#[test]
+fn unknown_parameter() {
+    fails(&["--technique", "direct", "--param", "vpls=64"], "vpls");
+    fails(
+        &["--technique", "direct", "--param", "direct.vpls=64"],
+        "technique 'direct' has no such parameter",
+    );
+}
+
+#[test]
+fn bad_resolutions() {
+    fails(&["--resolution", "0x192"], "resolution");
+    fails(&["--resolution", "100000x192"], "exceeds");
+    fails(&["--resolution", "256by192"], "WIDTHxHEIGHT");
+}
+
+#[test]
+fn zero_frames() {
+    let tmp = tempfile::tempdir().unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_gibench"))
+        .args(["run", "--frames", "0", "--quiet", "--out"])
+        .arg(tmp.path().join("out"))
+        .output()
+        .unwrap();
+    assert!(!o.status.success());
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        stderr.contains("frames") && stderr.contains("got 0"),
+        "{stderr}"
+    );
+    assert!(!tmp.path().join("out").exists());
+}
+
+#[test]
+fn bad_timing_mode_and_backend() {
+    fails(&["--timing", "sometimes"], "timing");
+    fails(&["--backend", "glide"], "unknown backend 'glide'");
+}
