@@ -84,7 +84,7 @@ struct RunArgs {
     #[arg(long, default_value = "results/local")]
     out: PathBuf,
     /// Extra directory searched first for scene assets (glTF files).
-    #[arg(long, env = "GIBENCH_ASSETS_DIR")]
+    #[arg(long)]
     assets: Option<PathBuf>,
     /// Do not write images.
     #[arg(long)]

@@ -75,13 +75,6 @@ impl GpuContext {
             Some(b) => parse_backend(b)?,
             None => wgpu::Backends::all(),
         };
-        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
-        desc.backends = backends;
-        let instance = wgpu::Instance::new(desc);
-        // GL is asked only when no other backend offers an adapter (or when it is asked for):
-        // probing EGL prints noise on headless machines.
-        let mut adapters =
-            pollster::block_on(instance.enumerate_adapters(backends - wgpu::Backends::GL));
         let wants_named = |a: &wgpu::Adapter| match &opts.adapter {
             Some(sub) => a
                 .get_info()
@@ -90,10 +83,26 @@ impl GpuContext {
                 .contains(&sub.to_lowercase()),
             None => true,
         };
-        if backends.contains(wgpu::Backends::GL) && !adapters.iter().any(wants_named) {
-            adapters.extend(pollster::block_on(
-                instance.enumerate_adapters(wgpu::Backends::GL),
-            ));
+        let open = |b: wgpu::Backends| {
+            let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
+            desc.backends = b;
+            let instance = wgpu::Instance::new(desc);
+            let adapters = pollster::block_on(instance.enumerate_adapters(b));
+            (instance, adapters)
+        };
+        // GL is initialised only when no other backend offers a matching adapter (or when it is
+        // the backend asked for): probing EGL prints noise on headless machines.
+        let others = backends - wgpu::Backends::GL;
+        let (mut instance, mut adapters) = if others.is_empty() {
+            open(backends)
+        } else {
+            open(others)
+        };
+        if backends.contains(wgpu::Backends::GL)
+            && !others.is_empty()
+            && !adapters.iter().any(wants_named)
+        {
+            (instance, adapters) = open(backends);
         }
         if adapters.is_empty() {
             let which = opts
