@@ -9,6 +9,8 @@ use std::process::ExitCode;
 use clap::{Args, Parser, Subcommand};
 use gibench_harness::assets::AssetPaths;
 use gibench_harness::gpu::{GpuContext, GpuOptions};
+use gibench_harness::quality::{IndirectComponent, QualityConfig, ReferenceCache};
+use gibench_harness::reference::ReferenceSettings;
 use gibench_harness::report;
 use gibench_harness::results::RunResult;
 use gibench_harness::runner::{Harness, RunConfig, TimingMode};
@@ -35,6 +37,79 @@ enum Command {
     List,
     /// Render tables (Markdown, CSV, LaTeX) and a stacked-bar SVG from results files.
     Report(ReportArgs),
+    /// Render the CPU reference (direct, one-bounce, multi-bounce) for one frame.
+    Reference(ReferenceArgs),
+}
+
+#[derive(Args, Clone)]
+struct ReferenceOpts {
+    /// Reference samples per pixel (cosine-weighted hemisphere paths at each visible point).
+    #[arg(long = "spp", default_value_t = ReferenceSettings::default().spp)]
+    spp: u32,
+    /// Reference bounce limit for the multi-bounce image.
+    #[arg(long = "bounces", default_value_t = ReferenceSettings::default().bounces)]
+    bounces: u32,
+    /// Reference seed.
+    #[arg(long = "reference-seed", default_value_t = ReferenceSettings::default().seed)]
+    reference_seed: u64,
+    /// Directory of the reference cache.
+    #[arg(long, default_value = "results/cache")]
+    cache: PathBuf,
+    /// Do not read or write the reference cache.
+    #[arg(long)]
+    no_cache: bool,
+}
+
+impl ReferenceOpts {
+    fn settings(&self) -> Result<ReferenceSettings> {
+        if self.spp == 0 {
+            return Err(Error::param(
+                "spp",
+                "at least one sample per pixel is needed (got 0)",
+            ));
+        }
+        if self.bounces == 0 {
+            return Err(Error::param(
+                "bounces",
+                "at least one bounce is needed (got 0)",
+            ));
+        }
+        Ok(ReferenceSettings {
+            spp: self.spp,
+            bounces: self.bounces,
+            seed: self.reference_seed,
+        })
+    }
+    fn cache(&self) -> ReferenceCache {
+        ReferenceCache {
+            dir: (!self.no_cache).then(|| self.cache.clone()),
+        }
+    }
+}
+
+#[derive(Args)]
+struct ReferenceArgs {
+    /// Scene: a built-in name or a descriptor JSON.
+    #[arg(long, default_value = "cornell")]
+    scene: String,
+    /// Animation frame.
+    #[arg(long, default_value_t = 0)]
+    frame: u32,
+    /// Image size WIDTHxHEIGHT.
+    #[arg(long, default_value = "256x192")]
+    resolution: String,
+    /// Output directory.
+    #[arg(long, default_value = "results/local")]
+    out: PathBuf,
+    /// Extra directory searched first for scene assets.
+    #[arg(long)]
+    assets: Option<PathBuf>,
+    /// Also render with the next seed and report the relative MSE between the two (an
+    /// estimate of the reference's own noise).
+    #[arg(long)]
+    error_estimate: bool,
+    #[command(flatten)]
+    reference: ReferenceOpts,
 }
 
 #[derive(Args, Clone)]
@@ -92,6 +167,19 @@ struct RunArgs {
     /// Do not show a progress bar.
     #[arg(long)]
     quiet: bool,
+    /// Also measure image error against the CPU reference (RMSE, relative MSE, MAE, FLIP,
+    /// flicker) on consecutive frame pairs spread over the measured frames.
+    #[arg(long)]
+    quality: bool,
+    /// Frame pairs compared with the reference when --quality is given.
+    #[arg(long, default_value_t = 2)]
+    quality_pairs: u32,
+    /// The reference component the indirect irradiance is compared with: one-bounce or
+    /// multi-bounce.
+    #[arg(long, default_value = "one-bounce")]
+    quality_reference: String,
+    #[command(flatten)]
+    reference: ReferenceOpts,
     #[command(flatten)]
     gpu: GpuArgs,
 }
@@ -119,6 +207,7 @@ fn main() -> ExitCode {
         Some(Command::Run(args)) => run(&args),
         Some(Command::List) => list(),
         Some(Command::Report(args)) => report_cmd(&args),
+        Some(Command::Reference(args)) => reference_cmd(&args),
     };
     match outcome {
         Ok(()) => ExitCode::SUCCESS,
@@ -230,6 +319,15 @@ fn run(args: &RunArgs) -> Result<()> {
         shadow_size: args.shadow_size,
     };
     config.validate()?;
+    let quality = if args.quality {
+        Some(QualityConfig {
+            pairs: args.quality_pairs,
+            reference: args.reference.settings()?,
+            component: IndirectComponent::parse(&args.quality_reference)?,
+        })
+    } else {
+        None
+    };
     let registry = registry::all();
     let names: Vec<String> = if args.technique.is_empty() {
         registry.iter().map(|t| t.name.to_string()).collect()
@@ -284,6 +382,30 @@ fn run(args: &RunArgs) -> Result<()> {
         bar.set_message(info.name.to_string());
         let (mut result, images) = harness.run(info, p, &config, &mut || bar.inc(1))?;
         let stem = format!("{}-{}", desc.name, info.name);
+        let mut extra_images = Vec::new();
+        if let Some(q) = &quality {
+            bar.set_message(format!("{} (quality)", info.name));
+            let (summary, qimages) = harness.measure_quality(
+                info,
+                p,
+                &config,
+                q,
+                &args.reference.cache(),
+                &mut || bar.inc(1),
+            )?;
+            result.quality = Some(summary);
+            if !args.no_images {
+                let reference_png = args.out.join(format!("{stem}-reference.png"));
+                gibench_harness::image_io::write_png(
+                    &reference_png,
+                    qimages.size,
+                    &qimages.reference_display,
+                )?;
+                let flip_png = args.out.join(format!("{stem}-flip.png"));
+                gibench_harness::image_io::write_png(&flip_png, qimages.size, &qimages.flip_map)?;
+                extra_images = vec![file_name(&reference_png), file_name(&flip_png)];
+            }
+        }
         if !args.no_images {
             let png = args.out.join(format!("{stem}.png"));
             gibench_harness::image_io::write_png(&png, images.size, &images.display)?;
@@ -292,6 +414,7 @@ fn run(args: &RunArgs) -> Result<()> {
             let direct = args.out.join(format!("{stem}-direct.exr"));
             gibench_harness::image_io::write_exr(&direct, images.size, &images.direct)?;
             result.images = vec![file_name(&png), file_name(&exr), file_name(&direct)];
+            result.images.extend(extra_images);
         }
         result.write(&args.out.join(format!("{stem}.json")))?;
         results.push(result);
@@ -390,5 +513,95 @@ fn report_cmd(args: &ReportArgs) -> Result<()> {
         &args.out.join(format!("{}.svg", args.stem)),
         "Per-stage times",
     )?;
+    Ok(())
+}
+
+fn reference_cmd(args: &ReferenceArgs) -> Result<()> {
+    let resolution = parse_resolution(&args.resolution)?;
+    RunConfig {
+        resolution,
+        frames: 1,
+        warmup: 0,
+        first_frame: args.frame,
+        timing: TimingMode::Stages,
+        seed: 1,
+        shadow_size: 256,
+    }
+    .validate()?;
+    let settings = args.reference.settings()?;
+    let desc = SceneDescriptor::resolve(&args.scene)?;
+    let scene = Scene::load(&desc, &AssetPaths::standard(args.assets.as_deref()))?;
+    let frame = gibench_harness::anim::FrameClock::new(&desc).frame(args.frame);
+    let cache = args.reference.cache();
+    eprintln!(
+        "gibench: reference for '{}' frame {} at {}x{}: {} spp, {} bounces, seed {}",
+        desc.name,
+        args.frame,
+        resolution[0],
+        resolution[1],
+        settings.spp,
+        settings.bounces,
+        settings.seed
+    );
+    let start = std::time::Instant::now();
+    let r = cache.get(&scene, &frame, resolution, &settings)?;
+    let seconds = start.elapsed().as_secs_f64();
+    let mut estimate = None;
+    if args.error_estimate {
+        let other = ReferenceSettings {
+            seed: settings.seed + 1,
+            ..settings
+        };
+        let r2 = cache.get(&scene, &frame, resolution, &other)?;
+        let one = gibench_harness::metrics::relative_mse(&r.one_bounce, &r2.one_bounce, &r.hit);
+        let multi =
+            gibench_harness::metrics::relative_mse(&r.multi_bounce, &r2.multi_bounce, &r.hit);
+        println!(
+            "relative MSE between seeds {} and {}: one-bounce {one:.5}, multi-bounce {multi:.5}",
+            settings.seed, other.seed
+        );
+        estimate = Some(
+            serde_json::json!({"seeds": [settings.seed, other.seed], "one_bounce_rel_mse": one, "multi_bounce_rel_mse": multi}),
+        );
+    }
+    let stem = format!("{}-f{}-reference", desc.name, args.frame);
+    let out = |suffix: &str| args.out.join(format!("{stem}{suffix}"));
+    let arr =
+        |v: &[gibench_harness::glam::Vec3]| v.iter().map(|c| c.to_array()).collect::<Vec<_>>();
+    gibench_harness::image_io::write_exr(&out("-direct.exr"), resolution, &arr(&r.direct))?;
+    gibench_harness::image_io::write_exr(&out("-one-bounce.exr"), resolution, &arr(&r.one_bounce))?;
+    gibench_harness::image_io::write_exr(
+        &out("-multi-bounce.exr"),
+        resolution,
+        &arr(&r.multi_bounce),
+    )?;
+    gibench_harness::image_io::write_exr(&out("-radiance.exr"), resolution, &arr(&r.radiance))?;
+    let exposure = desc.settings.exposure;
+    let png = |radiance: &[gibench_harness::glam::Vec3]| -> Vec<u8> {
+        gibench_harness::metrics::tonemap_srgb8(radiance, exposure)
+            .chunks_exact(3)
+            .flat_map(|p| [p[0], p[1], p[2], 255])
+            .collect()
+    };
+    gibench_harness::image_io::write_png(&out(".png"), resolution, &png(&r.radiance))?;
+    gibench_harness::image_io::write_png(
+        &out("-one-bounce.png"),
+        resolution,
+        &png(&r.radiance_with(&r.one_bounce)),
+    )?;
+    gibench_harness::image_io::write_png(
+        &out("-direct.png"),
+        resolution,
+        &png(&r.radiance_with(&vec![Default::default(); r.direct.len()])),
+    )?;
+    let info = serde_json::json!({
+        "scene": desc.name, "frame": args.frame, "resolution": resolution, "spp": settings.spp,
+        "bounces": settings.bounces, "seed": settings.seed, "seconds": seconds,
+        "reference_version": gibench_harness::reference::REFERENCE_VERSION,
+        "git_commit": gibench_harness::runner::git_commit(), "error_estimate": estimate,
+    });
+    let json = serde_json::to_vec_pretty(&info).map_err(|e| Error::Invalid(e.to_string()))?;
+    gibench_harness::error::write_atomic(&out(".json"), &json)?;
+    eprintln!("wrote {stem}.png, .json and -direct/-one-bounce/-multi-bounce/-radiance.exr to {} ({seconds:.1} s)", args.out.display());
     Ok(())
 }

@@ -83,3 +83,92 @@ fn sibenik_loads_through_the_asset_search_path() {
     let r = RunResult::read(&tmp.path().join("sibenik-direct.json")).unwrap();
     assert_eq!(r.scene, "sibenik");
 }
+
+#[test]
+fn quality_columns_and_results() {
+    let tmp = tempfile::tempdir().unwrap();
+    let cache = tmp.path().join("cache");
+    let stdout = run_ok(
+        &[
+            "--frames",
+            "3",
+            "--warmup",
+            "1",
+            "--quality",
+            "--quality-pairs",
+            "1",
+            "--spp",
+            "16",
+            "--cache",
+            cache.to_str().unwrap(),
+        ],
+        tmp.path(),
+    );
+    for col in ["RMSE", "relMSE", "FLIP", "flicker"] {
+        assert!(stdout.contains(col), "table lacks '{col}':\n{stdout}");
+    }
+    let r = RunResult::read(&tmp.path().join("cornell-direct.json")).unwrap();
+    let q = r.quality.expect("quality in the results");
+    // Frames 2 and 3 (a consecutive pair ending at the last measured frame).
+    assert_eq!(
+        q.frames.iter().map(|f| f.frame).collect::<Vec<_>>(),
+        vec![2, 3]
+    );
+    assert!(q.frames[1].temporal.is_some());
+    // `direct` has no indirect light: its relative MSE against one bounce is close to 1.
+    assert!(
+        q.rel_mse.mean > 0.5 && q.rel_mse.mean <= 1.0,
+        "relMSE {}",
+        q.rel_mse.mean
+    );
+    assert!(q.rmse.mean > 0.0 && q.flip_mean.mean > 0.0);
+    assert!(tmp.path().join("cornell-direct-reference.png").is_file());
+    assert!(tmp.path().join("cornell-direct-flip.png").is_file());
+    // The references were cached.
+    assert_eq!(std::fs::read_dir(&cache).unwrap().count(), 2);
+}
+
+/// README: two seeds of the reference at the default spp agree to a relative MSE below 0.02.
+#[test]
+fn reference_two_seeds_agree_at_default_spp() {
+    let tmp = tempfile::tempdir().unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_gibench"))
+        .args([
+            "reference",
+            "--scene",
+            "cornell",
+            "--resolution",
+            "128x96",
+            "--error-estimate",
+            "--no-cache",
+            "--out",
+        ])
+        .arg(tmp.path())
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let info: serde_json::Value = serde_json::from_slice(
+        &std::fs::read(tmp.path().join("cornell-f0-reference.json")).unwrap(),
+    )
+    .unwrap();
+    assert_eq!(info["spp"], 256);
+    let e = &info["error_estimate"];
+    for k in ["one_bounce_rel_mse", "multi_bounce_rel_mse"] {
+        let v = e[k].as_f64().unwrap();
+        assert!(v > 0.0 && v < 0.02, "{k} = {v}");
+    }
+    for f in [
+        "-direct.exr",
+        "-one-bounce.exr",
+        "-multi-bounce.exr",
+        "-radiance.exr",
+        ".png",
+    ] {
+        assert!(
+            tmp.path()
+                .join(format!("cornell-f0-reference{f}"))
+                .is_file(),
+            "{f}"
+        );
+    }
+}

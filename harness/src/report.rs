@@ -464,6 +464,10 @@ pub fn stage_table(results: &[RunResult]) -> Table {
         .into();
     columns.extend(stages.iter().cloned());
     columns.extend(["Σ stages", "frame (median ms)", "FPS"].map(String::from));
+    let quality = results.iter().any(|r| r.quality.is_some());
+    if quality {
+        columns.extend(["RMSE", "relMSE", "FLIP", "flicker"].map(String::from));
+    }
 
     let rows = results
         .iter()
@@ -481,15 +485,37 @@ pub fn stage_table(results: &[RunResult]) -> Table {
             row.push(Cell::Ms(stage_sum(r)));
             row.push(Cell::Ms(r.frame.as_ref().map(|f| f.frame_ms.median)));
             row.push(Cell::Num(r.frame.as_ref().map(|f| f.fps), 1));
+            if quality {
+                let q = r.quality.as_ref();
+                row.push(Cell::Num(q.map(|q| q.rmse.mean), 4));
+                row.push(Cell::Num(q.map(|q| q.rel_mse.mean), 4));
+                row.push(Cell::Num(q.map(|q| q.flip_mean.mean), 4));
+                row.push(Cell::Num(q.and_then(|q| q.temporal.map(|t| t.mean)), 4));
+            }
             row
         })
         .collect();
 
+    let mut notes = timing_notes(&results.iter().collect::<Vec<_>>());
+    if quality {
+        let mut refs: Vec<&str> = results
+            .iter()
+            .filter_map(|r| r.quality.as_ref().map(|q| q.reference.as_str()))
+            .collect();
+        refs.dedup();
+        notes.push(format!(
+            "Quality: means over the compared frames against the CPU reference ({}). RMSE, relMSE \
+             (relative MSE, Rousselle et al. 2011) of indirect irradiance; FLIP (LDR-FLIP, mean) of the \
+             tonemapped composed images; flicker: RMS of the frame-to-frame change of indirect irradiance \
+             beyond the reference's change.",
+            refs.join("; ")
+        ));
+    }
     Table {
         title: "Per-stage GPU/CPU time (median ms)".to_string(),
         columns,
         rows,
-        notes: timing_notes(&results.iter().collect::<Vec<_>>()),
+        notes,
     }
 }
 
@@ -961,6 +987,7 @@ mod tests {
                 frames_in_flight: 2,
             }),
             counters: BTreeMap::from([("shadow maps".to_string(), stats(1.0))]),
+            quality: None,
             images: vec!["frame.png".into()],
         }
     }

@@ -97,6 +97,9 @@ pub struct RunResult {
     /// Per-stage counters averaged over measured frames (e.g. shadow maps rendered).
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub counters: BTreeMap<String, Stats>,
+    /// Error against the CPU reference (`gibench run --quality`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub quality: Option<crate::metrics::QualitySummary>,
     /// Images written next to the results file (relative paths).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub images: Vec<String>,

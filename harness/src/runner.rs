@@ -13,8 +13,10 @@ use serde_json::Value;
 use crate::anim::{FrameClock, FrameState};
 use crate::bvh::SceneBvh;
 use crate::gpu::GpuContext;
+use crate::metrics::QualitySummary;
 use crate::passes::{Compose, DirectLight, FrameUniforms, GBuffer, GpuScene};
 use crate::profiler::{ProfileMode, Profiler};
+use crate::quality::{CapturedFrame, QualityConfig, QualityImages, ReferenceCache};
 use crate::results::{FrameRange, RunResult, SCHEMA_VERSION};
 use crate::scene::Scene;
 use crate::technique::{FrameContext, Params, PrepareContext, Technique, TechniqueInfo};
@@ -338,9 +340,62 @@ impl<'a> Harness<'a> {
             stages,
             frame: frame_result,
             counters,
+            quality: None,
             images: Vec::new(),
         };
         Ok((result, images.expect("at least one timing pass")))
+    }
+
+    /// Runs the technique once more over the frames, untimed, capturing its images at the
+    /// frames `quality` chooses, and compares them with the (cached) reference.
+    pub fn measure_quality(
+        &self,
+        info: &TechniqueInfo,
+        params: &Params,
+        config: &RunConfig,
+        quality: &QualityConfig,
+        cache: &ReferenceCache,
+        progress: &mut dyn FnMut(),
+    ) -> Result<(QualitySummary, QualityImages)> {
+        let (mut technique, compose) = self.build(info, params, config)?;
+        let mut profiler = Profiler::new(self.gpu, ProfileMode::Frame);
+        let targets = quality.capture_frames(config.first_frame + config.warmup, config.frames);
+        let last = targets.last().map(|t| t.0).unwrap_or(config.first_frame);
+        let to_vec3 = |v: Vec<[f32; 3]>| v.into_iter().map(glam::Vec3::from).collect::<Vec<_>>();
+        let mut captured = Vec::new();
+        for f in config.first_frame..=last {
+            let frame = self.clock.frame(f);
+            self.render_frame(technique.as_mut(), &compose, &mut profiler, &frame, false)?;
+            if let Some(&(_, pair_end)) = targets.iter().find(|(g, _)| *g == f) {
+                profiler.finish(self.gpu)?;
+                captured.push(CapturedFrame {
+                    frame: f,
+                    pair_end,
+                    indirect: to_vec3(self.read_technique_output(technique.as_ref())?),
+                    radiance: to_vec3(crate::image_io::read_rgb_f32(self.gpu, &compose.radiance)?),
+                });
+            }
+            progress();
+        }
+        profiler.finish(self.gpu)?;
+        let settings = quality.reference_settings();
+        let references = captured
+            .iter()
+            .map(|c| {
+                cache.get(
+                    self.scene,
+                    &self.clock.frame(c.frame),
+                    config.resolution,
+                    &settings,
+                )
+            })
+            .collect::<Result<Vec<_>>>()?;
+        crate::quality::compare(
+            &captured,
+            &references,
+            quality,
+            self.scene.descriptor.settings.exposure,
+        )
     }
 
     fn read_technique_output(&self, technique: &dyn Technique) -> Result<Vec<[f32; 3]>> {

@@ -1,0 +1,318 @@
+//! Image quality of a technique against the CPU reference renderer, and the reference cache.
+//!
+//! `gibench run --quality` runs the technique once more over the same frames, untimed, reads
+//! back its indirect irradiance and composed radiance at chosen frames (in consecutive pairs,
+//! so that flicker can be measured), and compares them with the reference for the same frames:
+//! RMSE, relative MSE and MAE of indirect irradiance, FLIP of the tonemapped composed images,
+//! and temporal instability (see [`crate::metrics`]).
+//!
+//! References are cached on disk by (scene descriptor, frame, resolution, spp, bounces, seed,
+//! reference code version), so sweeps and repeated runs reuse them.
+
+use std::path::{Path, PathBuf};
+
+use glam::Vec3;
+
+use crate::anim::FrameState;
+use crate::metrics::{self, FrameQuality, QualitySummary};
+use crate::reference::{self, ReferenceImages, ReferenceSettings};
+use crate::scene::Scene;
+use crate::{Error, Result};
+
+/// Which reference component a technique's indirect irradiance is compared with.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum IndirectComponent {
+    /// Exactly one bounce (Laine, Keller with one bounce, ISM).
+    OneBounce,
+    /// All bounces up to the reference's bounce count.
+    MultiBounce,
+}
+
+impl IndirectComponent {
+    pub fn parse(s: &str) -> Result<IndirectComponent> {
+        match s {
+            "one-bounce" => Ok(IndirectComponent::OneBounce),
+            "multi-bounce" => Ok(IndirectComponent::MultiBounce),
+            _ => Err(Error::param(
+                "quality-reference",
+                format!("expected one-bounce or multi-bounce (got '{s}')"),
+            )),
+        }
+    }
+    pub fn name(self) -> &'static str {
+        match self {
+            IndirectComponent::OneBounce => "one-bounce",
+            IndirectComponent::MultiBounce => "multi-bounce",
+        }
+    }
+    /// The component's image.
+    pub fn of(self, r: &ReferenceImages) -> &[Vec3] {
+        match self {
+            IndirectComponent::OneBounce => &r.one_bounce,
+            IndirectComponent::MultiBounce => &r.multi_bounce,
+        }
+    }
+}
+
+/// Settings of the quality measurement.
+#[derive(Clone, Debug)]
+pub struct QualityConfig {
+    /// Number of consecutive frame pairs compared (spread evenly over the measured frames).
+    pub pairs: u32,
+    pub reference: ReferenceSettings,
+    pub component: IndirectComponent,
+}
+
+impl QualityConfig {
+    /// The reference settings actually rendered: one bounce suffices for the one-bounce component.
+    pub fn reference_settings(&self) -> ReferenceSettings {
+        let mut s = self.reference;
+        if self.component == IndirectComponent::OneBounce {
+            s.bounces = 1;
+        }
+        s
+    }
+
+    /// Label stored in the results, e.g. "one-bounce, 256 spp, seed 1".
+    pub fn label(&self) -> String {
+        let s = self.reference_settings();
+        format!(
+            "{}, {} spp, {} bounces, seed {}",
+            self.component.name(),
+            s.spp,
+            s.bounces,
+            s.seed
+        )
+    }
+
+    /// Animation frames to capture, as (frame, is_pair_end) in increasing order: for each of
+    /// `pairs` target frames spread over the measured range, the target and the frame before it.
+    pub fn capture_frames(&self, first_measured: u32, measured: u32) -> Vec<(u32, bool)> {
+        let last = first_measured + measured - 1;
+        if measured < 2 || self.pairs == 0 {
+            return vec![(last, false)];
+        }
+        let mut out: Vec<(u32, bool)> = Vec::new();
+        for k in 1..=self.pairs {
+            let t =
+                first_measured + 1 + ((measured - 2) as u64 * k as u64 / self.pairs as u64) as u32;
+            for (f, end) in [(t - 1, false), (t, true)] {
+                match out.iter_mut().find(|(g, _)| *g == f) {
+                    Some(e) => e.1 |= end,
+                    None => out.push((f, end)),
+                }
+            }
+        }
+        out.sort();
+        out
+    }
+}
+
+/// On-disk cache of reference images (`None` directory: no caching).
+#[derive(Clone, Debug, Default)]
+pub struct ReferenceCache {
+    pub dir: Option<PathBuf>,
+}
+
+const MAGIC: &[u8; 8] = b"GIBREF1\n";
+
+fn fnv1a(bytes: &[u8], mut h: u64) -> u64 {
+    for b in bytes {
+        h ^= *b as u64;
+        h = h.wrapping_mul(0x100000001b3);
+    }
+    h
+}
+
+impl ReferenceCache {
+    /// The cache key's file name for these inputs.
+    pub fn file_name(
+        scene: &Scene,
+        frame: u32,
+        resolution: [u32; 2],
+        s: &ReferenceSettings,
+    ) -> String {
+        let desc = serde_json::to_vec(&scene.descriptor).unwrap_or_default();
+        let mut h = fnv1a(&desc, 0xcbf29ce484222325);
+        let key = format!(
+            "{frame}|{}x{}|{}|{}|{}|{}|{}|{}",
+            resolution[0],
+            resolution[1],
+            s.spp,
+            s.bounces,
+            s.seed,
+            reference::REFERENCE_VERSION,
+            scene.mesh.triangle_count(),
+            env!("CARGO_PKG_VERSION")
+        );
+        h = fnv1a(key.as_bytes(), h);
+        format!(
+            "{}-f{frame}-{}x{}-spp{}-b{}-s{}-{h:016x}.bin",
+            scene.descriptor.name, resolution[0], resolution[1], s.spp, s.bounces, s.seed
+        )
+    }
+
+    /// The reference for `frame`, from the cache or rendered (and then cached).
+    pub fn get(
+        &self,
+        scene: &Scene,
+        frame: &FrameState,
+        resolution: [u32; 2],
+        settings: &ReferenceSettings,
+    ) -> Result<ReferenceImages> {
+        let path = self
+            .dir
+            .as_ref()
+            .map(|d| d.join(Self::file_name(scene, frame.index, resolution, settings)));
+        if let Some(p) = &path {
+            if let Some(r) = read_cached(p, resolution, settings) {
+                return Ok(r);
+            }
+        }
+        let r = reference::render_reference(scene, frame, resolution, settings);
+        if let Some(p) = &path {
+            crate::error::write_atomic(p, &encode(&r))?;
+        }
+        Ok(r)
+    }
+}
+
+fn encode(r: &ReferenceImages) -> Vec<u8> {
+    let mut out = MAGIC.to_vec();
+    for v in [r.size[0], r.size[1], r.spp, r.bounces] {
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+    out.extend_from_slice(&r.seed.to_le_bytes());
+    out.extend(r.hit.iter().map(|h| *h as u8));
+    for img in [
+        &r.albedo,
+        &r.direct,
+        &r.one_bounce,
+        &r.multi_bounce,
+        &r.radiance,
+    ] {
+        for v in img.iter() {
+            for c in v.to_array() {
+                out.extend_from_slice(&c.to_le_bytes());
+            }
+        }
+    }
+    out
+}
+
+/// A cached reference, or `None` if absent or not matching (it is then rendered again).
+fn read_cached(path: &Path, size: [u32; 2], s: &ReferenceSettings) -> Option<ReferenceImages> {
+    let bytes = std::fs::read(path).ok()?;
+    let n = (size[0] * size[1]) as usize;
+    if bytes.len() != 8 + 24 + n + 5 * n * 12 || &bytes[..8] != MAGIC {
+        return None;
+    }
+    let u32_at = |o: usize| u32::from_le_bytes(bytes[o..o + 4].try_into().unwrap());
+    let seed = u64::from_le_bytes(bytes[24..32].try_into().unwrap());
+    if [u32_at(8), u32_at(12), u32_at(16), u32_at(20)] != [size[0], size[1], s.spp, s.bounces]
+        || seed != s.seed
+    {
+        return None;
+    }
+    let hit: Vec<bool> = bytes[32..32 + n].iter().map(|b| *b != 0).collect();
+    let mut o = 32 + n;
+    let mut img = || {
+        let v: Vec<Vec3> = (0..n)
+            .map(|i| {
+                let f = |c: usize| {
+                    f32::from_le_bytes(
+                        bytes[o + i * 12 + 4 * c..o + i * 12 + 4 * c + 4]
+                            .try_into()
+                            .unwrap(),
+                    )
+                };
+                Vec3::new(f(0), f(1), f(2))
+            })
+            .collect();
+        o += n * 12;
+        v
+    };
+    let (albedo, direct, one_bounce, multi_bounce, radiance) = (img(), img(), img(), img(), img());
+    Some(ReferenceImages {
+        size,
+        spp: s.spp,
+        bounces: s.bounces,
+        seed: s.seed,
+        hit,
+        albedo,
+        direct,
+        one_bounce,
+        multi_bounce,
+        radiance,
+    })
+}
+
+/// A technique's images at one frame.
+pub struct CapturedFrame {
+    pub frame: u32,
+    pub pair_end: bool,
+    pub indirect: Vec<Vec3>,
+    pub radiance: Vec<Vec3>,
+}
+
+/// Images kept for a person to look at: the last compared frame's reference and FLIP map.
+pub struct QualityImages {
+    pub size: [u32; 2],
+    pub reference_display: Vec<u8>,
+    pub flip_map: Vec<u8>,
+}
+
+/// Compares captured frames with their references.
+pub fn compare(
+    captured: &[CapturedFrame],
+    references: &[ReferenceImages],
+    config: &QualityConfig,
+    exposure: f32,
+) -> Result<(QualitySummary, QualityImages)> {
+    let mut frames = Vec::new();
+    let mut images = None;
+    for (i, (c, r)) in captured.iter().zip(references).enumerate() {
+        let component = config.component.of(r);
+        let ref_radiance = r.radiance_with(component);
+        let size = r.size;
+        let test8 = metrics::tonemap_srgb8(&c.radiance, exposure);
+        let ref8 = metrics::tonemap_srgb8(&ref_radiance, exposure);
+        let flip = metrics::flip_masked(&test8, &ref8, size, &r.hit)?;
+        let temporal = if c.pair_end && i > 0 && captured[i - 1].frame + 1 == c.frame {
+            let (pc, pr) = (&captured[i - 1], &references[i - 1]);
+            let mask: Vec<bool> = r.hit.iter().zip(&pr.hit).map(|(a, b)| *a && *b).collect();
+            Some(metrics::temporal_instability(
+                &pc.indirect,
+                &c.indirect,
+                config.component.of(pr),
+                component,
+                &mask,
+            ))
+        } else {
+            None
+        };
+        frames.push(FrameQuality {
+            frame: c.frame,
+            rmse: metrics::rmse(&c.indirect, component, &r.hit),
+            rel_mse: metrics::relative_mse(&c.indirect, component, &r.hit),
+            mae: metrics::mae(&c.indirect, component, &r.hit),
+            flip_mean: flip.mean,
+            temporal,
+        });
+        if i + 1 == captured.len() {
+            let rgba = |rgb: &[u8]| {
+                rgb.chunks_exact(3)
+                    .flat_map(|p| [p[0], p[1], p[2], 255])
+                    .collect::<Vec<u8>>()
+            };
+            images = Some(QualityImages {
+                size,
+                reference_display: rgba(&ref8),
+                flip_map: metrics::flip_error_png(&flip, size),
+            });
+        }
+    }
+    let images = images
+        .ok_or_else(|| Error::Invalid("no frames were compared with the reference".into()))?;
+    Ok((metrics::summarize(config.label(), frames), images))
+}
