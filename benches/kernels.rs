@@ -70,7 +70,7 @@ fn frames(c: &mut Criterion) {
     for info in registry::all() {
         let params = gibench_harness::technique::Params::parse(info.name, info.params, &[])
             .expect("defaults");
-        let (mut technique, compose) = h.build(&info, &params, &config).expect("technique");
+        let (mut technique, compose) = h.build(info, &params, &config).expect("technique");
         let mut profiler = Profiler::new(&gpu, ProfileMode::Frame);
         let mut i = 0;
         c.bench_function(&format!("frame/cornell-256x192/{}", info.name), |b| {

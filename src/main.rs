@@ -39,6 +39,34 @@ enum Command {
     Report(ReportArgs),
     /// Render the CPU reference (direct, one-bounce, multi-bounce) for one frame.
     Reference(ReferenceArgs),
+    /// Run one technique over a list of values of one parameter (e.g. vpls=64,128,256 or
+    /// tiles=1x1,2x2,4x4,8x8) and tabulate and plot per-stage times against it.
+    Sweep(SweepArgs),
+    /// Plot per-frame error against the reference from results files made with
+    /// `run --quality --quality-all` (e.g. the lag of keller-incremental).
+    PlotQuality(PlotQualityArgs),
+}
+
+#[derive(Args)]
+struct SweepArgs {
+    /// The swept parameter and its values: name=v1,v2,...
+    #[arg(long)]
+    sweep: String,
+    #[command(flatten)]
+    run: RunArgs,
+}
+
+#[derive(Args)]
+struct PlotQualityArgs {
+    /// Results JSON files (or directories holding them).
+    #[arg(required = true)]
+    inputs: Vec<PathBuf>,
+    /// rmse, rel_mse, mae, flip or flicker.
+    #[arg(long, default_value = "rmse")]
+    metric: String,
+    /// Output SVG.
+    #[arg(long, default_value = "results/local/quality-per-frame.svg")]
+    out: PathBuf,
 }
 
 #[derive(Args, Clone)]
@@ -174,6 +202,9 @@ struct RunArgs {
     /// Frame pairs compared with the reference when --quality is given.
     #[arg(long, default_value_t = 2)]
     quality_pairs: u32,
+    /// With --quality, compare every measured frame (per-frame error and lag plots).
+    #[arg(long)]
+    quality_all: bool,
     /// The reference component the indirect irradiance is compared with: one-bounce or
     /// multi-bounce.
     #[arg(long, default_value = "one-bounce")]
@@ -208,6 +239,8 @@ fn main() -> ExitCode {
         Some(Command::List) => list(),
         Some(Command::Report(args)) => report_cmd(&args),
         Some(Command::Reference(args)) => reference_cmd(&args),
+        Some(Command::Sweep(args)) => sweep(&args),
+        Some(Command::PlotQuality(args)) => plot_quality(&args),
     };
     match outcome {
         Ok(()) => ExitCode::SUCCESS,
@@ -307,8 +340,17 @@ fn assign_params(techniques: &[&TechniqueInfo], raw: &[String]) -> Result<Vec<Pa
         .collect()
 }
 
-fn run(args: &RunArgs) -> Result<()> {
-    // Everything that can be checked without running is checked before anything is written.
+/// Everything a run needs, checked before anything runs or is written.
+struct Plan {
+    config: RunConfig,
+    quality: Option<QualityConfig>,
+    techniques: Vec<&'static TechniqueInfo>,
+    params: Vec<Params>,
+    desc: SceneDescriptor,
+    scene: Scene,
+}
+
+fn plan(args: &RunArgs, extra_params: &[String]) -> Result<Plan> {
     let config = RunConfig {
         resolution: parse_resolution(&args.resolution)?,
         frames: args.frames,
@@ -322,6 +364,7 @@ fn run(args: &RunArgs) -> Result<()> {
     let quality = if args.quality {
         Some(QualityConfig {
             pairs: args.quality_pairs,
+            all: args.quality_all,
             reference: args.reference.settings()?,
             component: IndirectComponent::parse(&args.quality_reference)?,
         })
@@ -334,26 +377,32 @@ fn run(args: &RunArgs) -> Result<()> {
     } else {
         args.technique.clone()
     };
-    let techniques: Vec<&TechniqueInfo> = names
+    let techniques: Vec<&'static TechniqueInfo> = names
         .iter()
-        .map(|n| TechniqueInfo::find(&registry, n.trim()))
+        .map(|n| TechniqueInfo::find(registry, n.trim()))
         .collect::<Result<_>>()?;
-    let params = assign_params(&techniques, &args.params)?;
+    let mut raw = args.params.clone();
+    raw.extend_from_slice(extra_params);
+    let params = assign_params(&techniques, &raw)?;
     let desc = SceneDescriptor::resolve(&args.scene)?;
-    let assets = AssetPaths::standard(args.assets.as_deref());
-    let scene = Scene::load(&desc, &assets)?;
-    let gpu = GpuContext::new(&GpuOptions {
-        backend: args.gpu.backend.clone(),
-        adapter: args.gpu.adapter.clone(),
-    })?;
-    let harness = Harness::new(&gpu, &scene, &config)?;
+    let scene = Scene::load(&desc, &AssetPaths::standard(args.assets.as_deref()))?;
+    Ok(Plan {
+        config,
+        quality,
+        techniques,
+        params,
+        desc,
+        scene,
+    })
+}
 
-    let passes = if config.timing == TimingMode::Both {
+fn progress_bar(args: &RunArgs, plan: &Plan, runs: u64) -> indicatif::ProgressBar {
+    let passes = if plan.config.timing == TimingMode::Both {
         2
     } else {
         1
-    };
-    let total = (techniques.len() as u64) * passes * (config.frames + config.warmup) as u64;
+    } + plan.quality.is_some() as u64;
+    let total = runs * passes * (plan.config.frames + plan.config.warmup) as u64;
     let bar = if args.quiet {
         indicatif::ProgressBar::hidden()
     } else {
@@ -365,79 +414,200 @@ fn run(args: &RunArgs) -> Result<()> {
         )
         .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
     );
+    bar
+}
+
+fn announce(plan: &Plan, gpu: &GpuContext) {
+    let c = &plan.config;
     eprintln!(
         "gibench: scene '{}' ({} triangles) at {}x{} on {} ({}), {} measured + {} warm-up frames, timing '{}'",
-        desc.name,
-        scene.mesh.triangle_count(),
-        config.resolution[0],
-        config.resolution[1],
+        plan.desc.name,
+        plan.scene.mesh.triangle_count(),
+        c.resolution[0],
+        c.resolution[1],
         gpu.info.adapter,
         gpu.info.backend,
-        config.frames,
-        config.warmup,
-        config.timing.name()
+        c.frames,
+        c.warmup,
+        c.timing.name()
     );
-    let mut results = Vec::new();
-    for (info, p) in techniques.iter().zip(&params) {
-        bar.set_message(info.name.to_string());
-        let (mut result, images) = harness.run(info, p, &config, &mut || bar.inc(1))?;
-        let stem = format!("{}-{}", desc.name, info.name);
-        let mut extra_images = Vec::new();
-        if let Some(q) = &quality {
-            bar.set_message(format!("{} (quality)", info.name));
-            let (summary, qimages) = harness.measure_quality(
-                info,
-                p,
-                &config,
-                q,
-                &args.reference.cache(),
-                &mut || bar.inc(1),
-            )?;
-            result.quality = Some(summary);
-            if !args.no_images {
-                let reference_png = args.out.join(format!("{stem}-reference.png"));
-                gibench_harness::image_io::write_png(
-                    &reference_png,
-                    qimages.size,
-                    &qimages.reference_display,
-                )?;
-                let flip_png = args.out.join(format!("{stem}-flip.png"));
-                gibench_harness::image_io::write_png(&flip_png, qimages.size, &qimages.flip_map)?;
-                extra_images = vec![file_name(&reference_png), file_name(&flip_png)];
-            }
-        }
+}
+
+/// Runs one technique (timing passes, then quality if asked) and writes its results file and
+/// images as `{stem}.*` in `args.out`.
+fn run_one(
+    args: &RunArgs,
+    plan: &Plan,
+    harness: &Harness,
+    info: &TechniqueInfo,
+    params: &Params,
+    stem: &str,
+    bar: &indicatif::ProgressBar,
+) -> Result<RunResult> {
+    let write_png = gibench_harness::image_io::write_png;
+    let write_exr = gibench_harness::image_io::write_exr;
+    let (mut result, images) = harness.run(info, params, &plan.config, &mut || bar.inc(1))?;
+    let mut extra_images = Vec::new();
+    if let Some(q) = &plan.quality {
+        bar.set_message(format!("{} (quality)", info.name));
+        let (summary, qimages) = harness.measure_quality(
+            info,
+            params,
+            &plan.config,
+            q,
+            &args.reference.cache(),
+            &mut || bar.inc(1),
+        )?;
+        result.quality = Some(summary);
         if !args.no_images {
-            let png = args.out.join(format!("{stem}.png"));
-            gibench_harness::image_io::write_png(&png, images.size, &images.display)?;
-            let exr = args.out.join(format!("{stem}-indirect.exr"));
-            gibench_harness::image_io::write_exr(&exr, images.size, &images.indirect)?;
-            let direct = args.out.join(format!("{stem}-direct.exr"));
-            gibench_harness::image_io::write_exr(&direct, images.size, &images.direct)?;
-            result.images = vec![file_name(&png), file_name(&exr), file_name(&direct)];
-            result.images.extend(extra_images);
+            let reference_png = args.out.join(format!("{stem}-reference.png"));
+            write_png(&reference_png, qimages.size, &qimages.reference_display)?;
+            let flip_png = args.out.join(format!("{stem}-flip.png"));
+            write_png(&flip_png, qimages.size, &qimages.flip_map)?;
+            extra_images = vec![file_name(&reference_png), file_name(&flip_png)];
         }
-        result.write(&args.out.join(format!("{stem}.json")))?;
-        results.push(result);
+    }
+    if !args.no_images {
+        let png = args.out.join(format!("{stem}.png"));
+        write_png(&png, images.size, &images.display)?;
+        let exr = args.out.join(format!("{stem}-indirect.exr"));
+        write_exr(&exr, images.size, &images.indirect)?;
+        let direct = args.out.join(format!("{stem}-direct.exr"));
+        write_exr(&direct, images.size, &images.direct)?;
+        result.images = vec![file_name(&png), file_name(&exr), file_name(&direct)];
+        result.images.extend(extra_images);
+    }
+    result.write(&args.out.join(format!("{stem}.json")))?;
+    Ok(result)
+}
+
+fn open_gpu(args: &RunArgs) -> Result<GpuContext> {
+    GpuContext::new(&GpuOptions {
+        backend: args.gpu.backend.clone(),
+        adapter: args.gpu.adapter.clone(),
+    })
+}
+
+fn run(args: &RunArgs) -> Result<()> {
+    // Everything that can be checked without running is checked before anything is written.
+    let plan = plan(args, &[])?;
+    let gpu = open_gpu(args)?;
+    let harness = Harness::new(&gpu, &plan.scene, &plan.config)?;
+    announce(&plan, &gpu);
+    let bar = progress_bar(args, &plan, plan.techniques.len() as u64);
+    let mut results = Vec::new();
+    for (info, p) in plan.techniques.iter().zip(&plan.params) {
+        bar.set_message(info.name.to_string());
+        let stem = format!("{}-{}", plan.desc.name, info.name);
+        results.push(run_one(args, &plan, &harness, info, p, &stem, &bar)?);
     }
     bar.finish_and_clear();
+    let name = &plan.desc.name;
     let table = report::stage_table(&results);
     println!("{}", table.to_terminal());
-    let stem = format!("{}-summary", desc.name);
-    let written = report::write_tables(&table, &args.out, &stem)?;
+    let stem = format!("{name}-summary");
+    let mut written: Vec<String> = report::write_tables(&table, &args.out, &stem)?
+        .iter()
+        .map(|p| file_name(p))
+        .collect();
     report::stacked_bar_svg(
         &results,
         &args.out.join(format!("{stem}.svg")),
-        &format!("Per-stage times on {}", desc.name),
+        &format!("Per-stage times on {name}"),
+    )?;
+    written.push(format!("{stem}.svg"));
+    if plan.quality.as_ref().is_some_and(|q| q.all) {
+        for metric in ["rmse", "flicker"] {
+            let svg = args.out.join(format!("{name}-{metric}-per-frame.svg"));
+            report::quality_over_frames_svg(
+                &results,
+                metric,
+                &svg,
+                &format!("{metric} against the reference on {name}"),
+            )?;
+            written.push(file_name(&svg));
+        }
+    }
+    eprintln!(
+        "wrote {} results, images and {} to {}",
+        results.len(),
+        written.join(", "),
+        args.out.display()
+    );
+    Ok(())
+}
+
+/// `gibench sweep`: one technique, one parameter over a list of values.
+fn sweep(args: &SweepArgs) -> Result<()> {
+    let (name, values) = args
+        .sweep
+        .split_once('=')
+        .map(|(n, v)| {
+            (
+                n.trim().to_string(),
+                v.split(',')
+                    .map(|x| x.trim().to_string())
+                    .collect::<Vec<_>>(),
+            )
+        })
+        .filter(|(n, v)| !n.is_empty() && !v.is_empty() && v.iter().all(|x| !x.is_empty()))
+        .ok_or_else(|| {
+            Error::param(
+                "sweep",
+                format!("expected name=v1,v2,... (got '{}')", args.sweep),
+            )
+        })?;
+    if args.run.technique.len() != 1 {
+        return Err(Error::param(
+            "technique",
+            "a sweep runs exactly one technique",
+        ));
+    }
+    // Check every point before running any.
+    let plans: Vec<Plan> = values
+        .iter()
+        .map(|v| plan(&args.run, &[format!("{name}={v}")]))
+        .collect::<Result<_>>()?;
+    let first = &plans[0];
+    let gpu = open_gpu(&args.run)?;
+    let harness = Harness::new(&gpu, &first.scene, &first.config)?;
+    announce(first, &gpu);
+    let bar = progress_bar(&args.run, first, values.len() as u64);
+    let info = first.techniques[0];
+    let mut points = Vec::new();
+    for (v, p) in values.iter().zip(&plans) {
+        bar.set_message(format!("{}={v}", name));
+        let stem = format!("{}-{}-{name}-{v}", first.desc.name, info.name);
+        let r = run_one(&args.run, p, &harness, info, &p.params[0], &stem, &bar)?;
+        points.push((v.clone(), r));
+    }
+    bar.finish_and_clear();
+    let results: Vec<RunResult> = points.iter().map(|(_, r)| r.clone()).collect();
+    let mut table = report::stage_table(&results);
+    table.title = format!(
+        "{} on {}: per-stage time (median ms) against {name}",
+        info.name, first.desc.name
+    );
+    table.columns.insert(0, name.clone());
+    for (row, v) in table.rows.iter_mut().zip(&values) {
+        row.insert(0, report::Cell::text(v));
+    }
+    println!("{}", table.to_terminal());
+    let stem = format!("{}-{}-sweep-{name}", first.desc.name, info.name);
+    report::write_tables(&table, &args.run.out, &stem)?;
+    report::sweep_plot_svg(
+        &points,
+        &args.run.out.join(format!("{stem}.svg")),
+        &format!(
+            "{} on {}: stage times against {name}",
+            info.name, first.desc.name
+        ),
+        &name,
     )?;
     eprintln!(
-        "wrote {} results, images and tables ({}, {stem}.svg) to {}",
-        results.len(),
-        written
-            .iter()
-            .map(|p| file_name(p))
-            .collect::<Vec<_>>()
-            .join(", "),
-        args.out.display()
+        "wrote {} points and {stem}.md/.csv/.tex/.svg to {}",
+        points.len(),
+        args.run.out.display()
     );
     Ok(())
 }
@@ -476,9 +646,9 @@ fn list() -> Result<()> {
     Ok(())
 }
 
-fn report_cmd(args: &ReportArgs) -> Result<()> {
+fn read_results(inputs: &[PathBuf]) -> Result<Vec<RunResult>> {
     let mut files = Vec::new();
-    for input in &args.inputs {
+    for input in inputs {
         if input.is_dir() {
             let mut found: Vec<PathBuf> = std::fs::read_dir(input)
                 .map_err(|e| Error::io(input, e))?
@@ -500,6 +670,23 @@ fn report_cmd(args: &ReportArgs) -> Result<()> {
             "no results files found in the given inputs".into(),
         ));
     }
+    Ok(results)
+}
+
+fn plot_quality(args: &PlotQualityArgs) -> Result<()> {
+    let results = read_results(&args.inputs)?;
+    report::quality_over_frames_svg(
+        &results,
+        &args.metric,
+        &args.out,
+        &format!("{} against the reference per frame", args.metric),
+    )?;
+    eprintln!("wrote {}", args.out.display());
+    Ok(())
+}
+
+fn report_cmd(args: &ReportArgs) -> Result<()> {
+    let results = read_results(&args.inputs)?;
     let table = report::stage_table(&results);
     println!("{}", table.to_terminal());
     if args.detailed {

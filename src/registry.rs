@@ -1,8 +1,15 @@
-//! The technique registry: every technique crate's `INFO`, in the order `gibench list` shows them.
+//! The technique registry: every technique crate's `TechniqueInfo`, in the order `gibench list`
+//! shows them.
 
 use gibench_harness::technique::TechniqueInfo;
 
+static ALL: [TechniqueInfo; 3] = [
+    gibench_direct::INFO,
+    gibench_keller::FULL,
+    gibench_keller::INCREMENTAL,
+];
+
 /// All registered techniques.
-pub fn all() -> Vec<TechniqueInfo> {
-    vec![gibench_direct::INFO]
+pub fn all() -> &'static [TechniqueInfo] {
+    &ALL
 }

@@ -42,6 +42,7 @@ pub mod runner;
 pub mod scene;
 pub mod stats;
 pub mod technique;
+pub mod vpl;
 
 pub use error::{Error, Result};
 pub use glam;

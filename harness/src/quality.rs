@@ -59,6 +59,8 @@ impl IndirectComponent {
 pub struct QualityConfig {
     /// Number of consecutive frame pairs compared (spread evenly over the measured frames).
     pub pairs: u32,
+    /// Compare every measured frame instead (for per-frame error and lag plots).
+    pub all: bool,
     pub reference: ReferenceSettings,
     pub component: IndirectComponent,
 }
@@ -89,6 +91,11 @@ impl QualityConfig {
     /// `pairs` target frames spread over the measured range, the target and the frame before it.
     pub fn capture_frames(&self, first_measured: u32, measured: u32) -> Vec<(u32, bool)> {
         let last = first_measured + measured - 1;
+        if self.all {
+            return (first_measured..=last)
+                .map(|f| (f, f > first_measured))
+                .collect();
+        }
         if measured < 2 || self.pairs == 0 {
             return vec![(last, false)];
         }

@@ -924,6 +924,84 @@ pub fn sweep_plot_svg(
     })
 }
 
+/// Per-frame image error against the reference for each result that has quality data: one
+/// line per result ("technique @ scene"), frame number on the x axis, `metric` (`rmse`,
+/// `rel_mse`, `mae`, `flip` or `flicker`) on the y axis. This is the lag plot of incremental
+/// techniques: their error grows while the light moves. Errors when no result has a value.
+pub fn quality_over_frames_svg(
+    results: &[RunResult],
+    metric: &str,
+    path: &Path,
+    title: &str,
+) -> Result<()> {
+    let pick = |f: &crate::metrics::FrameQuality| -> Option<f64> {
+        match metric {
+            "rmse" => Some(f.rmse),
+            "rel_mse" => Some(f.rel_mse),
+            "mae" => Some(f.mae),
+            "flip" => Some(f.flip_mean),
+            "flicker" => f.temporal,
+            _ => None,
+        }
+    };
+    if !["rmse", "rel_mse", "mae", "flip", "flicker"].contains(&metric) {
+        return Err(Error::param(
+            "metric",
+            format!("expected rmse, rel_mse, mae, flip or flicker (got '{metric}')"),
+        ));
+    }
+    let lines: Vec<(String, Vec<(f64, f64)>)> = results
+        .iter()
+        .filter_map(|r| {
+            let q = r.quality.as_ref()?;
+            let pts: Vec<(f64, f64)> = q
+                .frames
+                .iter()
+                .filter_map(|f| pick(f).map(|v| (f.frame as f64, v)))
+                .collect();
+            (!pts.is_empty()).then(|| (run_label(r), pts))
+        })
+        .collect();
+    if lines.is_empty() {
+        return Err(Error::Invalid(format!(
+            "{}: no results hold per-frame '{metric}' values",
+            path.display()
+        )));
+    }
+    let all = || lines.iter().flat_map(|(_, p)| p.iter());
+    let (x0, x1) = all().fold((f64::MAX, f64::MIN), |(a, b), p| (a.min(p.0), b.max(p.0)));
+    let x1 = if x1 > x0 { x1 } else { x0 + 1.0 };
+    let ymax = axis_max(all().map(|p| p.1).fold(0.0, f64::max), 1.1);
+    let (width, height) = (1000u32, 600u32);
+    write_svg(path, (width, height), |root| {
+        root.fill(&WHITE)?;
+        let (plot, legend) = root.split_horizontally(width - LEGEND_W);
+        let mut chart = ChartBuilder::on(&plot)
+            .caption(title, (FONT, 22))
+            .margin(12)
+            .x_label_area_size(50)
+            .y_label_area_size(80)
+            .build_cartesian_2d(x0..x1, 0.0..ymax)?;
+        chart
+            .configure_mesh()
+            .x_desc("frame")
+            .y_desc(metric)
+            .label_style((FONT, 15))
+            .axis_desc_style((FONT, 16))
+            .draw()?;
+        let mut entries = Vec::new();
+        for (k, (label, pts)) in lines.iter().enumerate() {
+            let color = stage_color(k);
+            chart.draw_series(LineSeries::new(pts.iter().copied(), color.stroke_width(2)))?;
+            chart.draw_series(pts.iter().map(|&p| Circle::new(p, 3, color.filled())))?;
+            entries.push((label.clone(), color, Mark::Line(2)));
+        }
+        draw_legend(&legend, "runs", &entries)?;
+        root.present()?;
+        Ok(())
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use std::collections::BTreeMap;

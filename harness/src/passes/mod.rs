@@ -11,14 +11,18 @@
 mod compose;
 mod direct;
 mod gbuffer;
+mod interleave;
 mod scene_gpu;
+mod vpl_lighting;
 
 pub use compose::Compose;
 pub use direct::{needed_cube_faces, DirectLight, CUBE_FACES};
 pub use gbuffer::{GBuffer, GBufferTexels};
+pub use interleave::{FilterSettings, Interleave, INTERLEAVE_WGSL};
 pub use scene_gpu::{
     cube_face_matrix, light_axis_intensity, FrameUniforms, GpuScene, Vertex, MAX_MATERIALS,
 };
+pub use vpl_lighting::{VplLighting, VplMapKind, VplShadowSettings, VPL_COMMON_WGSL};
 
 /// WGSL declared once and prepended to every shader (View, Light, helpers).
 pub const COMMON_WGSL: &str = include_str!("shaders/common.wgsl");

@@ -271,6 +271,26 @@ impl GpuScene {
 
     /// Draws every object: the static mesh (or its shadow-caster copy when `shadow_casters`)
     /// and the movers, binding each one's object uniforms at `object_group_index`.
+    /// Draws only the static geometry's shadow-caster copy (object slot 0): what VPL shadow
+    /// maps hold, since they are reused across frames and indirect light bounces off static
+    /// geometry only (Laine et al. 2007, Section 7).
+    pub fn draw_static_casters(
+        &self,
+        pass: &mut wgpu::RenderPass,
+        uniforms: &FrameUniforms,
+        object_group_index: u32,
+    ) {
+        let mesh = self.shadow_mesh.as_ref().unwrap_or(&self.static_mesh);
+        pass.set_bind_group(
+            object_group_index,
+            &uniforms.object_group,
+            &[uniforms.object_offset(0)],
+        );
+        pass.set_vertex_buffer(0, mesh.vertices.slice(..));
+        pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
+        pass.draw_indexed(0..mesh.index_count, 0, 0..1);
+    }
+
     pub fn draw(
         &self,
         pass: &mut wgpu::RenderPass,
