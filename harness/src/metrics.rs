@@ -400,6 +400,9 @@ pub struct FrameQuality {
     pub mae: f64,
     /// Mean LDR-ꟻLIP error ([`FlipResult::mean`]) of the tone-mapped images.
     pub flip_mean: f64,
+    /// [`relative_bias`]: signed relative error of the mean (negative = too dark).
+    #[serde(default)]
+    pub bias: f64,
     /// [`temporal_instability`] (or its relative form, as the caller documents) against the
     /// previous frame; absent for the first frame or when not measured.
     #[serde(skip_serializing_if = "Option::is_none", default)]
@@ -421,10 +424,31 @@ pub struct QualitySummary {
     pub mae: Stats,
     /// Statistics of [`FrameQuality::flip_mean`].
     pub flip_mean: Stats,
+    /// Statistics of [`FrameQuality::bias`].
+    #[serde(default)]
+    pub bias: Stats,
     /// Statistics of [`FrameQuality::temporal`] over the frames that have it; `None` when no
     /// frame has it.
     #[serde(skip_serializing_if = "Option::is_none", default)]
     pub temporal: Option<Stats>,
+}
+
+/// Signed relative error of the image's mean over masked pixels and channels:
+/// Σ(t − r) / Σ r (0 when the reference is black). Negative means the technique is too dark —
+/// e.g. the energy that VPL clamping removes.
+pub fn relative_bias(test: &[Vec3], reference: &[Vec3], mask: &[bool]) -> f64 {
+    let (mut t, mut r) = (0.0f64, 0.0f64);
+    for ((a, b), m) in test.iter().zip(reference).zip(mask) {
+        if *m {
+            t += a.element_sum() as f64;
+            r += b.element_sum() as f64;
+        }
+    }
+    if r > 0.0 {
+        (t - r) / r
+    } else {
+        0.0
+    }
 }
 
 /// Summarises per-frame quality records ([`Stats::of`] of each metric over the frames).
@@ -437,6 +461,7 @@ pub fn summarize(reference: String, frames: Vec<FrameQuality>) -> QualitySummary
         rel_mse: of(|f| f.rel_mse),
         mae: of(|f| f.mae),
         flip_mean: of(|f| f.flip_mean),
+        bias: of(|f| f.bias),
         temporal: (!temporal.is_empty()).then(|| Stats::of(&temporal)),
         frames,
     }
@@ -772,8 +797,19 @@ mod tests {
             rel_mse: 0.1 * frame as f64,
             mae: 0.5 * frame as f64,
             flip_mean: 0.01 * frame as f64,
+            bias: -0.01 * frame as f64,
             temporal,
         }
+    }
+
+    #[test]
+    fn metrics_relative_bias_is_signed() {
+        let r = vec![Vec3::ONE; 4];
+        let dark = vec![Vec3::splat(0.9); 4];
+        let mask = [true, true, true, false];
+        assert!((relative_bias(&dark, &r, &mask) + 0.1).abs() < 1e-6);
+        assert_eq!(relative_bias(&r, &r, &mask), 0.0);
+        assert_eq!(relative_bias(&r, &[Vec3::ZERO; 4], &mask), 0.0);
     }
 
     #[test]

@@ -304,6 +304,7 @@ pub fn compare(
             rel_mse: metrics::relative_mse(&c.indirect, component, &r.hit),
             mae: metrics::mae(&c.indirect, component, &r.hit),
             flip_mean: flip.mean,
+            bias: metrics::relative_bias(&c.indirect, component, &r.hit),
             temporal,
         });
         if i + 1 == captured.len() {

@@ -7,8 +7,8 @@
 //!
 //! * [`stage_table`]: one row per run (scene, technique, resolution), one column per stage (the
 //!   union of the runs' stage names, in execution order), then "Σ stages", the median frame time
-//!   and FPS. A stage cell is the median GPU timestamp time where the run has one, else the median
-//!   flushed CPU wall time ([`StageResult::best_ms`]). This is the table `gibench run` prints and
+//!   and FPS. A stage cell is the median flushed CPU wall time (Laine's per-task method), else the
+//!   median GPU timestamp time ([`StageResult::best_ms`]). This is the table `gibench run` prints and
 //!   `gibench report` writes.
 //! * [`stage_table_detailed`]: one run, one row per stage, with median/mean/p5/p95/min/max of both
 //!   the GPU timestamp and the wall-clock timings (`gibench report --detailed`).
@@ -414,9 +414,10 @@ fn timing_notes(results: &[&RunResult]) -> Vec<String> {
             .join("; "),
     };
     let mut notes = vec![format!(
-        "Times in milliseconds, median over {frames}; GPU stages: GPU timestamps where the adapter has them, else CPU \
-         wall time with the queue flushed before and after; frame: no added synchronisation \
-         (time between frame starts); CPU stages: wall time; FPS: 1000 / mean frame time."
+        "Times in milliseconds, median over {frames}; GPU stages: CPU wall time with the queue flushed before and \
+         after (Laine et al. 2007's per-task method; GPU timestamps are in the results files and in \
+         `gibench report --detailed`); frame: no added synchronisation (time between frame starts); CPU stages: \
+         wall time; FPS: 1000 / mean frame time."
     )];
 
     let fallbacks: Vec<String> = results
@@ -425,7 +426,7 @@ fn timing_notes(results: &[&RunResult]) -> Vec<String> {
             let stages: Vec<&str> = r
                 .stages
                 .iter()
-                .filter(|s| s.kind == StageKind::Gpu && s.gpu_ms.is_none() && s.wall_ms.is_some())
+                .filter(|s| s.kind == StageKind::Gpu && s.wall_ms.is_none() && s.gpu_ms.is_some())
                 .map(|s| s.name.as_str())
                 .collect();
             (!stages.is_empty()).then(|| format!("{} ({})", run_label(r), stages.join(", ")))
@@ -433,7 +434,7 @@ fn timing_notes(results: &[&RunResult]) -> Vec<String> {
         .collect();
     if !fallbacks.is_empty() {
         notes.push(format!(
-            "GPU stages timed by flushed wall time (no GPU timestamps): {}.",
+            "GPU stages timed by GPU timestamps only (no flushed wall time): {}.",
             fallbacks.join("; ")
         ));
     }
@@ -454,8 +455,8 @@ fn timing_notes(results: &[&RunResult]) -> Vec<String> {
     notes
 }
 
-/// One row per run: scene, technique, resolution "WxH", one column per stage (median ms, GPU
-/// timestamps when present else flushed wall time), "Σ stages", "frame (median ms)", "FPS".
+/// One row per run: scene, technique, resolution "WxH", one column per stage (median ms:
+/// flushed wall time, else GPU timestamps), "Σ stages", "frame (median ms)", "FPS".
 /// Notes say how the times were taken and on which device(s).
 pub fn stage_table(results: &[RunResult]) -> Table {
     let stages = stage_names(results);
@@ -466,7 +467,7 @@ pub fn stage_table(results: &[RunResult]) -> Table {
     columns.extend(["Σ stages", "frame (median ms)", "FPS"].map(String::from));
     let quality = results.iter().any(|r| r.quality.is_some());
     if quality {
-        columns.extend(["RMSE", "relMSE", "FLIP", "flicker"].map(String::from));
+        columns.extend(["RMSE", "relMSE", "bias", "FLIP", "flicker"].map(String::from));
     }
 
     let rows = results
@@ -489,6 +490,7 @@ pub fn stage_table(results: &[RunResult]) -> Table {
                 let q = r.quality.as_ref();
                 row.push(Cell::Num(q.map(|q| q.rmse.mean), 4));
                 row.push(Cell::Num(q.map(|q| q.rel_mse.mean), 4));
+                row.push(Cell::Num(q.map(|q| q.bias.mean), 4));
                 row.push(Cell::Num(q.map(|q| q.flip_mean.mean), 4));
                 row.push(Cell::Num(q.and_then(|q| q.temporal.map(|t| t.mean)), 4));
             }
@@ -505,7 +507,8 @@ pub fn stage_table(results: &[RunResult]) -> Table {
         refs.dedup();
         notes.push(format!(
             "Quality: means over the compared frames against the CPU reference ({}). RMSE, relMSE \
-             (relative MSE, Rousselle et al. 2011) of indirect irradiance; FLIP (LDR-FLIP, mean) of the \
+             (relative MSE, Rousselle et al. 2011) and bias (signed relative error of the mean) of indirect \
+             irradiance; FLIP (LDR-FLIP, mean) of the \
              tonemapped composed images; flicker: RMS of the frame-to-frame change of indirect irradiance \
              beyond the reference's change.",
             refs.join("; ")
@@ -728,7 +731,7 @@ fn axis_max(max: f64, headroom: f64) -> f64 {
 }
 
 /// One horizontal bar per run ("technique @ scene", first run on top), stacked by stage in
-/// execution order (median ms: GPU timestamps when present, else flushed wall time), the total
+/// execution order (median ms: flushed wall time, else GPU timestamps), the total
 /// written after each bar, and a legend of stage colours. Errors on empty `results`.
 pub fn stacked_bar_svg(results: &[RunResult], path: &Path, title: &str) -> Result<()> {
     if results.is_empty() {
@@ -820,8 +823,8 @@ pub fn stacked_bar_svg(results: &[RunResult], path: &Path, title: &str) -> Resul
     })
 }
 
-/// Per-stage median times (one coloured line each, GPU timestamps when present else flushed
-/// wall time) and their total (black) against a swept value: `points` are (x label, run) in the
+/// Per-stage median times (one coloured line each: flushed wall time, else GPU timestamps)
+/// and their total (black) against a swept value: `points` are (x label, run) in the
 /// order they are placed on the categorical x axis named `x_name`. A stage missing at some
 /// point breaks its line. Errors on empty `points`.
 pub fn sweep_plot_svg(
@@ -939,6 +942,7 @@ pub fn quality_over_frames_svg(
             "rmse" => Some(f.rmse),
             "rel_mse" => Some(f.rel_mse),
             "mae" => Some(f.mae),
+            "bias" => Some(f.bias),
             "flip" => Some(f.flip_mean),
             "flicker" => f.temporal,
             _ => None,
@@ -1070,15 +1074,16 @@ mod tests {
         }
     }
 
-    /// Run A: three GPU stages, the last one without GPU timestamps (wall time 0.75 ms).
+    /// Run A: three GPU stages (GPU timestamps a little above the wall times), the last one
+    /// without GPU timestamps (wall time 0.75 ms).
     /// Run B: a name with a comma and quotes, a scene with `_` and `%`, an extra CPU stage.
     fn two_runs() -> Vec<RunResult> {
         let a = run(
             "sponza",
             "direct",
             vec![
-                stage("g-buffer", StageKind::Gpu, Some(0.5), Some(0.6)),
-                stage("shadow map", StageKind::Gpu, Some(1.234), Some(1.5)),
+                stage("g-buffer", StageKind::Gpu, Some(0.6), Some(0.5)),
+                stage("shadow map", StageKind::Gpu, Some(1.5), Some(1.234)),
                 stage("compose", StageKind::Gpu, None, Some(0.75)),
             ],
             3.0,
@@ -1087,9 +1092,9 @@ mod tests {
             "cornell_box 100%",
             "ism, \"imperfect\"",
             vec![
-                stage("g-buffer", StageKind::Gpu, Some(0.25), Some(0.3)),
+                stage("g-buffer", StageKind::Gpu, Some(0.3), Some(0.25)),
                 stage("vpl trace", StageKind::Cpu, None, Some(2.0)),
-                stage("compose", StageKind::Gpu, Some(0.05), Some(0.1)),
+                stage("compose", StageKind::Gpu, Some(0.1), Some(0.05)),
             ],
             4.5,
         );
@@ -1140,7 +1145,7 @@ mod tests {
             lines[3]
         );
         assert!(md.starts_with("### "));
-        assert!(md.contains("\nTimes in milliseconds, median over 100 measured frames (10 warm-up frames dropped); GPU stages: GPU timestamps where the adapter has them, else CPU wall time with the queue flushed before and after;"), "{md}");
+        assert!(md.contains("\nTimes in milliseconds, median over 100 measured frames (10 warm-up frames dropped); GPU stages: CPU wall time with the queue flushed before and after"), "{md}");
         assert!(
             md.contains("Device: Test GPU (Vulkan, DiscreteGpu; driver testdrv 1.2.3)."),
             "{md}"
@@ -1148,22 +1153,16 @@ mod tests {
     }
 
     #[test]
-    fn missing_gpu_time_falls_back_to_wall_time() {
+    fn tables_use_flushed_wall_time() {
         let runs = two_runs();
         let t = stage_table(&runs);
         let compose = t.columns.iter().position(|c| c == "compose").unwrap();
         assert_eq!(t.rows[0][compose], Cell::Ms(Some(0.75)));
-        // A GPU timestamp wins over the wall time when present.
+        // The flushed wall time wins over a GPU timestamp (Laine's per-task method).
         let gbuffer = t.columns.iter().position(|c| c == "g-buffer").unwrap();
         assert_eq!(t.rows[1][gbuffer], Cell::Ms(Some(0.25)));
-        // The fallback is named in the notes; the CPU stage is not.
-        let note = t
-            .notes
-            .iter()
-            .find(|n| n.contains("no GPU timestamps"))
-            .expect("fallback note");
-        assert!(note.contains("direct @ sponza (compose)"), "{note}");
-        assert!(!note.contains("vpl trace"), "{note}");
+        // No stage lacks a wall time here: no fallback note.
+        assert!(!t.notes.iter().any(|n| n.contains("GPU timestamps only")));
     }
 
     #[test]
@@ -1247,8 +1246,8 @@ mod tests {
         assert_eq!(t.columns[13], "wall max");
         assert_eq!(t.rows.len(), 4);
         assert_eq!(t.rows[1][0], Cell::text("shadow map"));
-        assert_eq!(t.rows[1][2].display(), "1.23");
-        assert_eq!(t.rows[1][8].display(), "1.50");
+        assert_eq!(t.rows[1][2].display(), "1.50");
+        assert_eq!(t.rows[1][8].display(), "1.23");
         assert_eq!(t.rows[2][2], Cell::Ms(None));
         assert_eq!(t.rows[3][0], Cell::text("frame"));
         assert_eq!(t.rows[3][8].display(), "3.00");

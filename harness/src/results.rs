@@ -137,8 +137,11 @@ impl RunResult {
 }
 
 impl StageResult {
-    /// The best available per-stage time: median GPU timestamp time, else median flushed wall time.
+    /// The per-stage time tables show: the median flushed wall time (Laine et al. 2007's
+    /// per-task method, and the one that is right on every adapter: lavapipe's timestamps around
+    /// some compute passes were seen to miss most of their work), else the median GPU timestamp
+    /// time.
     pub fn best_ms(&self) -> Option<f64> {
-        self.gpu_ms.or(self.wall_ms).map(|s| s.median)
+        self.wall_ms.or(self.gpu_ms).map(|s| s.median)
     }
 }
