@@ -1021,6 +1021,7 @@ mod tests {
             median,
             p5: median * 0.9,
             p95: median * 1.2,
+            p99: median * 1.4,
             min: median * 0.8,
             max: median * 1.5,
         }

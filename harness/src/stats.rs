@@ -10,6 +10,9 @@ pub struct Stats {
     pub median: f64,
     pub p5: f64,
     pub p95: f64,
+    /// 99th percentile (stutters: Laine et al. 2007 report them for VPL management).
+    #[serde(default)]
+    pub p99: f64,
     pub min: f64,
     pub max: f64,
 }
@@ -36,6 +39,7 @@ impl Stats {
             median: pct(0.5),
             p5: pct(0.05),
             p95: pct(0.95),
+            p99: pct(0.99),
             min: s[0],
             max: s[n - 1],
         }
@@ -56,6 +60,7 @@ mod tests {
         assert!((s.mean - 3.0).abs() < 1e-12);
         assert!((s.p5 - 1.2).abs() < 1e-12);
         assert!((s.p95 - 4.8).abs() < 1e-12);
+        assert!((s.p99 - 4.96).abs() < 1e-12);
         assert_eq!(Stats::of(&[]).count, 0);
     }
 }

@@ -1,0 +1,583 @@
+//! Tests of the sampling-point domains (Laine et al. 2007, §4.5–§4.7).
+
+use std::f64::consts::PI;
+use std::time::Instant;
+
+use gibench_laine::domain::{DomainKind, SamplingDomain};
+use glam::{DVec2, DVec3};
+
+const SIZES: [usize; 3] = [16, 256, 1024];
+
+/// SplitMix64: a tiny deterministic generator of uniform doubles in [0, 1).
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^= z >> 31;
+        (z >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+fn radical_inverse(base: u64, mut i: u64) -> f64 {
+    let inv = 1.0 / base as f64;
+    let (mut f, mut r) = (inv, 0.0);
+    while i > 0 {
+        r += (i % base) as f64 * f;
+        i /= base;
+        f *= inv;
+    }
+    r
+}
+
+/// Uniform disc point from the unit square (polar mapping).
+fn to_disc(u: f64, v: f64) -> DVec3 {
+    let r = u.sqrt();
+    let phi = 2.0 * PI * v;
+    DVec3::new(r * phi.cos(), r * phi.sin(), 0.0)
+}
+
+/// Uniform sphere point from the unit square.
+fn to_sphere(u: f64, v: f64) -> DVec3 {
+    let z = 1.0 - 2.0 * u;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = 2.0 * PI * v;
+    DVec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+fn point_set(kind: DomainKind, n: usize, random: bool) -> Vec<DVec3> {
+    let mut rng = Rng(0x1234_5678 + n as u64);
+    (0..n)
+        .map(|i| {
+            let (u, v) = if random {
+                (rng.next(), rng.next())
+            } else {
+                (
+                    radical_inverse(2, i as u64 + 1),
+                    radical_inverse(3, i as u64 + 1),
+                )
+            };
+            match kind {
+                DomainKind::Disc => to_disc(u, v),
+                DomainKind::Sphere => to_sphere(u, v),
+            }
+        })
+        .collect()
+}
+
+fn build(kind: DomainKind, pts: &[DVec3]) -> SamplingDomain {
+    let mut d = SamplingDomain::new(kind);
+    for (i, &p) in pts.iter().enumerate() {
+        d.insert(i as u64 * 7 + 3, p).unwrap();
+    }
+    assert_eq!(d.len(), pts.len());
+    d
+}
+
+fn nearest_distance(pts: &[DVec3], x: DVec3) -> f64 {
+    pts.iter()
+        .map(|p| (*p - x).length_squared())
+        .fold(f64::INFINITY, f64::min)
+        .sqrt()
+}
+
+fn all_cases() -> Vec<(DomainKind, usize, bool)> {
+    let mut cases = Vec::new();
+    for kind in [DomainKind::Disc, DomainKind::Sphere] {
+        for n in SIZES {
+            for random in [false, true] {
+                cases.push((kind, n, random));
+            }
+        }
+    }
+    cases
+}
+
+/// Every Delaunay triangle's circumcircle (disc) / circumcap on the empty side (sphere) holds
+/// no other site.
+fn check_empty_circumcircles(d: &SamplingDomain) {
+    let pts = d.points();
+    let get = |id: u64| d.point(id).unwrap();
+    let tris = d.triangles();
+    match d.kind() {
+        DomainKind::Disc => {
+            // Euler: a planar triangulation of n points with h on the hull has 2n − 2 − h
+            // triangles.
+            for t in &tris {
+                let [a, b, c] = t.map(|id| get(id).truncate());
+                let area2 = (b - a).perp_dot(c - a);
+                assert!(area2 > 0.0, "triangle {t:?} not counter-clockwise");
+                let (ba, ca) = (b - a, c - a);
+                let dd = 2.0 * ba.perp_dot(ca);
+                let cx = (ca.y * ba.length_squared() - ba.y * ca.length_squared()) / dd;
+                let cy = (ba.x * ca.length_squared() - ca.x * ba.length_squared()) / dd;
+                let centre = a + DVec2::new(cx, cy);
+                let r = (a - centre).length();
+                for &(id, p) in &pts {
+                    if t.contains(&id) {
+                        continue;
+                    }
+                    let dist = (p.truncate() - centre).length();
+                    assert!(
+                        dist >= r * (1.0 - 1e-9) - 1e-12,
+                        "site {id} inside circumcircle of {t:?}: {dist} < {r}"
+                    );
+                }
+            }
+        }
+        DomainKind::Sphere => {
+            // A triangulation of the sphere: 2n − 4 triangles.
+            if pts.len() >= 3 {
+                assert_eq!(tris.len(), 2 * pts.len() - 4, "Euler characteristic");
+            }
+            for t in &tris {
+                let [a, b, c] = t.map(get);
+                let m = (b - a).cross(c - a).normalize();
+                let h = m.dot(a);
+                for &(id, p) in &pts {
+                    if t.contains(&id) {
+                        continue;
+                    }
+                    assert!(
+                        m.dot(p) <= h + 1e-12,
+                        "site {id} beyond the plane of {t:?} (cap not empty or orientation wrong)"
+                    );
+                }
+                // Seen from the circumcentre m, the vertices are equidistant and nearest.
+                let r = (m - a).length();
+                assert!(
+                    nearest_distance(&pts.iter().map(|p| p.1).collect::<Vec<_>>(), m) >= r - 1e-9
+                );
+            }
+        }
+    }
+}
+
+/// The largest empty circle agrees with a brute-force search over a fine sampling of the
+/// domain.
+fn check_largest_empty_circle(d: &SamplingDomain) {
+    let pts: Vec<DVec3> = d.points().into_iter().map(|p| p.1).collect();
+    let (centre, radius) = d.largest_empty_circle().unwrap();
+    assert_eq!(d.dispersion(), radius);
+    assert!(
+        (nearest_distance(&pts, centre) - radius).abs() < 1e-9,
+        "radius is not the distance to the nearest site"
+    );
+    let (brute, tol) = match d.kind() {
+        DomainKind::Disc => {
+            assert!(centre.truncate().length() <= 1.0 + 1e-12 && centre.z == 0.0);
+            let g = 400;
+            let mut best = 0.0f64;
+            for i in 0..g {
+                for j in 0..g {
+                    let x = DVec3::new(
+                        -1.0 + 2.0 * (i as f64 + 0.5) / g as f64,
+                        -1.0 + 2.0 * (j as f64 + 0.5) / g as f64,
+                        0.0,
+                    );
+                    if x.truncate().length_squared() <= 1.0 {
+                        best = best.max(nearest_distance(&pts, x));
+                    }
+                }
+            }
+            for k in 0..4096 {
+                let phi = 2.0 * PI * k as f64 / 4096.0;
+                let x = DVec3::new(phi.cos(), phi.sin(), 0.0);
+                best = best.max(nearest_distance(&pts, x));
+            }
+            // Any point of the disc is within half a grid diagonal of a sample.
+            (best, 2.0 / g as f64)
+        }
+        DomainKind::Sphere => {
+            assert!((centre.length() - 1.0).abs() < 1e-12);
+            let n = 200_000;
+            let golden = PI * (3.0 - 5f64.sqrt());
+            let mut best = 0.0f64;
+            for k in 0..n {
+                let z = 1.0 - (2.0 * k as f64 + 1.0) / n as f64;
+                let r = (1.0 - z * z).sqrt();
+                let phi = golden * k as f64;
+                let x = DVec3::new(r * phi.cos(), r * phi.sin(), z);
+                best = best.max(nearest_distance(&pts, x));
+            }
+            (best, 0.01)
+        }
+    };
+    assert!(
+        brute <= radius + 1e-9,
+        "a sampled point is farther from all sites ({brute}) than the largest empty circle ({radius})"
+    );
+    assert!(
+        radius <= brute + tol,
+        "largest empty circle {radius} exceeds brute force {brute} + {tol}"
+    );
+}
+
+fn check_voronoi_areas(d: &SamplingDomain) {
+    let areas = d.voronoi_areas();
+    assert_eq!(areas.len(), d.len());
+    let mut ids: Vec<u64> = areas.iter().map(|a| a.0).collect();
+    ids.sort_unstable();
+    ids.dedup();
+    assert_eq!(ids.len(), d.len());
+    let total: f64 = areas.iter().map(|a| a.1).sum();
+    let expected = match d.kind() {
+        DomainKind::Disc => PI,
+        DomainKind::Sphere => 4.0 * PI,
+    };
+    assert!(
+        ((total - expected) / expected).abs() < 1e-9,
+        "Voronoi areas sum to {total}, expected {expected}"
+    );
+    for (id, a) in areas {
+        assert!(a > 0.0 && a.is_finite(), "area of {id} = {a}");
+    }
+}
+
+fn check_all(d: &SamplingDomain) {
+    check_empty_circumcircles(d);
+    check_largest_empty_circle(d);
+    check_voronoi_areas(d);
+}
+
+#[test]
+fn delaunay_circumcircles_are_empty() {
+    for (kind, n, random) in all_cases() {
+        let d = build(kind, &point_set(kind, n, random));
+        check_empty_circumcircles(&d);
+    }
+}
+
+#[test]
+fn largest_empty_circle_matches_brute_force() {
+    for (kind, n, random) in all_cases() {
+        let d = build(kind, &point_set(kind, n, random));
+        check_largest_empty_circle(&d);
+    }
+}
+
+#[test]
+fn voronoi_areas_partition_the_domain() {
+    for (kind, n, random) in all_cases() {
+        let d = build(kind, &point_set(kind, n, random));
+        check_voronoi_areas(&d);
+    }
+}
+
+#[test]
+fn uniform_points_get_similar_areas() {
+    // Sanity of the §4.7 intensities: for a Halton set every cell is within a small factor of
+    // the mean area.
+    for kind in [DomainKind::Disc, DomainKind::Sphere] {
+        let n = 256;
+        let d = build(kind, &point_set(kind, n, false));
+        let areas = d.voronoi_areas();
+        let mean = areas.iter().map(|a| a.1).sum::<f64>() / n as f64;
+        for (_, a) in areas {
+            assert!(
+                a > 0.2 * mean && a < 5.0 * mean,
+                "{kind:?}: {a} vs mean {mean}"
+            );
+        }
+    }
+}
+
+#[test]
+fn insert_and_remove_keep_everything_consistent() {
+    for (kind, n, random) in all_cases() {
+        let pts = point_set(kind, n, random);
+        let mut d = build(kind, &pts);
+        let ids: Vec<u64> = (0..n as u64).map(|i| i * 7 + 3).collect();
+        // Remove every other point, in a scrambled order, and the first inserted (the sphere's
+        // projection pole) among them.
+        let mut removed = Vec::new();
+        for (k, &id) in ids.iter().enumerate() {
+            if k % 2 == 0 {
+                removed.push(id);
+            }
+        }
+        removed.reverse();
+        let third = removed.len() / 3;
+        removed.rotate_left(third);
+        for &id in &removed {
+            assert!(d.remove(id).is_some());
+            assert!(!d.contains(id));
+        }
+        assert_eq!(d.len(), n - removed.len());
+        for (k, &id) in ids.iter().enumerate() {
+            assert_eq!(d.contains(id), k % 2 == 1);
+            if k % 2 == 1 {
+                let p = d.point(id).unwrap();
+                assert!((p - pts[k]).length() < 1e-12);
+            }
+        }
+        check_all(&d);
+        // Grow it back at the largest empty circles (§4.6), as the management does.
+        for k in 0..removed.len().min(64) {
+            let (c, r) = d.largest_empty_circle().unwrap();
+            assert!(r > 0.0);
+            d.insert(1_000_000 + k as u64, c).unwrap();
+        }
+        check_all(&d);
+    }
+}
+
+#[test]
+fn inserting_at_the_largest_empty_circle_reduces_dispersion() {
+    for kind in [DomainKind::Disc, DomainKind::Sphere] {
+        let mut d = SamplingDomain::new(kind);
+        let mut last = f64::INFINITY;
+        for id in 0..300u64 {
+            let (c, r) = d.largest_empty_circle().unwrap();
+            assert!(r <= last + 1e-12, "{kind:?}: dispersion grew {last} → {r}");
+            last = r;
+            d.insert(id, c).unwrap();
+            if id % 50 == 49 {
+                check_all(&d);
+            }
+        }
+        // 300 well-spread points: the dispersion is about that of a regular lattice.
+        let area = match kind {
+            DomainKind::Disc => PI,
+            DomainKind::Sphere => 4.0 * PI,
+        };
+        let hex = (2.0 * area / (3.0 * 3f64.sqrt() * 300.0)).sqrt();
+        assert!(
+            last < 2.0 * hex,
+            "{kind:?}: dispersion {last} vs lattice {hex}"
+        );
+    }
+}
+
+#[test]
+fn small_sets() {
+    for kind in [DomainKind::Disc, DomainKind::Sphere] {
+        let mut d = SamplingDomain::new(kind);
+        let (c, r) = d.largest_empty_circle().unwrap();
+        match kind {
+            DomainKind::Disc => assert_eq!((c, r), (DVec3::ZERO, 1.0)),
+            DomainKind::Sphere => assert_eq!(r, 2.0),
+        }
+        assert!(d.voronoi_areas().is_empty());
+        assert_eq!(d.shortest_edge(), None);
+        assert_eq!(d.deletion_candidate(), None);
+        let pts = [
+            DVec3::new(0.3, 0.1, 0.2),
+            DVec3::new(-0.5, 0.4, -0.6),
+            DVec3::new(0.1, -0.7, 0.3),
+            DVec3::new(0.6, 0.5, -0.4),
+            DVec3::new(-0.2, -0.2, 0.9),
+        ];
+        for (i, &p) in pts.iter().enumerate() {
+            d.insert(i as u64, p).unwrap();
+            check_all(&d);
+            assert!(d.shortest_edge().is_some() == (i >= 1));
+        }
+        for i in 0..pts.len() as u64 {
+            d.remove(i).unwrap();
+            if !d.is_empty() {
+                check_all(&d);
+            }
+        }
+        assert!(d.is_empty());
+        // A site at the disc's centre: every boundary point is at distance 1.
+        if kind == DomainKind::Disc {
+            d.insert(9, DVec3::ZERO).unwrap();
+            let (c, r) = d.largest_empty_circle().unwrap();
+            assert!((r - 1.0).abs() < 1e-12 && (c.length() - 1.0).abs() < 1e-12);
+            assert!((d.voronoi_areas()[0].1 - PI).abs() < 1e-12);
+        }
+    }
+}
+
+#[test]
+fn degenerate_configurations() {
+    // Disc: collinear sites and a regular polygon (co-circular).
+    let mut d = SamplingDomain::new(DomainKind::Disc);
+    for i in 0..5 {
+        d.insert(i, DVec3::new(-0.8 + 0.4 * i as f64, 0.0, 0.0))
+            .unwrap();
+    }
+    check_all(&d);
+    let mut d = SamplingDomain::new(DomainKind::Disc);
+    for i in 0..8 {
+        let phi = 2.0 * PI * i as f64 / 8.0;
+        d.insert(i, DVec3::new(0.5 * phi.cos(), 0.5 * phi.sin(), 0.0))
+            .unwrap();
+    }
+    check_all(&d);
+    // Sphere: sites on one small circle, on a great circle, and an octahedron.
+    for z in [0.0f64, 0.6] {
+        let mut d = SamplingDomain::new(DomainKind::Sphere);
+        let r = (1.0 - z * z).sqrt();
+        for i in 0..7 {
+            let phi = 2.0 * PI * i as f64 / 7.0 + 0.1;
+            d.insert(i, DVec3::new(r * phi.cos(), r * phi.sin(), z))
+                .unwrap();
+        }
+        check_largest_empty_circle(&d);
+        check_voronoi_areas(&d);
+    }
+    let mut d = SamplingDomain::new(DomainKind::Sphere);
+    for (i, p) in [
+        DVec3::X,
+        DVec3::NEG_X,
+        DVec3::Y,
+        DVec3::NEG_Y,
+        DVec3::Z,
+        DVec3::NEG_Z,
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        d.insert(i as u64, p).unwrap();
+    }
+    check_largest_empty_circle(&d);
+    check_voronoi_areas(&d);
+    for (_, a) in d.voronoi_areas() {
+        assert!((a - 4.0 * PI / 6.0).abs() < 1e-9);
+    }
+    let (c, r) = d.largest_empty_circle().unwrap();
+    assert!((c.abs() - DVec3::splat(1.0 / 3f64.sqrt())).length() < 1e-9);
+    assert!((r - (2.0 - 2.0 / 3f64.sqrt()).sqrt()).abs() < 1e-9);
+}
+
+#[test]
+fn insert_rejects_duplicates_and_invalid_points() {
+    for kind in [DomainKind::Disc, DomainKind::Sphere] {
+        let mut d = SamplingDomain::new(kind);
+        let p = DVec3::new(0.3, 0.4, 0.0);
+        d.insert(1, p).unwrap();
+        d.insert(2, DVec3::new(-0.3, 0.2, 0.5)).unwrap();
+        assert!(d.insert(1, DVec3::new(0.1, 0.1, 0.1)).is_err());
+        assert!(d.insert(3, p).is_err());
+        assert!(d.insert(4, DVec3::new(f64::NAN, 0.0, 0.0)).is_err());
+        assert_eq!(d.len(), 2);
+        assert_eq!(d.remove(7), None);
+    }
+    // Outside the disc: moved onto the circle. Sphere: normalised.
+    let mut d = SamplingDomain::new(DomainKind::Disc);
+    d.insert(1, DVec3::new(3.0, 4.0, 9.0)).unwrap();
+    assert!((d.point(1).unwrap() - DVec3::new(0.6, 0.8, 0.0)).length() < 1e-15);
+    let mut d = SamplingDomain::new(DomainKind::Sphere);
+    d.insert(1, DVec3::new(0.0, 0.0, 2.0)).unwrap();
+    assert_eq!(d.point(1), Some(DVec3::Z));
+    assert!(d.insert(2, DVec3::ZERO).is_err());
+}
+
+/// Disc points of the deletion test around `origin`, scaled: A–B is the shortest edge; B's
+/// second-closest neighbour (E, 0.15 away) is closer than A's (C, 0.30 away), so §4.5 deletes
+/// B. Mirrored, the roles swap.
+fn deletion_configuration(mirror: bool) -> Vec<(u64, DVec2)> {
+    let s = if mirror { -1.0 } else { 1.0 };
+    let mut pts = vec![
+        (10, DVec2::new(0.0, 0.0)),        // A
+        (20, DVec2::new(0.05 * s, 0.0)),   // B
+        (30, DVec2::new(-0.30 * s, 0.0)),  // C: A's second-closest
+        (40, DVec2::new(0.20 * s, 0.0)),   // E: B's second-closest
+        (50, DVec2::new(0.025 * s, 0.6)),  // above
+        (60, DVec2::new(0.025 * s, -0.6)), // below
+    ];
+    for k in 0..8 {
+        let phi = 2.0 * PI * (k as f64 + 0.5) / 8.0;
+        pts.push((100 + k, 0.9 * DVec2::new(phi.cos(), phi.sin())));
+    }
+    pts
+}
+
+#[test]
+fn deletion_removes_the_endpoint_with_the_closer_second_neighbour() {
+    for mirror in [false, true] {
+        let config = deletion_configuration(mirror);
+        // Disc.
+        let mut d = SamplingDomain::new(DomainKind::Disc);
+        for &(id, p) in &config {
+            d.insert(id, p.extend(0.0)).unwrap();
+        }
+        let (a, b, len) = d.shortest_edge().unwrap();
+        assert_eq!((a.min(b), a.max(b)), (10, 20));
+        assert!((len - 0.05).abs() < 1e-12);
+        assert!((d.second_closest_neighbour_distance(10).unwrap() - 0.30).abs() < 1e-12);
+        assert!((d.second_closest_neighbour_distance(20).unwrap() - 0.15).abs() < 1e-12);
+        assert_eq!(d.deletion_candidate(), Some(20));
+        // Insert B's partner last and A's first, so insertion order cannot decide.
+        let mut d = SamplingDomain::new(DomainKind::Disc);
+        for &(id, p) in config.iter().rev() {
+            d.insert(id, p.extend(0.0)).unwrap();
+        }
+        assert_eq!(d.deletion_candidate(), Some(20));
+        // Sphere: the same configuration on the tangent plane at +Z, gnomonically (distances
+        // change a little but not their order); plus a site at the south pole.
+        let mut d = SamplingDomain::new(DomainKind::Sphere);
+        d.insert(999, DVec3::NEG_Z).unwrap();
+        for &(id, p) in &config {
+            d.insert(id, (p * 0.5).extend(1.0)).unwrap();
+        }
+        let (a, b, _) = d.shortest_edge().unwrap();
+        assert_eq!((a.min(b), a.max(b)), (10, 20));
+        assert_eq!(d.deletion_candidate(), Some(20));
+        // Deleting repeatedly always removes an endpoint of the shortest edge and never
+        // decreases the shortest edge length (§4.5: "always increases the smallest distance").
+        let mut last = 0.0;
+        while d.len() > 4 {
+            let (a, b, len) = d.shortest_edge().unwrap();
+            assert!(len >= last - 1e-12);
+            last = len;
+            let victim = d.deletion_candidate().unwrap();
+            assert!(victim == a || victim == b);
+            d.remove(victim).unwrap();
+        }
+    }
+}
+
+#[test]
+fn timing_report() {
+    for kind in [DomainKind::Disc, DomainKind::Sphere] {
+        for n in [256usize, 1024] {
+            let pts = point_set(kind, n, true);
+            let t0 = Instant::now();
+            let d = build(kind, &pts);
+            let t_build = t0.elapsed();
+            let reps = 50;
+            let t0 = Instant::now();
+            let mut acc = 0.0;
+            for _ in 0..reps {
+                acc += d.largest_empty_circle().unwrap().1;
+            }
+            let t_lec = t0.elapsed() / reps;
+            let t0 = Instant::now();
+            for _ in 0..reps {
+                acc += d.voronoi_areas()[0].1;
+            }
+            let t_area = t0.elapsed() / reps;
+            let t0 = Instant::now();
+            for _ in 0..reps {
+                acc += d.deletion_candidate().unwrap() as f64;
+            }
+            let t_del = t0.elapsed() / reps;
+            // Remove + re-insert one point (not the sphere's pole).
+            let mut d2 = d.clone();
+            let t0 = Instant::now();
+            for k in 0..reps as u64 {
+                let id = (k + 1) * 7 + 3;
+                let p = d2.remove(id).unwrap();
+                d2.insert(id, p).unwrap();
+            }
+            let t_upd = t0.elapsed() / reps;
+            // Removing the sphere's projection pole (the first site inserted) re-projects and
+            // bulk-loads the rest.
+            let mut d3 = d.clone();
+            let t0 = Instant::now();
+            d3.remove(3).unwrap();
+            let t_first = t0.elapsed();
+            println!(
+                "{kind:?} n={n}: build {t_build:?}, largest_empty_circle {t_lec:?}, \
+                 voronoi_areas {t_area:?}, deletion_candidate {t_del:?}, remove+insert {t_upd:?}, \
+                 remove first-inserted {t_first:?} ({acc:.1})"
+            );
+        }
+    }
+}
