@@ -3,10 +3,11 @@
 
 use gibench_harness::technique::TechniqueInfo;
 
-static ALL: [TechniqueInfo; 3] = [
+static ALL: [TechniqueInfo; 4] = [
     gibench_direct::INFO,
     gibench_keller::FULL,
     gibench_keller::INCREMENTAL,
+    gibench_laine::INFO,
 ];
 
 /// All registered techniques.

@@ -68,10 +68,10 @@ fn keller_full_matches_the_reference_one_bounce() {
             .collect();
         let rel = gibench_harness::metrics::relative_mse(&e, &r.one_bounce, &r.hit);
         let (mut a, mut b) = (0.0f64, 0.0f64);
-        for i in 0..e.len() {
-            if r.hit[i] {
-                a += e[i].element_sum() as f64;
-                b += r.one_bounce[i].element_sum() as f64;
+        for ((t, x), hit) in e.iter().zip(&r.one_bounce).zip(&r.hit) {
+            if *hit {
+                a += t.element_sum() as f64;
+                b += x.element_sum() as f64;
             }
         }
         eprintln!(

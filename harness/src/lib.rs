@@ -29,6 +29,7 @@ pub mod anim;
 pub mod assets;
 pub mod bvh;
 pub mod error;
+pub mod gather;
 pub mod gpu;
 pub mod image_io;
 pub mod metrics;

@@ -1,0 +1,96 @@
+//! Laine's VPL management on the Cornell box (CPU only): invariants every frame, and the
+//! dispersion of the sampling points under a still light.
+
+use gibench_harness::anim::FrameClock;
+use gibench_harness::assets::AssetPaths;
+use gibench_harness::bvh::SceneBvh;
+use gibench_harness::scene::descriptor::LightKind;
+use gibench_harness::scene::Scene;
+use gibench_laine::Manager;
+
+fn cornell(kind: LightKind) -> (Scene, SceneBvh) {
+    let mut scene = Scene::load_named("cornell", &AssetPaths::standard(None)).unwrap();
+    scene.descriptor.light.kind = kind;
+    if kind == LightKind::Omni {
+        // Keep the omni light inside the box, below the ceiling.
+        for k in &mut scene.descriptor.light.path.keys {
+            k.position[1] = 400.0;
+        }
+    }
+    let bvh = SceneBvh::new(&scene.mesh);
+    (scene, bvh)
+}
+
+#[test]
+fn still_light_dispersion_only_goes_down() {
+    for kind in [LightKind::Spot, LightKind::Omni] {
+        let (scene, bvh) = cornell(kind);
+        let light = FrameClock::new(&scene.descriptor).frame(0).light;
+        let mut m = Manager::new(256, 4, 8);
+        m.step(&scene, &bvh, light);
+        let mut previous = m.dispersion();
+        let first = previous;
+        for frame in 1..80 {
+            m.step(&scene, &bvh, light);
+            let d = m.dispersion();
+            assert!(
+                d <= previous + 1e-12,
+                "{kind:?} frame {frame}: dispersion rose from {previous} to {d}"
+            );
+            previous = d;
+        }
+        assert!(
+            previous < first,
+            "{kind:?}: dispersion did not improve ({first} -> {previous})"
+        );
+    }
+}
+
+#[test]
+fn management_invariants_while_the_light_moves() {
+    for kind in [LightKind::Spot, LightKind::Omni] {
+        let (scene, bvh) = cornell(kind);
+        let clock = FrameClock::new(&scene.descriptor);
+        let mut m = Manager::new(128, 4, 8);
+        for frame in 0..60 {
+            let light = clock.frame(frame).light;
+            let step = m.step(&scene, &bvh, light);
+            let vpls = m.vpls();
+            assert!(vpls.len() <= 128);
+            if frame > 0 {
+                assert!(
+                    step.created <= 8,
+                    "{kind:?} frame {frame}: {} new sampling points",
+                    step.created
+                );
+            }
+            let mut slots: Vec<u32> = vpls.iter().map(|(s, _)| *s).collect();
+            slots.sort();
+            slots.dedup();
+            assert_eq!(slots.len(), vpls.len(), "slots are unique");
+            let mut flux = gibench_harness::glam::Vec3::ZERO;
+            for (_, v) in &vpls {
+                // Every VPL is lit by the current light (validity, §4.4).
+                assert!(
+                    !bvh.occluded(light.position, v.position, 1e-4),
+                    "{kind:?} frame {frame}: an occluded VPL"
+                );
+                if kind == LightKind::Spot {
+                    let d = v.position - light.position;
+                    assert!(d.dot(light.direction) >= -1e-5 * d.length());
+                }
+                flux += v.flux;
+            }
+            // Intensities are Voronoi shares of the power times the albedo (§4.7).
+            let max_albedo = 0.725;
+            assert!(
+                flux.x <= light.power.x * max_albedo * 1.0001,
+                "{kind:?} frame {frame}: flux {flux} exceeds the power"
+            );
+            assert!(
+                flux.x > 0.2 * light.power.x * 0.63,
+                "{kind:?} frame {frame}: flux {flux} too small"
+            );
+        }
+    }
+}
