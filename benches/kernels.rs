@@ -1,5 +1,6 @@
-//! Criterion benches: CPU kernels the techniques lean on (BVH ray casts) and one whole frame of
-//! each registered technique on the Cornell box (GPU, flushed per frame).
+//! Criterion benches: CPU kernels the techniques lean on (BVH ray casts, Laine's VPL
+//! management for spot and omni lights at 256 and 1024 VPLs) and one whole frame of each
+//! registered technique on the Cornell box (GPU, flushed per frame).
 //!
 //! `cargo bench` runs them; `cargo bench -- rays` runs a subset.
 
@@ -50,6 +51,39 @@ fn rays(c: &mut Criterion) {
     }
 }
 
+/// Laine's VPL management per frame (validity, deletion, creation, Voronoi intensities), spot
+/// and omni, at 256 and 1024 VPLs, with the light moving along Sibenik's path (Cornell if
+/// Sibenik is not on the asset path).
+fn laine_management(c: &mut Criterion) {
+    use gibench_harness::scene::descriptor::LightKind;
+    let assets = AssetPaths::standard(None);
+    let scene = Scene::load_named("sibenik", &assets)
+        .or_else(|_| Scene::load_named("cornell", &assets))
+        .expect("a scene");
+    let bvh = gibench_harness::bvh::SceneBvh::new(&scene.mesh);
+    for kind in [LightKind::Spot, LightKind::Omni] {
+        let mut desc = scene.descriptor.clone();
+        desc.light.kind = kind;
+        let clock = gibench_harness::anim::FrameClock::new(&desc);
+        for vpls in [256, 1024] {
+            let mut m = gibench_laine::Manager::new(vpls, 4, 8);
+            m.step(&scene, &bvh, clock.frame(0).light);
+            let mut frame = 1;
+            let name = format!(
+                "laine-management/{}-{vpls}/{}",
+                format!("{kind:?}").to_lowercase(),
+                desc.name
+            );
+            c.bench_function(&name, |b| {
+                b.iter(|| {
+                    m.step(&scene, &bvh, clock.frame(frame).light);
+                    frame += 1;
+                })
+            });
+        }
+    }
+}
+
 fn frames(c: &mut Criterion) {
     let Ok(gpu) = GpuContext::new(&GpuOptions::default()) else {
         eprintln!("skipping frame benches: no GPU adapter");
@@ -88,6 +122,6 @@ fn frames(c: &mut Criterion) {
 criterion_group! {
     name = benches;
     config = Criterion::default().sample_size(20);
-    targets = rays, frames
+    targets = rays, laine_management, frames
 }
 criterion_main!(benches);

@@ -2,6 +2,7 @@
 //! frames and timing harness, and render their per-stage timing tables.
 
 mod registry;
+mod reproduce;
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -42,6 +43,8 @@ enum Command {
     /// Run one technique over a list of values of one parameter (e.g. vpls=64,128,256 or
     /// tiles=1x1,2x2,4x4,8x8) and tabulate and plot per-stage times against it.
     Sweep(SweepArgs),
+    /// Regenerate a paper's table: laine-table1, laine-table2 or laine-management.
+    Reproduce(reproduce::ReproduceArgs),
     /// Plot per-frame error against the reference from results files made with
     /// `run --quality --quality-all` (e.g. the lag of keller-incremental).
     PlotQuality(PlotQualityArgs),
@@ -151,7 +154,7 @@ struct GpuArgs {
 }
 
 #[derive(Args, Clone)]
-struct RunArgs {
+pub(crate) struct RunArgs {
     /// Scene: a built-in name (see `gibench list`) or a path to a descriptor JSON.
     #[arg(long, default_value = "cornell")]
     scene: String,
@@ -241,6 +244,7 @@ fn main() -> ExitCode {
         Some(Command::Reference(args)) => reference_cmd(&args),
         Some(Command::Sweep(args)) => sweep(&args),
         Some(Command::PlotQuality(args)) => plot_quality(&args),
+        Some(Command::Reproduce(args)) => reproduce::reproduce(&args),
     };
     match outcome {
         Ok(()) => ExitCode::SUCCESS,
@@ -254,12 +258,19 @@ fn main() -> ExitCode {
 impl RunArgs {
     /// The defaults of `gibench run`, for `gibench` with no arguments.
     fn parse_default() -> RunArgs {
+        RunArgs::parse_args(["gibench"])
+    }
+
+    /// `gibench run` options from an argument list (the first item is the program name).
+    fn parse_args<I: IntoIterator<Item = T>, T: Into<std::ffi::OsString> + Clone>(
+        args: I,
+    ) -> RunArgs {
         #[derive(Parser)]
         struct Only {
             #[command(flatten)]
             run: RunArgs,
         }
-        Only::parse_from(["gibench"]).run
+        Only::parse_from(args).run
     }
 }
 
@@ -341,7 +352,7 @@ fn assign_params(techniques: &[&TechniqueInfo], raw: &[String]) -> Result<Vec<Pa
 }
 
 /// Everything a run needs, checked before anything runs or is written.
-struct Plan {
+pub(crate) struct Plan {
     config: RunConfig,
     quality: Option<QualityConfig>,
     techniques: Vec<&'static TechniqueInfo>,
@@ -350,7 +361,7 @@ struct Plan {
     scene: Scene,
 }
 
-fn plan(args: &RunArgs, extra_params: &[String]) -> Result<Plan> {
+pub(crate) fn plan(args: &RunArgs, extra_params: &[String]) -> Result<Plan> {
     let config = RunConfig {
         resolution: parse_resolution(&args.resolution)?,
         frames: args.frames,
@@ -396,7 +407,7 @@ fn plan(args: &RunArgs, extra_params: &[String]) -> Result<Plan> {
     })
 }
 
-fn progress_bar(args: &RunArgs, plan: &Plan, runs: u64) -> indicatif::ProgressBar {
+pub(crate) fn progress_bar(args: &RunArgs, plan: &Plan, runs: u64) -> indicatif::ProgressBar {
     let passes = if plan.config.timing == TimingMode::Both {
         2
     } else {
@@ -417,7 +428,7 @@ fn progress_bar(args: &RunArgs, plan: &Plan, runs: u64) -> indicatif::ProgressBa
     bar
 }
 
-fn announce(plan: &Plan, gpu: &GpuContext) {
+pub(crate) fn announce(plan: &Plan, gpu: &GpuContext) {
     let c = &plan.config;
     eprintln!(
         "gibench: scene '{}' ({} triangles) at {}x{} on {} ({}), {} measured + {} warm-up frames, timing '{}'",
@@ -435,7 +446,7 @@ fn announce(plan: &Plan, gpu: &GpuContext) {
 
 /// Runs one technique (timing passes, then quality if asked) and writes its results file and
 /// images as `{stem}.*` in `args.out`.
-fn run_one(
+pub(crate) fn run_one(
     args: &RunArgs,
     plan: &Plan,
     harness: &Harness,
@@ -481,7 +492,7 @@ fn run_one(
     Ok(result)
 }
 
-fn open_gpu(args: &RunArgs) -> Result<GpuContext> {
+pub(crate) fn open_gpu(args: &RunArgs) -> Result<GpuContext> {
     GpuContext::new(&GpuOptions {
         backend: args.gpu.backend.clone(),
         adapter: args.gpu.adapter.clone(),

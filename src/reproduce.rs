@@ -1,0 +1,447 @@
+//! `gibench reproduce`: regenerate the per-stage timing tables of Laine et al. 2007 with the
+//! harness, printing the paper's figures (from `results/papers/laine2007.json`, labelled with
+//! their source) beside ours.
+//!
+//! * `laine-table1`: per scene × resolution, `laine` and its comparison method `keller-full` on
+//!   the same frames: direct illumination (shadow map + PCF), G-buffer, Σ common (split,
+//!   accumulate, combine, filter), shadow-map rendering of both methods, FPS of both, and the
+//!   speedups. The paper's indirect speedup is (frame_comp − direct) / (frame_ours − direct),
+//!   which reproduces its printed values from its own columns.
+//! * `laine-table2`: split, accumulate, combine, filter and Σ common per resolution.
+//! * `laine-management`: VPL management cost on the CPU, spot vs omni, at 256 and 1024 VPLs
+//!   (median and p99 per frame), the figures of the paper's §6.
+//!
+//! Paper sizes (1024×768 and 1600×1200, 256 VPLs with 256² maps, 1000 frames) are the
+//! defaults, for a GPU; `--quick` runs small sizes that finish on a CPU adapter.
+
+use std::path::PathBuf;
+
+use clap::Args;
+use gibench_harness::report::{self, Cell, Table};
+use gibench_harness::results::RunResult;
+use gibench_harness::runner::Harness;
+use gibench_harness::{Error, Result};
+
+use crate::{announce, open_gpu, plan, progress_bar, run_one, RunArgs};
+
+#[derive(Args)]
+pub struct ReproduceArgs {
+    /// laine-table1, laine-table2, laine-tables (both from one set of runs) or laine-management.
+    pub target: String,
+    /// Small sizes for machines without a GPU: 256x192 and 400x300, 256 VPLs with 128² maps
+    /// (64² on Sibenik), 12 frames after 2 warm-up frames.
+    #[arg(long)]
+    pub quick: bool,
+    /// Scenes (default: cornell, sibenik; the paper's Maze is not generated yet).
+    #[arg(long, value_delimiter = ',')]
+    pub scenes: Vec<String>,
+    /// Output directory.
+    #[arg(long, default_value = "results/laine")]
+    pub out: PathBuf,
+    /// Restrict the adapter to one backend.
+    #[arg(long, env = "GIBENCH_BACKEND")]
+    pub backend: Option<String>,
+    /// Use the adapter whose name contains this.
+    #[arg(long, env = "GIBENCH_ADAPTER")]
+    pub adapter: Option<String>,
+}
+
+/// The paper's published figures.
+fn paper() -> Result<serde_json::Value> {
+    let text = include_str!("../results/papers/laine2007.json");
+    serde_json::from_str(text)
+        .map_err(|e| Error::Invalid(format!("results/papers/laine2007.json: {e}")))
+}
+
+struct Sizes {
+    resolutions: Vec<[u32; 2]>,
+    frames: u32,
+    warmup: u32,
+}
+
+fn sizes(quick: bool) -> Sizes {
+    if quick {
+        Sizes {
+            resolutions: vec![[256, 192], [400, 300]],
+            frames: 12,
+            warmup: 2,
+        }
+    } else {
+        Sizes {
+            resolutions: vec![[1024, 768], [1600, 1200]],
+            frames: 1000,
+            warmup: 20,
+        }
+    }
+}
+
+/// VPL settings per scene: the paper's 256 VPLs with 256² maps, or quick ones.
+fn vpl_params(scene: &str, quick: bool) -> Vec<String> {
+    let (vpls, size) = match (quick, scene) {
+        (false, _) => (256, 256),
+        (true, "sibenik") => (256, 64),
+        (true, _) => (256, 128),
+    };
+    vec![
+        format!("keller-full.vpls={vpls}"),
+        format!("laine.max-lights={vpls}"),
+        format!("shadow-size={size}"),
+        "tiles=4x4".into(),
+        "depth-bits=16".into(),
+    ]
+}
+
+/// Runs `laine` and `keller-full` on each scene and resolution; returns (scene, resolution,
+/// laine result, keller result).
+fn run_pairs(args: &ReproduceArgs) -> Result<Vec<(String, [u32; 2], RunResult, RunResult)>> {
+    let s = sizes(args.quick);
+    let scenes = if args.scenes.is_empty() {
+        vec!["cornell".to_string(), "sibenik".to_string()]
+    } else {
+        args.scenes.clone()
+    };
+    let shadow = if args.quick { 256 } else { 1024 };
+    let mut out = Vec::new();
+    for scene in &scenes {
+        for res in &s.resolutions {
+            let mut argv: Vec<String> = vec!["gibench".into(), "--scene".into(), scene.clone()];
+            argv.extend(["--technique", "laine,keller-full"].map(String::from));
+            argv.extend(["--resolution".into(), format!("{}x{}", res[0], res[1])]);
+            argv.extend([
+                "--frames".into(),
+                s.frames.to_string(),
+                "--warmup".into(),
+                s.warmup.to_string(),
+            ]);
+            argv.extend([
+                "--shadow-size".into(),
+                shadow.to_string(),
+                "--no-images".into(),
+            ]);
+            argv.extend(["--out".into(), args.out.join("runs").display().to_string()]);
+            for p in vpl_params(scene, args.quick) {
+                argv.extend(["--param".into(), p]);
+            }
+            if let Some(b) = &args.backend {
+                argv.extend(["--backend".into(), b.clone()]);
+            }
+            if let Some(a) = &args.adapter {
+                argv.extend(["--adapter".into(), a.clone()]);
+            }
+            let run_args = RunArgs::parse_args(argv);
+            let p = plan(&run_args, &[])?;
+            let gpu = open_gpu(&run_args)?;
+            let harness = Harness::new(&gpu, &p.scene, &p.config)?;
+            announce(&p, &gpu);
+            let bar = progress_bar(&run_args, &p, 2);
+            let mut results = Vec::new();
+            for (info, params) in p.techniques.iter().zip(&p.params) {
+                bar.set_message(info.name.to_string());
+                let stem = format!("{}-{}-{}x{}", p.desc.name, info.name, res[0], res[1]);
+                results.push(run_one(&run_args, &p, &harness, info, params, &stem, &bar)?);
+            }
+            bar.finish_and_clear();
+            let keller = results.pop().expect("two runs");
+            let laine = results.pop().expect("two runs");
+            out.push((scene.clone(), *res, laine, keller));
+        }
+    }
+    Ok(out)
+}
+
+fn ms(r: &RunResult, stage: &str) -> Option<f64> {
+    r.stage(stage).and_then(|s| s.best_ms())
+}
+
+fn sum(r: &RunResult, stages: &[&str]) -> Option<f64> {
+    stages.iter().map(|s| ms(r, s)).sum()
+}
+
+const COMMON: [&str; 4] = ["split", "accumulate", "combine", "filter"];
+
+fn device_note(runs: &[&RunResult]) -> String {
+    let mut devices: Vec<String> = runs
+        .iter()
+        .map(|r| {
+            format!(
+                "{} ({}, driver {})",
+                r.device.adapter, r.device.backend, r.device.driver
+            )
+        })
+        .collect();
+    devices.dedup();
+    format!(
+        "Ours: {}; git {}.",
+        devices.join("; "),
+        runs.first().map(|r| r.git_commit.as_str()).unwrap_or("?")
+    )
+}
+
+fn paper_cells(values: &serde_json::Value) -> Vec<Cell> {
+    values
+        .as_array()
+        .map(|a| a.iter().map(|v| Cell::Num(v.as_f64(), 1)).collect())
+        .unwrap_or_default()
+}
+
+fn table1(pairs: &[(String, [u32; 2], RunResult, RunResult)]) -> Result<Table> {
+    let paper = paper()?;
+    let mut columns: Vec<String> = ["source", "scene", "resolution"].map(String::from).into();
+    columns.extend(
+        [
+            "direct SM+PCF",
+            "G-buffer",
+            "Σ common",
+            "SM ours",
+            "SM comp.",
+            "VPL mgmt (CPU)",
+            "FPS comp.",
+            "FPS ours",
+            "speedup indirect",
+            "speedup frame",
+        ]
+        .map(String::from),
+    );
+    let mut rows = Vec::new();
+    for (scene, res, laine, keller) in pairs {
+        let direct = sum(laine, &["direct-shadow-map", "direct-light"]);
+        let fps = |r: &RunResult| r.frame.as_ref().map(|f| f.fps);
+        let (fc, fo) = (fps(keller), fps(laine));
+        let speedup_indirect = match (fc, fo, direct) {
+            (Some(c), Some(o), Some(d)) => Some((1000.0 / c - d) / (1000.0 / o - d)),
+            _ => None,
+        };
+        let speedup_frame = fc.zip(fo).map(|(c, o)| o / c);
+        rows.push(vec![
+            Cell::text("gibench"),
+            Cell::text(scene),
+            Cell::text(format!("{}x{}", res[0], res[1])),
+            Cell::Ms(direct),
+            Cell::Ms(ms(laine, "gbuffer")),
+            Cell::Ms(sum(laine, &COMMON)),
+            Cell::Ms(ms(laine, "vpl-shadow-maps")),
+            Cell::Ms(ms(keller, "vpl-shadow-maps")),
+            Cell::Ms(ms(laine, "vpl-management")),
+            Cell::Num(fc, 1),
+            Cell::Num(fo, 1),
+            Cell::Num(speedup_indirect, 1),
+            Cell::Num(speedup_frame, 1),
+        ]);
+        // The paper's row for the same scene, at the paper resolution in the same position.
+        let name = scene.to_uppercase();
+        let paper_rows = paper["table1"]["rows"]
+            .as_array()
+            .cloned()
+            .unwrap_or_default();
+        let index = pairs
+            .iter()
+            .filter(|p| &p.0 == scene)
+            .position(|p| p.1 == *res)
+            .unwrap_or(0);
+        if let Some(row) = paper_rows
+            .iter()
+            .filter(|r| r["scene"] == name.as_str())
+            .nth(index)
+        {
+            let mut cells = vec![
+                Cell::text("Laine et al. 2007, Table 1 (GeForce 8800 GTX)"),
+                Cell::text(&name),
+                Cell::text(format!("{}x{}", row["resolution"][0], row["resolution"][1])),
+            ];
+            let v = paper_cells(&row["values"]);
+            cells.extend(v[..5].iter().cloned());
+            cells.push(Cell::Num(None, 1));
+            cells.extend(v[5..].iter().cloned());
+            rows.push(cells);
+        }
+    }
+    let all: Vec<&RunResult> = pairs.iter().flat_map(|p| [&p.2, &p.3]).collect();
+    let frames = all
+        .first()
+        .map(|r| (r.frames.measured, r.frames.warmup))
+        .unwrap_or_default();
+    Ok(Table {
+        title: "Laine et al. 2007, Table 1: timings (ms) with the light and the camera moving".into(),
+        columns,
+        rows,
+        notes: vec![
+            format!(
+                "gibench rows: medians over {} frames ({} warm-up frames dropped), stages timed with the queue flushed before \
+                 and after (the paper's per-task method), FPS without added synchronisation. `laine` vs `keller-full` (the \
+                 comparison method) on the same frames with the same gathering; VPL management runs on the CPU on the frame's \
+                 critical path here (the paper overlapped it with GPU work). Speedup indirect = (frame_comp − direct) / \
+                 (frame_ours − direct); speedup frame = FPS ours / FPS comp.",
+                frames.0, frames.1
+            ),
+            format!("Paper rows: {}; {}", paper["source"].as_str().unwrap_or(""), paper["note"].as_str().unwrap_or("")),
+            device_note(&all),
+        ],
+    })
+}
+
+fn table2(pairs: &[(String, [u32; 2], RunResult, RunResult)]) -> Result<Table> {
+    let paper = paper()?;
+    let mut columns: Vec<String> = ["source", "scene", "resolution"].map(String::from).into();
+    columns.extend(["split", "accum.", "combine", "filter", "Σ common"].map(String::from));
+    let mut rows = Vec::new();
+    let mut seen = Vec::new();
+    for (scene, res, laine, _) in pairs {
+        let mut row = vec![
+            Cell::text("gibench"),
+            Cell::text(scene),
+            Cell::text(format!("{}x{}", res[0], res[1])),
+        ];
+        row.extend(COMMON.iter().map(|s| Cell::Ms(ms(laine, s))));
+        row.push(Cell::Ms(sum(laine, &COMMON)));
+        rows.push(row);
+        if !seen.contains(res) {
+            seen.push(*res);
+        }
+    }
+    for (i, row) in paper["table2"]["rows"]
+        .as_array()
+        .cloned()
+        .unwrap_or_default()
+        .iter()
+        .enumerate()
+    {
+        let mut cells = vec![
+            Cell::text("Laine et al. 2007, Table 2 (GeForce 8800 GTX)"),
+            Cell::text("(scene-independent)"),
+            Cell::text(format!("{}x{}", row["resolution"][0], row["resolution"][1])),
+        ];
+        cells.extend(paper_cells(&row["values"]));
+        if i < seen.len() {
+            rows.push(cells);
+        }
+    }
+    let all: Vec<&RunResult> = pairs.iter().map(|p| &p.2).collect();
+    Ok(Table {
+        title: "Laine et al. 2007, Table 2: scene-independent common steps (ms)".into(),
+        columns,
+        rows,
+        notes: vec![
+            "gibench rows: `laine`'s stages, medians over the measured frames, flushed per stage. The paper's split and \
+             combine were fragment passes over textures; gibench's are compute passes over storage buffers (see the \
+             README's deviations)."
+                .into(),
+            format!("Paper rows: {}.", paper["source"].as_str().unwrap_or("")),
+            device_note(&all),
+        ],
+    })
+}
+
+/// VPL management cost per frame on the CPU (spot and omni, 256 and 1024 VPLs) on Sibenik's
+/// animation: a CPU-only run of the `laine` manager.
+fn management(args: &ReproduceArgs) -> Result<Table> {
+    use gibench_harness::anim::FrameClock;
+    use gibench_harness::assets::AssetPaths;
+    use gibench_harness::bvh::SceneBvh;
+    use gibench_harness::scene::descriptor::LightKind;
+    use gibench_harness::scene::{Scene, SceneDescriptor};
+    use gibench_harness::stats::Stats;
+    let frames = if args.quick { 100 } else { 1000 };
+    let name = args
+        .scenes
+        .first()
+        .cloned()
+        .unwrap_or_else(|| "sibenik".into());
+    let desc = SceneDescriptor::resolve(&name)?;
+    let scene = Scene::load(&desc, &AssetPaths::standard(None))?;
+    let bvh = SceneBvh::new(&scene.mesh);
+    let paper = paper()?;
+    let mut rows = Vec::new();
+    let mut records = serde_json::Map::new();
+    for kind in [LightKind::Spot, LightKind::Omni] {
+        let mut d = desc.clone();
+        d.light.kind = kind;
+        let clock = FrameClock::new(&d);
+        for vpls in [256u32, 1024] {
+            let mut m = gibench_laine::Manager::new(vpls, 4, 8);
+            m.step(&scene, &bvh, clock.frame(0).light);
+            let times: Vec<f64> = (1..=frames)
+                .map(|f| {
+                    let light = clock.frame(f).light;
+                    let t = std::time::Instant::now();
+                    m.step(&scene, &bvh, light);
+                    t.elapsed().as_secs_f64() * 1e3
+                })
+                .collect();
+            let s = Stats::of(&times);
+            let label = format!("{kind:?}").to_lowercase();
+            rows.push(vec![
+                Cell::text("gibench"),
+                Cell::text(&label),
+                Cell::Num(Some(vpls as f64), 0),
+                Cell::Ms(Some(s.median)),
+                Cell::Ms(Some(s.p99)),
+                Cell::Ms(Some(s.max)),
+            ]);
+            records.insert(
+                format!("{label}-{vpls}"),
+                serde_json::to_value(s).unwrap_or_default(),
+            );
+        }
+        let range = &paper["section6"]["vpl_management_ms"][format!("{kind:?}").to_lowercase()];
+        rows.push(vec![
+            Cell::text("Laine et al. 2007, §6 (Athlon 64, one core, CGAL)"),
+            Cell::text(format!("{kind:?}").to_lowercase()),
+            Cell::Num(Some(256.0), 0),
+            Cell::text(format!("{}–{}", range[0], range[1])),
+            Cell::Ms(None),
+            Cell::Ms(None),
+        ]);
+    }
+    let json = serde_json::json!({
+        "scene": name, "frames": frames, "git_commit": gibench_harness::runner::git_commit(),
+        "cpu_threads": std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1),
+        "per_frame_ms": records,
+    });
+    let bytes = serde_json::to_vec_pretty(&json).map_err(|e| Error::Invalid(e.to_string()))?;
+    gibench_harness::error::write_atomic(&args.out.join("laine-management.json"), &bytes)?;
+    Ok(Table {
+        title: format!("VPL management per frame on the CPU ({name}, {frames} frames, recalcMin 4, recalcMax 8)"),
+        columns: ["source", "light", "VPLs", "median ms", "p99 ms", "max ms"].map(String::from).into(),
+        rows,
+        notes: vec![
+            "gibench: validity rays, deletion, creation rays and Voronoi intensities of `laine`'s manager, single-threaded, \
+             wall time per frame; the sphere is triangulated on its surface (no 3D tetrahedralisation)."
+                .into(),
+            format!("Paper: {} — a range over its test scenes, median only.", paper["source"].as_str().unwrap_or("")),
+        ],
+    })
+}
+
+pub fn reproduce(args: &ReproduceArgs) -> Result<()> {
+    let tables = match args.target.as_str() {
+        "laine-table1" => vec![(table1(&run_pairs(args)?)?, "laine-table1")],
+        "laine-table2" => vec![(table2(&run_pairs(args)?)?, "laine-table2")],
+        "laine-tables" => {
+            let pairs = run_pairs(args)?;
+            vec![(table1(&pairs)?, "laine-table1"), (table2(&pairs)?, "laine-table2")]
+        }
+        "laine-management" => vec![(management(args)?, "laine-management")],
+        other => {
+            return Err(Error::param(
+                "target",
+                format!(
+                    "unknown target '{other}'; expected laine-table1, laine-table2, laine-tables (both from one set of \
+                     runs) or laine-management"
+                ),
+            ))
+        }
+    };
+    for (table, stem) in tables {
+        println!("{}", table.to_terminal());
+        let written = report::write_tables(&table, &args.out, stem)?;
+        eprintln!(
+            "wrote {}",
+            written
+                .iter()
+                .map(|p| p.display().to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
+    Ok(())
+}
