@@ -91,9 +91,11 @@ fn vpl_params(scene: &str, quick: bool) -> Vec<String> {
     ]
 }
 
-/// Runs `laine` and `keller-full` on each scene and resolution; returns (scene, resolution,
-/// laine result, keller result).
-fn run_pairs(args: &ReproduceArgs) -> Result<Vec<(String, [u32; 2], RunResult, RunResult)>> {
+/// One table row's runs: (scene, resolution, `laine` result, `keller-full` result).
+type Pair = (String, [u32; 2], RunResult, RunResult);
+
+/// Runs `laine` and `keller-full` on each scene and resolution.
+fn run_pairs(args: &ReproduceArgs) -> Result<Vec<Pair>> {
     let s = sizes(args.quick);
     let scenes = if args.scenes.is_empty() {
         vec!["cornell".to_string(), "sibenik".to_string()]
@@ -184,7 +186,7 @@ fn paper_cells(values: &serde_json::Value) -> Vec<Cell> {
         .unwrap_or_default()
 }
 
-fn table1(pairs: &[(String, [u32; 2], RunResult, RunResult)]) -> Result<Table> {
+fn table1(pairs: &[Pair]) -> Result<Table> {
     let paper = paper()?;
     let mut columns: Vec<String> = ["source", "scene", "resolution"].map(String::from).into();
     columns.extend(
@@ -279,7 +281,7 @@ fn table1(pairs: &[(String, [u32; 2], RunResult, RunResult)]) -> Result<Table> {
     })
 }
 
-fn table2(pairs: &[(String, [u32; 2], RunResult, RunResult)]) -> Result<Table> {
+fn table2(pairs: &[Pair]) -> Result<Table> {
     let paper = paper()?;
     let mut columns: Vec<String> = ["source", "scene", "resolution"].map(String::from).into();
     columns.extend(["split", "accum.", "combine", "filter", "Σ common"].map(String::from));
