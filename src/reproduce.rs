@@ -38,6 +38,9 @@ pub struct ReproduceArgs {
     /// Output directory.
     #[arg(long, default_value = "results/laine")]
     pub out: PathBuf,
+    /// Override the measured frame count (e.g. for a smoke test).
+    #[arg(long)]
+    pub frames: Option<u32>,
     /// Restrict the adapter to one backend.
     #[arg(long, env = "GIBENCH_BACKEND")]
     pub backend: Option<String>,
@@ -96,7 +99,11 @@ type Pair = (String, [u32; 2], RunResult, RunResult);
 
 /// Runs `laine` and `keller-full` on each scene and resolution.
 fn run_pairs(args: &ReproduceArgs) -> Result<Vec<Pair>> {
-    let s = sizes(args.quick);
+    let mut s = sizes(args.quick);
+    if let Some(f) = args.frames {
+        s.frames = f;
+        s.warmup = s.warmup.min(f);
+    }
     let scenes = if args.scenes.is_empty() {
         vec!["cornell".to_string(), "sibenik".to_string()]
     } else {
@@ -342,7 +349,7 @@ fn management(args: &ReproduceArgs) -> Result<Table> {
     use gibench_harness::scene::descriptor::LightKind;
     use gibench_harness::scene::{Scene, SceneDescriptor};
     use gibench_harness::stats::Stats;
-    let frames = if args.quick { 100 } else { 1000 };
+    let frames = args.frames.unwrap_or(if args.quick { 100 } else { 1000 });
     let name = args
         .scenes
         .first()
