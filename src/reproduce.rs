@@ -26,7 +26,8 @@ use crate::{announce, open_gpu, plan, progress_bar, run_one, RunArgs};
 
 #[derive(Args)]
 pub struct ReproduceArgs {
-    /// laine-table1, laine-table2, laine-tables (both from one set of runs) or laine-management.
+    /// laine-table1, laine-table2, laine-tables (both from one set of runs), laine-management or
+    /// laine-dispersion.
     pub target: String,
     /// Small sizes for machines without a GPU: 256x192 and 400x300, 256 VPLs with 128² maps
     /// (64² on Sibenik), 12 frames after 2 warm-up frames.
@@ -421,6 +422,85 @@ fn management(args: &ReproduceArgs) -> Result<Table> {
     })
 }
 
+/// Dispersion of `laine`'s sampling points over the animation (Laine §4.3: the radius of the
+/// largest empty circle), spot and omni, with the light moving along the scene's path and with
+/// it still at frame 0's pose: a table of statistics, a JSON of every frame and an SVG plot.
+fn dispersion(args: &ReproduceArgs) -> Result<Table> {
+    use gibench_harness::anim::FrameClock;
+    use gibench_harness::assets::AssetPaths;
+    use gibench_harness::bvh::SceneBvh;
+    use gibench_harness::scene::descriptor::LightKind;
+    use gibench_harness::scene::{Scene, SceneDescriptor};
+    use gibench_harness::stats::Stats;
+    let frames = args.frames.unwrap_or(if args.quick { 120 } else { 600 });
+    let name = args
+        .scenes
+        .first()
+        .cloned()
+        .unwrap_or_else(|| "cornell".into());
+    let desc = SceneDescriptor::resolve(&name)?;
+    let scene = Scene::load(&desc, &AssetPaths::standard(None))?;
+    let bvh = SceneBvh::new(&scene.mesh);
+    let mut lines = Vec::new();
+    let mut rows = Vec::new();
+    let mut records = serde_json::Map::new();
+    for kind in [LightKind::Spot, LightKind::Omni] {
+        let mut d = desc.clone();
+        d.light.kind = kind;
+        let clock = FrameClock::new(&d);
+        for moving in [true, false] {
+            let mut m = gibench_laine::Manager::new(256, 4, 8);
+            let series: Vec<(f64, f64)> = (0..frames)
+                .map(|f| {
+                    let light = clock.frame(if moving { f } else { 0 }).light;
+                    m.step(&scene, &bvh, light);
+                    (f as f64, m.dispersion())
+                })
+                .collect();
+            let label = format!(
+                "{} light, {}",
+                format!("{kind:?}").to_lowercase(),
+                if moving { "moving" } else { "still" }
+            );
+            let values: Vec<f64> = series.iter().skip(1).map(|p| p.1).collect();
+            let st = Stats::of(&values);
+            rows.push(vec![
+                Cell::text(&label),
+                Cell::Num(Some(series[0].1), 4),
+                Cell::Num(Some(st.median), 4),
+                Cell::Num(Some(st.max), 4),
+                Cell::Num(series.last().map(|p| p.1), 4),
+            ]);
+            records.insert(label.clone(), serde_json::json!(values));
+            lines.push((label, series));
+        }
+    }
+    let json = serde_json::json!({
+        "scene": name, "frames": frames, "max_lights": 256, "recalc_min": 4, "recalc_max": 8,
+        "git_commit": gibench_harness::runner::git_commit(), "dispersion_per_frame_after_the_first": records,
+    });
+    let bytes = serde_json::to_vec_pretty(&json).map_err(|e| Error::Invalid(e.to_string()))?;
+    gibench_harness::error::write_atomic(&args.out.join("laine-dispersion.json"), &bytes)?;
+    report::lines_svg(
+        &lines,
+        &args.out.join("laine-dispersion.svg"),
+        &format!("Dispersion of laine's sampling points on {name} (256 VPLs)"),
+        "frame",
+        "dispersion (largest empty circle radius)",
+    )?;
+    Ok(Table {
+        title: format!("Dispersion of the sampling points ({name}, {frames} frames, 256 VPLs, recalcMin 4, recalcMax 8)"),
+        columns: ["light", "after frame 0", "median", "max", "last frame"].map(String::from).into(),
+        rows,
+        notes: vec![
+            "Dispersion is the radius of the largest empty circle among the sampling points (unit disc for spot lights, \
+             chordal on the unit sphere for omni lights; Laine et al. 2007 §4.3). Frame 0 fills every slot; a still \
+             light keeps the first frame's pose."
+                .into(),
+        ],
+    })
+}
+
 pub fn reproduce(args: &ReproduceArgs) -> Result<()> {
     let tables = match args.target.as_str() {
         "laine-table1" => vec![(table1(&run_pairs(args)?)?, "laine-table1")],
@@ -430,12 +510,13 @@ pub fn reproduce(args: &ReproduceArgs) -> Result<()> {
             vec![(table1(&pairs)?, "laine-table1"), (table2(&pairs)?, "laine-table2")]
         }
         "laine-management" => vec![(management(args)?, "laine-management")],
+        "laine-dispersion" => vec![(dispersion(args)?, "laine-dispersion")],
         other => {
             return Err(Error::param(
                 "target",
                 format!(
                     "unknown target '{other}'; expected laine-table1, laine-table2, laine-tables (both from one set of \
-                     runs) or laine-management"
+                     runs), laine-management or laine-dispersion"
                 ),
             ))
         }

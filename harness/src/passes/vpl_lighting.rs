@@ -10,10 +10,12 @@
 //! frames and indirect light bounces off static geometry only (Laine §7).
 //!
 //! **Accumulation** — reads: the split G-buffer ([`Interleave`]), the VPL list, the atlas;
-//! writes: the split irradiance. VPL k is assigned to tile k mod T (T = n·m tiles), in list order
-//! (Laine §5.1, §7), and each VPL's contribution is E = Φ/π · cos θ_v cos θ_r / max(r², d²) · V
+//! writes: the split irradiance. The VPL in shadow-map slot k is assigned to tile k mod T
+//! (T = n·m tiles; Laine §5.1, §7), which stays the same while the VPL lives, and each VPL's
+//! contribution is E = Φ/π · cos θ_v cos θ_r / max(r², d²) · V
 //! with d the clamp distance against the 1/r² singularity.
 
+use bytemuck::Zeroable;
 use glam::{Mat4, Vec3};
 
 use crate::gpu::GpuContext;
@@ -418,22 +420,28 @@ impl VplLighting {
         );
     }
 
-    /// Uploads the VPLs to accumulate, in tile-assignment order, each with its shadow-map slot.
+    /// Uploads the VPLs to accumulate, each with its shadow-map slot. The GPU list is indexed by
+    /// slot (slots without a VPL get a zero-flux entry, skipped by the shader), so a VPL's tile
+    /// is `slot mod T` for its whole life: incremental techniques do not reshuffle the
+    /// interleaving pattern when other VPLs come and go.
     pub fn write_vpls(&self, queue: &wgpu::Queue, vpls: &[(u32, Vpl)]) {
-        let n = vpls.len().min(self.settings.capacity as usize);
-        let data: Vec<GpuVpl> = vpls[..n]
+        let n = vpls
             .iter()
-            .map(|(slot, v)| {
-                let (t, b) = frame_from_normal(v.normal);
-                GpuVpl {
-                    position: v.position.extend(*slot as f32).to_array(),
-                    normal: v.normal.extend(0.0).to_array(),
-                    flux: v.flux.extend(0.0).to_array(),
-                    tangent: t.extend(self.lift).to_array(),
-                    bitangent: b.extend(0.0).to_array(),
-                }
-            })
-            .collect();
+            .map(|(slot, _)| *slot as usize + 1)
+            .max()
+            .unwrap_or(0)
+            .min(self.settings.capacity as usize);
+        let mut data = vec![GpuVpl::zeroed(); n];
+        for (slot, v) in vpls.iter().filter(|(slot, _)| (*slot as usize) < n) {
+            let (t, b) = frame_from_normal(v.normal);
+            data[*slot as usize] = GpuVpl {
+                position: v.position.extend(*slot as f32).to_array(),
+                normal: v.normal.extend(0.0).to_array(),
+                flux: v.flux.extend(0.0).to_array(),
+                tangent: t.extend(self.lift).to_array(),
+                bitangent: b.extend(0.0).to_array(),
+            };
+        }
         if !data.is_empty() {
             queue.write_buffer(&self.vpl_buffer, 0, bytemuck::cast_slice(&data));
         }

@@ -180,7 +180,15 @@ const BUILTINS: &[(&str, &str)] = &[
         "cornell-bunny",
         include_str!("../../../scenes/cornell-bunny.json"),
     ),
+    (
+        "cornell-omni",
+        include_str!("../../../scenes/cornell-omni.json"),
+    ),
     ("sibenik", include_str!("../../../scenes/sibenik.json")),
+    (
+        "sibenik-omni",
+        include_str!("../../../scenes/sibenik-omni.json"),
+    ),
     ("sponza", include_str!("../../../scenes/sponza.json")),
     (
         "conference",

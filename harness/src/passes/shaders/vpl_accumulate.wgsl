@@ -1,6 +1,6 @@
 // Interleaved accumulation of VPL irradiance (Laine et al. 2007, Section 5.1): every texel of
-// the split G-buffer gathers from the VPLs assigned to its tile (VPL k goes to tile k mod T, in
-// the order the VPLs are listed) with a visibility lookup each. Each tile sees 1/T of the VPLs,
+// the split G-buffer gathers from the VPLs assigned to its tile (the VPL in slot k goes to tile
+// k mod T; the list is indexed by slot) with a visibility lookup each. Each tile sees 1/T of the VPLs,
 // so its sum is scaled by T: after the n x m filter averages the T tiles, every pixel has the
 // full estimate.
 

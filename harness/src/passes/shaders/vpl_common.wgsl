@@ -70,6 +70,10 @@ fn vpl_visibility(v: GpuVpl, p_surface: vec3<f32>, n: vec3<f32>) -> f32 {
 // Irradiance at `p` (unit normal `n`) from VPL `v`, including visibility. The 1/r^2
 // singularity is clamped by a minimum distance.
 fn vpl_irradiance(v: GpuVpl, p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    // Empty slots carry no flux: skip them before any lookup.
+    if (all(v.flux.rgb == vec3<f32>(0.0))) {
+        return vec3<f32>(0.0);
+    }
     let d = p - v.position.xyz;
     let r2 = dot(d, d);
     let dir = d * inverseSqrt(max(r2, 1e-30));
