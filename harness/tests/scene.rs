@@ -380,3 +380,46 @@ fn builtin_scenes_load_and_are_sensible() {
         }
     }
 }
+
+#[test]
+fn tessellated_mesh_keeps_area_and_bounds_edges() {
+    let (mesh, _) = gibench_harness::scene::cornell::cornell_box(None);
+    let area = |m: &gibench_harness::scene::Mesh| -> f64 {
+        (0..m.triangle_count())
+            .map(|t| {
+                let [a, b, c] = m.triangle(t);
+                0.5 * (b - a).cross(c - a).length() as f64
+            })
+            .sum()
+    };
+    let t = mesh.tessellated(40.0);
+    assert!(t.triangle_count() > 10 * mesh.triangle_count());
+    assert!((area(&t) - area(&mesh)).abs() < 1e-4 * area(&mesh));
+    for k in 0..t.triangle_count() {
+        let [a, b, c] = t.triangle(k);
+        for e in [(b - a).length(), (c - b).length(), (a - c).length()] {
+            assert!(e <= 40.0 + 1e-3, "edge {e}");
+        }
+        // Same orientation as the source: normals still face the box's interior side.
+        let n = (b - a).cross(c - a);
+        let i = t.indices[3 * k] as usize;
+        assert!(n.dot(t.normals[i]) > 0.0);
+    }
+    // Already small triangles are kept as they are.
+    assert_eq!(
+        mesh.tessellated(1e6).triangle_count(),
+        mesh.triangle_count()
+    );
+}
+
+#[test]
+#[ignore = "prints triangle counts of Sibenik tessellations; used to choose sibenik.json's shadow_mesh"]
+fn sibenik_tessellation_counts() {
+    let scene = Scene::load_named("sibenik", &AssetPaths::standard(None)).unwrap();
+    for edge in [1.5f32, 1.9, 2.0] {
+        eprintln!(
+            "edge {edge}: {} triangles",
+            scene.mesh.tessellated(edge).triangle_count()
+        );
+    }
+}

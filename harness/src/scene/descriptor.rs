@@ -20,7 +20,9 @@ pub struct MeshSource {
     pub file: Option<String>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub generated: Option<String>,
-    /// Generated meshes only: split every quad into cells of about this edge length.
+    /// Split the mesh finely: generated meshes split every quad into cells of about this edge
+    /// length; loaded meshes split every triangle whose longest edge exceeds it into a regular
+    /// grid of sub-triangles with edges no longer than it (for paraboloid shadow maps).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tessellate: Option<f32>,
 }
@@ -427,13 +429,6 @@ fn validate_mesh_source(p: &Path, field: &str, src: &MeshSource) -> Result<()> {
             if file.trim().is_empty() {
                 return Err(invalid(p, &format!("{field}.file"), "must not be empty"));
             }
-            if src.tessellate.is_some() {
-                return Err(invalid(
-                    p,
-                    &format!("{field}.tessellate"),
-                    "only generated meshes can be tessellated",
-                ));
-            }
         }
         (None, Some(name)) => {
             if name != GENERATED_CORNELL_BOX {
@@ -664,12 +659,12 @@ mod tests {
                 }),
             ),
             (
-                "mesh.tessellate: only generated",
+                "mesh.tessellate: must be a positive",
                 Box::new(|d| {
                     d.mesh = MeshSource {
                         file: Some("a.glb".into()),
                         generated: None,
-                        tessellate: Some(3.0),
+                        tessellate: Some(-3.0),
                     }
                 }),
             ),

@@ -88,6 +88,62 @@ impl Mesh {
             |(lo, hi), p| (lo.min(*p), hi.max(*p)),
         )
     }
+    /// A copy in which every triangle whose longest edge exceeds `max_edge` is split into an
+    /// n×n grid of sub-triangles (n = ceil(longest edge / max_edge)) with attributes
+    /// interpolated linearly; smaller triangles are kept. Neighbours split differently meet at
+    /// T-junctions; the copy is only rendered into shadow maps, where these are sub-texel.
+    pub fn tessellated(&self, max_edge: f32) -> Mesh {
+        let mut out = Mesh::default();
+        if !(max_edge.is_finite() && max_edge > 0.0) {
+            return self.clone();
+        }
+        for t in 0..self.triangle_count() {
+            let idx = [
+                self.indices[3 * t] as usize,
+                self.indices[3 * t + 1] as usize,
+                self.indices[3 * t + 2] as usize,
+            ];
+            let p = idx.map(|i| self.positions[i]);
+            let longest = (p[1] - p[0])
+                .length()
+                .max((p[2] - p[1]).length())
+                .max((p[0] - p[2]).length());
+            let n = ((longest / max_edge).ceil() as usize).clamp(1, 256);
+            let base = out.positions.len() as u32;
+            // Vertices of the barycentric grid: row i (0..=n) has n - i + 1 vertices.
+            let mut row_start = Vec::with_capacity(n + 1);
+            for i in 0..=n {
+                row_start.push(out.positions.len() as u32 - base);
+                for j in 0..=(n - i) {
+                    let (b1, b2) = (i as f32 / n as f32, j as f32 / n as f32);
+                    let b0 = 1.0 - b1 - b2;
+                    let mix3 = |a: Vec3, b: Vec3, c: Vec3| a * b0 + b * b1 + c * b2;
+                    out.positions.push(mix3(p[0], p[1], p[2]));
+                    let nrm = mix3(
+                        self.normals[idx[0]],
+                        self.normals[idx[1]],
+                        self.normals[idx[2]],
+                    );
+                    out.normals.push(nrm.normalize_or(self.normals[idx[0]]));
+                    let uv = |k: usize| self.uvs.get(idx[k]).copied().unwrap_or(Vec2::ZERO);
+                    out.uvs.push(uv(0) * b0 + uv(1) * b1 + uv(2) * b2);
+                    out.materials.push(self.materials[idx[0]]);
+                }
+            }
+            let v = |i: usize, j: usize| base + row_start[i] + j as u32;
+            for i in 0..n {
+                for j in 0..(n - i) {
+                    out.indices.extend([v(i, j), v(i + 1, j), v(i, j + 1)]);
+                    if j + 1 < n - i {
+                        out.indices
+                            .extend([v(i + 1, j), v(i + 1, j + 1), v(i, j + 1)]);
+                    }
+                }
+            }
+        }
+        out
+    }
+
     /// Appends `other`, offsetting its indices and its material indices by `material_offset`.
     pub fn append(&mut self, other: &Mesh, material_offset: u32) {
         let base = self.positions.len() as u32;
@@ -165,8 +221,12 @@ fn build_mesh(src: &MeshSource, assets: &AssetPaths) -> Result<BuiltMesh> {
         (Some(file), _) => {
             let path = assets.find(file)?;
             let g = gltf_load::load_gltf(&path, 0)?;
+            let mesh = match src.tessellate {
+                Some(edge) => g.mesh.tessellated(edge),
+                None => g.mesh,
+            };
             Ok(BuiltMesh {
-                mesh: g.mesh,
+                mesh,
                 materials: g.materials,
                 textures: g.textures,
                 lights: g.lights,
