@@ -30,10 +30,10 @@ pub struct ReproduceArgs {
     /// laine-dispersion.
     pub target: String,
     /// Small sizes for machines without a GPU: 256x192 and 400x300, 256 VPLs with 128² maps
-    /// (64² on Sibenik), 12 frames after 2 warm-up frames.
+    /// (64² on Maze and Sibenik), 12 frames after 2 warm-up frames.
     #[arg(long)]
     pub quick: bool,
-    /// Scenes (default: cornell, sibenik; the paper's Maze is not generated yet).
+    /// Scenes (default: the paper's cornell, maze, sibenik).
     #[arg(long, value_delimiter = ',')]
     pub scenes: Vec<String>,
     /// Output directory.
@@ -83,7 +83,7 @@ fn sizes(quick: bool) -> Sizes {
 fn vpl_params(scene: &str, quick: bool) -> Vec<String> {
     let (vpls, size) = match (quick, scene) {
         (false, _) => (256, 256),
-        (true, "sibenik") => (256, 64),
+        (true, "sibenik" | "maze") => (256, 64),
         (true, _) => (256, 128),
     };
     vec![
@@ -106,7 +106,7 @@ fn run_pairs(args: &ReproduceArgs) -> Result<Vec<Pair>> {
         s.warmup = s.warmup.min(f);
     }
     let scenes = if args.scenes.is_empty() {
-        vec!["cornell".to_string(), "sibenik".to_string()]
+        ["cornell", "maze", "sibenik"].map(String::from).to_vec()
     } else {
         args.scenes.clone()
     };

@@ -10,6 +10,8 @@ use crate::{Error, Result};
 
 /// The only name `generated` mesh sources accept.
 pub const GENERATED_CORNELL_BOX: &str = "cornell-box";
+/// Name of the generated maze of Laine et al. 2007's MAZE scene ([`crate::scene::maze`]).
+pub const GENERATED_MAZE: &str = "maze";
 
 /// Where a mesh comes from: exactly one of `file` (a glTF binary on the asset search path) or
 /// `generated` (a scene built in code, e.g. `"cornell-box"`).
@@ -96,6 +98,20 @@ pub struct LightDesc {
     pub path: PathDesc,
 }
 
+/// A mesh placed once into the static geometry (e.g. the MAZE's statue): scaled, turned about
+/// +Y, then moved. It bounces light, casts shadows and is in the CPU BVH like the main mesh.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StaticInstance {
+    pub mesh: MeshSource,
+    #[serde(default = "one")]
+    pub scale: f32,
+    #[serde(default)]
+    pub position: [f32; 3],
+    #[serde(default)]
+    pub rotation_y_deg: f32,
+}
+
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MoverDesc {
@@ -160,6 +176,9 @@ pub struct SceneDescriptor {
     pub light: LightDesc,
     #[serde(default)]
     pub movers: Vec<MoverDesc>,
+    /// Meshes added to the static geometry (and to the shadow-map copy).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub statics: Vec<StaticInstance>,
     pub settings: SceneSettings,
     /// Animation frames per second: frame i is at time i / fps.
     #[serde(default = "default_fps")]
@@ -192,6 +211,7 @@ const BUILTINS: &[(&str, &str)] = &[
         include_str!("../../../scenes/sibenik-omni.json"),
     ),
     ("sponza", include_str!("../../../scenes/sponza.json")),
+    ("maze", include_str!("../../../scenes/maze.json")),
     (
         "conference",
         include_str!("../../../scenes/conference.json"),
@@ -237,6 +257,24 @@ impl SceneDescriptor {
         validate_mesh_source(p, "mesh", &self.mesh)?;
         if let Some(shadow) = &self.shadow_mesh {
             validate_mesh_source(p, "shadow_mesh", shadow)?;
+        }
+        for (i, st) in self.statics.iter().enumerate() {
+            let field = format!("statics[{i}]");
+            validate_mesh_source(p, &format!("{field}.mesh"), &st.mesh)?;
+            if !(st.scale.is_finite() && st.scale > 0.0) {
+                return Err(invalid(
+                    p,
+                    &format!("{field}.scale"),
+                    format!("must be positive, got {}", st.scale),
+                ));
+            }
+            if !st.position.iter().all(|c| c.is_finite()) || !st.rotation_y_deg.is_finite() {
+                return Err(invalid(
+                    p,
+                    &field,
+                    "position and rotation_y_deg must be finite",
+                ));
+            }
         }
 
         let cam = &self.camera;
@@ -431,11 +469,11 @@ fn validate_mesh_source(p: &Path, field: &str, src: &MeshSource) -> Result<()> {
             }
         }
         (None, Some(name)) => {
-            if name != GENERATED_CORNELL_BOX {
+            if name != GENERATED_CORNELL_BOX && name != GENERATED_MAZE {
                 return Err(invalid(
                     p,
                     &format!("{field}.generated"),
-                    format!("unknown generated mesh '{name}'; the only one is '{GENERATED_CORNELL_BOX}'"),
+                    format!("unknown generated mesh '{name}'; expected '{GENERATED_CORNELL_BOX}' or '{GENERATED_MAZE}'"),
                 ));
             }
         }

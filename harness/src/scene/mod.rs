@@ -12,6 +12,7 @@
 pub mod cornell;
 pub mod descriptor;
 pub mod gltf_load;
+pub mod maze;
 
 use std::path::Path;
 
@@ -21,7 +22,7 @@ use crate::assets::AssetPaths;
 use crate::Result;
 
 pub use descriptor::SceneDescriptor;
-use descriptor::{MeshSource, GENERATED_CORNELL_BOX};
+use descriptor::{MeshSource, GENERATED_CORNELL_BOX, GENERATED_MAZE};
 
 /// A diffuse material.
 #[derive(Clone, Debug, PartialEq)]
@@ -232,6 +233,15 @@ fn build_mesh(src: &MeshSource, assets: &AssetPaths) -> Result<BuiltMesh> {
                 lights: g.lights,
             })
         }
+        (None, Some(name)) if name == GENERATED_MAZE => {
+            let (mesh, materials) = maze::maze(src.tessellate);
+            Ok(BuiltMesh {
+                mesh,
+                materials,
+                textures: Vec::new(),
+                lights: Vec::new(),
+            })
+        }
         (None, Some(name)) if name == GENERATED_CORNELL_BOX => {
             let (mesh, materials) = cornell::cornell_box(src.tessellate);
             Ok(BuiltMesh {
@@ -242,7 +252,7 @@ fn build_mesh(src: &MeshSource, assets: &AssetPaths) -> Result<BuiltMesh> {
             })
         }
         (None, Some(name)) => Err(crate::Error::Invalid(format!(
-            "unknown generated mesh '{name}'; the only one is '{GENERATED_CORNELL_BOX}'"
+            "unknown generated mesh '{name}'; expected '{GENERATED_CORNELL_BOX}' or '{GENERATED_MAZE}'"
         ))),
         (None, None) => Err(crate::Error::Invalid(
             "a mesh source needs a `file` or a `generated` name".into(),
@@ -320,6 +330,31 @@ impl Scene {
                 Some(shadow_mesh)
             }
         };
+
+        // Static instances (e.g. the MAZE's statue) join the static mesh and its shadow copy.
+        let mut mesh = mesh;
+        let mut shadow_mesh = shadow_mesh;
+        for st in &desc.statics {
+            let built = build_mesh(&st.mesh, assets)?;
+            let offset = materials.len() as u32;
+            materials.extend(append_textures(
+                &mut textures,
+                built.textures,
+                built.materials,
+            ));
+            let rot = glam::Quat::from_rotation_y(st.rotation_y_deg.to_radians());
+            let mut placed = built.mesh;
+            for p in &mut placed.positions {
+                *p = rot * (*p * st.scale) + Vec3::from(st.position);
+            }
+            for n in &mut placed.normals {
+                *n = (rot * *n).normalize_or_zero();
+            }
+            mesh.append(&placed, offset);
+            if let Some(s) = shadow_mesh.as_mut() {
+                s.append(&placed, offset);
+            }
+        }
 
         let mut movers = Vec::with_capacity(desc.movers.len());
         for mover in &desc.movers {
