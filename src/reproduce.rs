@@ -341,24 +341,37 @@ fn table2(pairs: &[Pair]) -> Result<Table> {
     })
 }
 
-/// VPL management cost per frame on the CPU (spot and omni, 256 and 1024 VPLs) on Sibenik's
-/// animation: a CPU-only run of the `laine` manager.
-fn management(args: &ReproduceArgs) -> Result<Table> {
-    use gibench_harness::anim::FrameClock;
-    use gibench_harness::assets::AssetPaths;
-    use gibench_harness::bvh::SceneBvh;
-    use gibench_harness::scene::descriptor::LightKind;
+/// The scene a CPU-only target runs on (the first `--scenes` entry, else `default`), with its
+/// descriptor and the BVH of its static geometry.
+fn cpu_scene(
+    args: &ReproduceArgs,
+    default: &str,
+) -> Result<(
+    String,
+    gibench_harness::scene::SceneDescriptor,
+    gibench_harness::scene::Scene,
+    gibench_harness::bvh::SceneBvh,
+)> {
     use gibench_harness::scene::{Scene, SceneDescriptor};
-    use gibench_harness::stats::Stats;
-    let frames = args.frames.unwrap_or(if args.quick { 100 } else { 1000 });
     let name = args
         .scenes
         .first()
         .cloned()
-        .unwrap_or_else(|| "sibenik".into());
+        .unwrap_or_else(|| default.to_string());
     let desc = SceneDescriptor::resolve(&name)?;
-    let scene = Scene::load(&desc, &AssetPaths::standard(None))?;
-    let bvh = SceneBvh::new(&scene.mesh);
+    let scene = Scene::load(&desc, &gibench_harness::assets::AssetPaths::standard(None))?;
+    let bvh = gibench_harness::bvh::SceneBvh::new(&scene.mesh);
+    Ok((name, desc, scene, bvh))
+}
+
+/// VPL management cost per frame on the CPU (spot and omni, 256 and 1024 VPLs) on Sibenik's
+/// animation: a CPU-only run of the `laine` manager.
+fn management(args: &ReproduceArgs) -> Result<Table> {
+    use gibench_harness::anim::FrameClock;
+    use gibench_harness::scene::descriptor::LightKind;
+    use gibench_harness::stats::Stats;
+    let frames = args.frames.unwrap_or(if args.quick { 100 } else { 1000 });
+    let (name, desc, scene, bvh) = cpu_scene(args, "sibenik")?;
     let paper = paper()?;
     let mut rows = Vec::new();
     let mut records = serde_json::Map::new();
@@ -427,20 +440,10 @@ fn management(args: &ReproduceArgs) -> Result<Table> {
 /// it still at frame 0's pose: a table of statistics, a JSON of every frame and an SVG plot.
 fn dispersion(args: &ReproduceArgs) -> Result<Table> {
     use gibench_harness::anim::FrameClock;
-    use gibench_harness::assets::AssetPaths;
-    use gibench_harness::bvh::SceneBvh;
     use gibench_harness::scene::descriptor::LightKind;
-    use gibench_harness::scene::{Scene, SceneDescriptor};
     use gibench_harness::stats::Stats;
     let frames = args.frames.unwrap_or(if args.quick { 120 } else { 600 });
-    let name = args
-        .scenes
-        .first()
-        .cloned()
-        .unwrap_or_else(|| "cornell".into());
-    let desc = SceneDescriptor::resolve(&name)?;
-    let scene = Scene::load(&desc, &AssetPaths::standard(None))?;
-    let bvh = SceneBvh::new(&scene.mesh);
+    let (name, desc, scene, bvh) = cpu_scene(args, "cornell")?;
     let mut lines = Vec::new();
     let mut rows = Vec::new();
     let mut records = serde_json::Map::new();

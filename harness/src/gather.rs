@@ -56,23 +56,7 @@ impl VplGather {
     /// Builds the gather for at most `capacity` VPLs from the gather parameters in `params`.
     pub fn new(params: &Params, ctx: &PrepareContext, capacity: u32) -> Result<VplGather> {
         let device = &ctx.gpu.device;
-        let [w, h] = ctx.resolution;
-        let output = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("indirect irradiance"),
-            size: wgpu::Extent3d {
-                width: w,
-                height: h,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: crate::passes::HDR_FORMAT,
-            usage: wgpu::TextureUsages::STORAGE_BINDING
-                | wgpu::TextureUsages::TEXTURE_BINDING
-                | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
+        let output = crate::passes::indirect_target(device, ctx.resolution, true);
         let settings = &ctx.scene.descriptor.settings;
         let interleave = Interleave::new(
             ctx.gpu,

@@ -76,6 +76,30 @@ pub fn texture_entry(
     }
 }
 
+/// The full-resolution indirect-irradiance texture a technique returns (HDR_FORMAT; sampled by
+/// compose, copied out for images and quality). `storage` adds STORAGE_BINDING for compute
+/// writes. wgpu zero-initialises it, so a technique that never writes it outputs zero.
+pub fn indirect_target(device: &wgpu::Device, size: [u32; 2], storage: bool) -> wgpu::Texture {
+    let mut usage = wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC;
+    if storage {
+        usage |= wgpu::TextureUsages::STORAGE_BINDING;
+    }
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("indirect irradiance"),
+        size: wgpu::Extent3d {
+            width: size[0],
+            height: size[1],
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: HDR_FORMAT,
+        usage,
+        view_formats: &[],
+    })
+}
+
 /// A full-resolution 2D render target.
 pub fn render_target(
     device: &wgpu::Device,

@@ -24,29 +24,8 @@ pub struct Direct {
 }
 
 fn create(_params: &Params, ctx: &PrepareContext) -> Result<Box<dyn Technique>> {
-    use gibench_harness::wgpu::util::DeviceExt;
-    let [w, h] = ctx.resolution;
-    let texture = ctx.gpu.device.create_texture_with_data(
-        &ctx.gpu.queue,
-        &wgpu::TextureDescriptor {
-            label: Some("direct: zero indirect"),
-            size: wgpu::Extent3d {
-                width: w,
-                height: h,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: gibench_harness::passes::HDR_FORMAT,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING
-                | wgpu::TextureUsages::COPY_SRC
-                | wgpu::TextureUsages::COPY_DST,
-            view_formats: &[],
-        },
-        wgpu::util::TextureDataOrder::LayerMajor,
-        &vec![0u8; (w * h * 8) as usize],
-    );
+    // Zero-initialised by wgpu and never written: the indirect irradiance is zero.
+    let texture = gibench_harness::passes::indirect_target(&ctx.gpu.device, ctx.resolution, false);
     Ok(Box::new(Direct {
         view: texture.create_view(&Default::default()),
     }))
