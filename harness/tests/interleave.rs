@@ -62,22 +62,7 @@ fn with_cornell(gpu: &GpuContext, resolution: [u32; 2], f: impl FnOnce(&Harness,
 }
 
 fn output_texture(gpu: &GpuContext, size: [u32; 2]) -> wgpu::Texture {
-    gpu.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("test indirect"),
-        size: wgpu::Extent3d {
-            width: size[0],
-            height: size[1],
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: wgpu::TextureFormat::Rgba16Float,
-        usage: wgpu::TextureUsages::STORAGE_BINDING
-            | wgpu::TextureUsages::TEXTURE_BINDING
-            | wgpu::TextureUsages::COPY_SRC,
-        view_formats: &[],
-    })
+    gibench_harness::passes::indirect_target(&gpu.device, size, true)
 }
 
 /// Reads a buffer of `vec4<f32>` back to the CPU.

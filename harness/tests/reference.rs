@@ -3,7 +3,6 @@
 //! check on the Cornell box. Test scenes are built in code. No GPU needed.
 
 use std::f32::consts::PI;
-use std::path::Path;
 
 use gibench_harness::anim::{CameraPose, FrameClock, FrameState, LightPose};
 use gibench_harness::assets::AssetPaths;
@@ -11,56 +10,11 @@ use gibench_harness::glam::{Mat4, Vec2, Vec3};
 use gibench_harness::reference::{
     camera_ray, render_reference, ReferenceImages, ReferenceSettings, ReferenceTracer,
 };
-use gibench_harness::scene::descriptor::{LightKind, SceneDescriptor};
+use gibench_harness::scene::descriptor::LightKind;
 use gibench_harness::scene::{Material, Mesh, Mover, Scene, Texture};
 
-/// A minimal valid descriptor (its mesh source is unused: the scenes below are built in code).
-fn descriptor() -> SceneDescriptor {
-    let json = r#"{
-        "name": "test",
-        "mesh": { "generated": "cornell-box" },
-        "camera": { "fov_y_deg": 60, "near": 0.1,
-                    "path": { "keys": [ { "time": 0, "position": [0, 5, 5], "target": [0, 0, 0] } ] } },
-        "light": { "kind": "omni", "power": [1, 1, 1],
-                   "path": { "keys": [ { "time": 0, "position": [0, 3, 0] } ] } },
-        "settings": { "filter_distance": 1 }
-    }"#;
-    SceneDescriptor::from_json(Path::new("test.json"), json).unwrap()
-}
-
-fn material(name: &str, color: Vec3) -> Material {
-    Material {
-        name: name.into(),
-        base_color: color,
-        texture: None,
-        average_color: color,
-    }
-}
-
-/// Appends quad `c` (corners in order) as two triangles with flat normal `n` and `material`.
-fn quad(mesh: &mut Mesh, c: [Vec3; 4], n: Vec3, material: u32) {
-    let base = mesh.positions.len() as u32;
-    for (p, uv) in c.iter().zip([Vec2::ZERO, Vec2::X, Vec2::ONE, Vec2::Y]) {
-        mesh.positions.push(*p);
-        mesh.normals.push(n);
-        mesh.uvs.push(uv);
-        mesh.materials.push(material);
-    }
-    mesh.indices
-        .extend([0, 1, 2, 0, 2, 3].into_iter().map(|i| base + i));
-}
-
-fn scene(mesh: Mesh, materials: Vec<Material>) -> Scene {
-    Scene {
-        descriptor: descriptor(),
-        mesh,
-        shadow_mesh: None,
-        materials,
-        textures: Vec::new(),
-        movers: Vec::new(),
-        gltf_lights: Vec::new(),
-    }
-}
+mod support;
+use support::{material, quad, scene};
 
 /// The square [−h, h]² in the y = 0 plane, facing +Y.
 fn plane(h: f32) -> Mesh {

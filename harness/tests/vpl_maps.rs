@@ -33,24 +33,7 @@ fn one_vpl(backend: &str, kind: VplMapKind, vpl: Vpl) -> Vec<Option<(f32, f32, b
     let harness = Harness::new(&gpu, &scene, &config).unwrap();
     let frame = harness.clock.frame(0);
     harness.uniforms.write(&gpu.queue, &frame);
-    let output = gpu
-        .device
-        .create_texture(&gibench_harness::wgpu::TextureDescriptor {
-            label: None,
-            size: gibench_harness::wgpu::Extent3d {
-                width: w,
-                height: h,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: gibench_harness::wgpu::TextureDimension::D2,
-            format: gibench_harness::passes::HDR_FORMAT,
-            usage: gibench_harness::wgpu::TextureUsages::STORAGE_BINDING
-                | gibench_harness::wgpu::TextureUsages::TEXTURE_BINDING
-                | gibench_harness::wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
+    let output = gibench_harness::passes::indirect_target(&gpu.device, [w, h], true);
     // 1x1 tiles and a filter that never averages: the output is the raw accumulation.
     let interleave = Interleave::new(
         &gpu,

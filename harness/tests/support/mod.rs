@@ -1,0 +1,56 @@
+//! Scene-building helpers shared by the integration tests that make small scenes in code.
+#![allow(dead_code)]
+
+use std::path::Path;
+
+use gibench_harness::glam::{Vec2, Vec3};
+use gibench_harness::scene::descriptor::SceneDescriptor;
+use gibench_harness::scene::{Material, Mesh, Scene};
+
+/// A minimal valid descriptor (its mesh source is unused: the scenes below are built in code).
+pub fn descriptor() -> SceneDescriptor {
+    let json = r#"{
+        "name": "test",
+        "mesh": { "generated": "cornell-box" },
+        "camera": { "fov_y_deg": 60, "near": 0.1,
+                    "path": { "keys": [ { "time": 0, "position": [0, 5, 5], "target": [0, 0, 0] } ] } },
+        "light": { "kind": "omni", "power": [1, 1, 1],
+                   "path": { "keys": [ { "time": 0, "position": [0, 3, 0] } ] } },
+        "settings": { "filter_distance": 1 }
+    }"#;
+    SceneDescriptor::from_json(Path::new("test.json"), json).unwrap()
+}
+
+pub fn material(name: &str, color: Vec3) -> Material {
+    Material {
+        name: name.into(),
+        base_color: color,
+        texture: None,
+        average_color: color,
+    }
+}
+
+/// Appends quad `c` (corners in order) as two triangles with flat normal `n` and `material`.
+pub fn quad(mesh: &mut Mesh, c: [Vec3; 4], n: Vec3, material: u32) {
+    let base = mesh.positions.len() as u32;
+    for (p, uv) in c.iter().zip([Vec2::ZERO, Vec2::X, Vec2::ONE, Vec2::Y]) {
+        mesh.positions.push(*p);
+        mesh.normals.push(n);
+        mesh.uvs.push(uv);
+        mesh.materials.push(material);
+    }
+    mesh.indices
+        .extend([0, 1, 2, 0, 2, 3].into_iter().map(|i| base + i));
+}
+
+pub fn scene(mesh: Mesh, materials: Vec<Material>) -> Scene {
+    Scene {
+        descriptor: descriptor(),
+        mesh,
+        shadow_mesh: None,
+        materials,
+        textures: Vec::new(),
+        movers: Vec::new(),
+        gltf_lights: Vec::new(),
+    }
+}
