@@ -102,9 +102,11 @@ fn frames(c: &mut Criterion) {
     };
     let h = Harness::new(&gpu, &scene, &config).expect("harness");
     for info in registry::all() {
-        let params = gibench_harness::technique::Params::parse(info.name, info.params, &[])
-            .expect("defaults");
-        let (mut technique, compose) = h.build(info, &params, &config).expect("technique");
+        let params = info.parse_params(&[]).expect("defaults");
+        let prepared = h.prepare(info, &params, &config).expect("preparation");
+        let (mut technique, compose) = h
+            .build(info, &params, &config, &prepared)
+            .expect("technique");
         let mut profiler = Profiler::new(&gpu, ProfileMode::Frame);
         let mut i = 0;
         c.bench_function(&format!("frame/cornell-256x192/{}", info.name), |b| {

@@ -14,8 +14,9 @@ use gibench_harness::quality::{IndirectComponent, QualityConfig, ReferenceCache}
 use gibench_harness::reference::ReferenceSettings;
 use gibench_harness::report;
 use gibench_harness::results::RunResult;
-use gibench_harness::runner::{Harness, RunConfig, TimingMode};
+use gibench_harness::runner::{RunConfig, TimingMode};
 use gibench_harness::scene::{descriptor, Scene, SceneDescriptor};
+use gibench_harness::session::{self, Progress, RunSpec, TechniqueRun};
 use gibench_harness::technique::{Params, TechniqueInfo};
 use gibench_harness::{Error, Result};
 
@@ -209,9 +210,9 @@ pub(crate) struct RunArgs {
     #[arg(long)]
     quality_all: bool,
     /// The reference component the indirect irradiance is compared with: one-bounce or
-    /// multi-bounce.
-    #[arg(long, default_value = "one-bounce")]
-    quality_reference: String,
+    /// multi-bounce (default: each technique's declared component, see `gibench list`).
+    #[arg(long)]
+    quality_reference: Option<String>,
     #[command(flatten)]
     reference: ReferenceOpts,
     #[command(flatten)]
@@ -312,7 +313,7 @@ fn assign_params(techniques: &[&TechniqueInfo], raw: &[String]) -> Result<Vec<Pa
             None => techniques
                 .iter()
                 .enumerate()
-                .filter(|(_, info)| info.params.iter().any(|s| s.name == key))
+                .filter(|(_, info)| info.has_param(key))
                 .map(|(i, _)| (i, key))
                 .collect(),
         };
@@ -320,7 +321,7 @@ fn assign_params(techniques: &[&TechniqueInfo], raw: &[String]) -> Result<Vec<Pa
             let known: Vec<String> = techniques
                 .iter()
                 .map(|t| {
-                    let names: Vec<&str> = t.params.iter().map(|s| s.name).collect();
+                    let names: Vec<&str> = t.param_specs().map(|s| s.name).collect();
                     format!(
                         "{}: {}",
                         t.name,
@@ -347,7 +348,7 @@ fn assign_params(techniques: &[&TechniqueInfo], raw: &[String]) -> Result<Vec<Pa
     techniques
         .iter()
         .zip(given)
-        .map(|(t, g)| Params::parse(t.name, t.params, &g))
+        .map(|(t, g)| t.parse_params(&g))
         .collect()
 }
 
@@ -377,7 +378,11 @@ pub(crate) fn plan(args: &RunArgs, extra_params: &[String]) -> Result<Plan> {
             pairs: args.quality_pairs,
             all: args.quality_all,
             reference: args.reference.settings()?,
-            component: IndirectComponent::parse(&args.quality_reference)?,
+            component: args
+                .quality_reference
+                .as_deref()
+                .map(IndirectComponent::parse)
+                .transpose()?,
         })
     } else {
         None
@@ -407,14 +412,48 @@ pub(crate) fn plan(args: &RunArgs, extra_params: &[String]) -> Result<Plan> {
     })
 }
 
-pub(crate) fn progress_bar(args: &RunArgs, plan: &Plan, runs: u64) -> indicatif::ProgressBar {
-    let passes = if plan.config.timing == TimingMode::Both {
-        2
-    } else {
-        1
-    } + plan.quality.is_some() as u64;
-    let total = runs * passes * (plan.config.frames + plan.config.warmup) as u64;
-    let bar = if args.quiet {
+impl Plan {
+    /// The typed run of these techniques, files named `{scene}-{technique}`.
+    fn spec(&self, args: &RunArgs) -> RunSpec<'_> {
+        let runs = self
+            .techniques
+            .iter()
+            .zip(&self.params)
+            .map(|(info, params)| TechniqueRun {
+                info,
+                params: params.clone(),
+                stem: format!("{}-{}", self.desc.name, info.name),
+            })
+            .collect();
+        RunSpec {
+            scene: &self.scene,
+            runs,
+            config: self.config.clone(),
+            quality: self.quality.clone(),
+            cache: args.reference.cache(),
+            out: args.out.clone(),
+            images: !args.no_images,
+        }
+    }
+}
+
+/// Runs `spec` with a progress bar (hidden when `quiet`).
+pub(crate) fn execute_with_bar(
+    quiet: bool,
+    gpu: &GpuContext,
+    spec: &RunSpec,
+) -> Result<Vec<RunResult>> {
+    let bar = progress_bar(quiet, spec.total_frames());
+    let results = session::execute(gpu, spec, &mut |p| match p {
+        Progress::Technique(name) => bar.set_message(name.to_string()),
+        Progress::Frame => bar.inc(1),
+    });
+    bar.finish_and_clear();
+    results
+}
+
+pub(crate) fn progress_bar(quiet: bool, total: u64) -> indicatif::ProgressBar {
+    let bar = if quiet {
         indicatif::ProgressBar::hidden()
     } else {
         indicatif::ProgressBar::new(total)
@@ -444,54 +483,6 @@ pub(crate) fn announce(plan: &Plan, gpu: &GpuContext) {
     );
 }
 
-/// Runs one technique (timing passes, then quality if asked) and writes its results file and
-/// images as `{stem}.*` in `args.out`.
-pub(crate) fn run_one(
-    args: &RunArgs,
-    plan: &Plan,
-    harness: &Harness,
-    info: &TechniqueInfo,
-    params: &Params,
-    stem: &str,
-    bar: &indicatif::ProgressBar,
-) -> Result<RunResult> {
-    let write_png = gibench_harness::image_io::write_png;
-    let write_exr = gibench_harness::image_io::write_exr;
-    let (mut result, images) = harness.run(info, params, &plan.config, &mut || bar.inc(1))?;
-    let mut extra_images = Vec::new();
-    if let Some(q) = &plan.quality {
-        bar.set_message(format!("{} (quality)", info.name));
-        let (summary, qimages) = harness.measure_quality(
-            info,
-            params,
-            &plan.config,
-            q,
-            &args.reference.cache(),
-            &mut || bar.inc(1),
-        )?;
-        result.quality = Some(summary);
-        if !args.no_images {
-            let reference_png = args.out.join(format!("{stem}-reference.png"));
-            write_png(&reference_png, qimages.size, &qimages.reference_display)?;
-            let flip_png = args.out.join(format!("{stem}-flip.png"));
-            write_png(&flip_png, qimages.size, &qimages.flip_map)?;
-            extra_images = vec![file_name(&reference_png), file_name(&flip_png)];
-        }
-    }
-    if !args.no_images {
-        let png = args.out.join(format!("{stem}.png"));
-        write_png(&png, images.size, &images.display)?;
-        let exr = args.out.join(format!("{stem}-indirect.exr"));
-        write_exr(&exr, images.size, &images.indirect)?;
-        let direct = args.out.join(format!("{stem}-direct.exr"));
-        write_exr(&direct, images.size, &images.direct)?;
-        result.images = vec![file_name(&png), file_name(&exr), file_name(&direct)];
-        result.images.extend(extra_images);
-    }
-    result.write(&args.out.join(format!("{stem}.json")))?;
-    Ok(result)
-}
-
 pub(crate) fn open_gpu(args: &RunArgs) -> Result<GpuContext> {
     GpuContext::new(&GpuOptions {
         backend: args.gpu.backend.clone(),
@@ -502,17 +493,11 @@ pub(crate) fn open_gpu(args: &RunArgs) -> Result<GpuContext> {
 fn run(args: &RunArgs) -> Result<()> {
     // Everything that can be checked without running is checked before anything is written.
     let plan = plan(args, &[])?;
+    let spec = plan.spec(args);
+    spec.validate()?;
     let gpu = open_gpu(args)?;
-    let harness = Harness::new(&gpu, &plan.scene, &plan.config)?;
     announce(&plan, &gpu);
-    let bar = progress_bar(args, &plan, plan.techniques.len() as u64);
-    let mut results = Vec::new();
-    for (info, p) in plan.techniques.iter().zip(&plan.params) {
-        bar.set_message(info.name.to_string());
-        let stem = format!("{}-{}", plan.desc.name, info.name);
-        results.push(run_one(args, &plan, &harness, info, p, &stem, &bar)?);
-    }
-    bar.finish_and_clear();
+    let results = execute_with_bar(args.quiet, &gpu, &spec)?;
     let name = &plan.desc.name;
     let table = report::stage_table(&results);
     println!("{}", table.to_terminal());
@@ -580,19 +565,22 @@ fn sweep(args: &SweepArgs) -> Result<()> {
         .map(|v| plan(&args.run, &[format!("{name}={v}")]))
         .collect::<Result<_>>()?;
     let first = &plans[0];
-    let gpu = open_gpu(&args.run)?;
-    let harness = Harness::new(&gpu, &first.scene, &first.config)?;
-    announce(first, &gpu);
-    let bar = progress_bar(&args.run, first, values.len() as u64);
     let info = first.techniques[0];
-    let mut points = Vec::new();
-    for (v, p) in values.iter().zip(&plans) {
-        bar.set_message(format!("{}={v}", name));
-        let stem = format!("{}-{}-{name}-{v}", first.desc.name, info.name);
-        let r = run_one(&args.run, p, &harness, info, &p.params[0], &stem, &bar)?;
-        points.push((v.clone(), r));
-    }
-    bar.finish_and_clear();
+    let mut spec = first.spec(&args.run);
+    spec.runs = values
+        .iter()
+        .zip(&plans)
+        .map(|(v, p)| TechniqueRun {
+            info,
+            params: p.params[0].clone(),
+            stem: format!("{}-{}-{name}-{v}", first.desc.name, info.name),
+        })
+        .collect();
+    spec.validate()?;
+    let gpu = open_gpu(&args.run)?;
+    announce(first, &gpu);
+    let runs = execute_with_bar(args.run.quiet, &gpu, &spec)?;
+    let points: Vec<(String, RunResult)> = values.iter().cloned().zip(runs).collect();
     let results: Vec<RunResult> = points.iter().map(|(_, r)| r.clone()).collect();
     let mut table = report::stage_table(&results);
     table.title = format!(
@@ -647,10 +635,14 @@ fn list() -> Result<()> {
     println!("\nTechniques:");
     for t in registry::all() {
         println!("  {:<16} {}", t.name, t.description);
-        if t.params.is_empty() {
+        println!(
+            "      compared with the {} reference by default",
+            t.reference.name()
+        );
+        if t.param_specs().next().is_none() {
             println!("      (no parameters)");
         }
-        for p in t.params {
+        for p in t.param_specs() {
             println!("      {:<14} default {:<8} {}", p.name, p.default, p.doc);
         }
     }

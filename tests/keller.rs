@@ -9,7 +9,6 @@ use gibench_harness::gpu::{GpuContext, GpuOptions};
 use gibench_harness::reference::{render_reference, ReferenceSettings};
 use gibench_harness::runner::{Harness, RunConfig, TimingMode};
 use gibench_harness::scene::Scene;
-use gibench_harness::technique::Params;
 
 #[test]
 fn keller_full_matches_the_reference_one_bounce() {
@@ -44,17 +43,15 @@ fn keller_full_matches_the_reference_one_bounce() {
     let info = &gibench_keller::FULL;
     for (tiles, bound) in [("1x1", 0.1), ("4x4", 0.25)] {
         let kv = |k: &str, v: &str| (k.to_string(), v.to_string());
-        let params = Params::parse(
-            info.name,
-            info.params,
-            &[
+        let params = info
+            .parse_params(&[
                 kv("vpls", "256"),
                 kv("tiles", tiles),
-                kv("shadow-size", "256"),
-            ],
-        )
-        .unwrap();
-        let (mut t, compose) = h.build(info, &params, &config).unwrap();
+                kv("vpl-map-size", "256"),
+            ])
+            .unwrap();
+        let prepared = h.prepare(info, &params, &config).unwrap();
+        let (mut t, compose) = h.build(info, &params, &config, &prepared).unwrap();
         let mut profiler = gibench_harness::profiler::Profiler::new(
             &gpu,
             gibench_harness::profiler::ProfileMode::Stages,

@@ -2,7 +2,8 @@
 //!
 //! Everything the techniques share, written once: the GPU context ([`gpu`]), the scene model and
 //! its loaders ([`scene`]), the deterministic animation clock ([`anim`]), CPU ray casting over the
-//! static geometry ([`bvh`]), the shared GPU passes ([`passes`]), the profiler ([`profiler`]), the
+//! static geometry ([`bvh`]), the one light model ([`light`]), the shared GPU passes
+//! ([`passes`]), the instant-radiosity kit ([`ir`]), the profiler ([`profiler`]), the
 //! technique interface ([`technique`]), the frame loop ([`runner`]), results ([`results`]) and
 //! their tables and plots ([`report`]).
 //!
@@ -29,9 +30,10 @@ pub mod anim;
 pub mod assets;
 pub mod bvh;
 pub mod error;
-pub mod gather;
 pub mod gpu;
 pub mod image_io;
+pub mod ir;
+pub mod light;
 pub mod metrics;
 pub mod passes;
 pub mod profiler;
@@ -41,6 +43,7 @@ pub mod report;
 pub mod results;
 pub mod runner;
 pub mod scene;
+pub mod session;
 pub mod stats;
 pub mod technique;
 pub mod vpl;

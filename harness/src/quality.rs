@@ -62,14 +62,31 @@ pub struct QualityConfig {
     /// Compare every measured frame instead (for per-frame error and lag plots).
     pub all: bool,
     pub reference: ReferenceSettings,
-    pub component: IndirectComponent,
+    /// The component to compare with; `None`: each technique's own
+    /// ([`crate::technique::TechniqueInfo::reference`]).
+    pub component: Option<IndirectComponent>,
 }
 
 impl QualityConfig {
+    /// This configuration with the component resolved for `info` (its declared one unless
+    /// overridden).
+    pub fn for_technique(&self, info: &crate::technique::TechniqueInfo) -> QualityConfig {
+        QualityConfig {
+            component: Some(self.component.unwrap_or(info.reference)),
+            ..self.clone()
+        }
+    }
+
+    /// The component compared with (one-bounce when neither the configuration nor a technique
+    /// chose one).
+    pub fn component(&self) -> IndirectComponent {
+        self.component.unwrap_or(IndirectComponent::OneBounce)
+    }
+
     /// The reference settings actually rendered: one bounce suffices for the one-bounce component.
     pub fn reference_settings(&self) -> ReferenceSettings {
         let mut s = self.reference;
-        if self.component == IndirectComponent::OneBounce {
+        if self.component() == IndirectComponent::OneBounce {
             s.bounces = 1;
         }
         s
@@ -80,7 +97,7 @@ impl QualityConfig {
         let s = self.reference_settings();
         format!(
             "{}, {} spp, {} bounces, seed {}",
-            self.component.name(),
+            self.component().name(),
             s.spp,
             s.bounces,
             s.seed
@@ -279,7 +296,7 @@ pub fn compare(
     let mut frames = Vec::new();
     let mut images = None;
     for (i, (c, r)) in captured.iter().zip(references).enumerate() {
-        let component = config.component.of(r);
+        let component = config.component().of(r);
         let ref_radiance = r.radiance_with(component);
         let size = r.size;
         let test8 = metrics::tonemap_srgb8(&c.radiance, exposure);
@@ -291,7 +308,7 @@ pub fn compare(
             Some(metrics::temporal_instability(
                 &pc.indirect,
                 &c.indirect,
-                config.component.of(pr),
+                config.component().of(pr),
                 component,
                 &mask,
             ))

@@ -36,6 +36,9 @@
 //!   of ±Y. E = ∫ L cos θ_l cos θ_r / r² V dA, estimated with `spp` stratified points at the
 //!   primary hit and **one** uniform point per secondary vertex (the paths average those).
 //!   A rectangle with no area is treated as a spot light (its far field).
+//! * sun: parallel light against its direction with irradiance E⊥ (`power`) on a surface facing
+//!   it: E = E⊥ cos θ_r × V, V from one shadow ray to infinity.
+//! * Every kind's geometry and intensity come from the one light model, [`crate::light`].
 //! * The light itself is not geometry: rays pass through it and never see it; all light enters
 //!   paths through next-event estimation (the shadow rays above).
 //!
@@ -319,8 +322,8 @@ fn srgb_to_linear(c: f32) -> f32 {
 
 /// How the primary light is sampled.
 enum LightShape {
-    /// A point with radiant intensity `i0 · max(0, cos θ)` (spot) or `i0` (omni).
-    Point { i0: Vec3, spot: bool },
+    /// A point with radiant intensity [`LightPose::intensity_toward`].
+    Point,
     /// A rectangle: centre `position`, half-extent vectors, normal, radiance × area (Φ/π).
     Rect {
         half_u: Vec3,
@@ -328,6 +331,8 @@ enum LightShape {
         normal: Vec3,
         radiance_area: Vec3,
     },
+    /// Parallel rays against `direction` carrying irradiance E⊥.
+    Sun,
 }
 
 /// Everything needed to trace one frame: the BVH over the frame's geometry, the light, the
@@ -353,34 +358,16 @@ impl<'a> ReferenceTracer<'a> {
             1e-6
         };
         let light = frame.light;
-        let pi = std::f32::consts::PI;
-        let spot = LightShape::Point {
-            i0: light.power / pi,
-            spot: true,
-        };
-        let shape = match light.kind {
-            LightKind::Omni => LightShape::Point {
-                i0: light.power / (4.0 * pi),
-                spot: false,
+        let shape = match (light.kind, light.area_half_extents()) {
+            (LightKind::Sun, _) => LightShape::Sun,
+            (LightKind::Area, Some((half_u, half_v))) => LightShape::Rect {
+                half_u,
+                half_v,
+                normal: light.axis(),
+                radiance_area: light.power / std::f32::consts::PI,
             },
-            LightKind::Spot => spot,
-            LightKind::Area => {
-                let [w, h] = light.size;
-                if w > 0.0 && h > 0.0 && w.is_finite() && h.is_finite() {
-                    let n = light.direction.normalize_or(Vec3::NEG_Y);
-                    let up = if n.y.abs() > 0.999 { Vec3::Z } else { Vec3::Y };
-                    let u = up.cross(n).normalize();
-                    let v = n.cross(u);
-                    LightShape::Rect {
-                        half_u: 0.5 * w * u,
-                        half_v: 0.5 * h * v,
-                        normal: n,
-                        radiance_area: light.power / pi,
-                    }
-                } else {
-                    spot
-                }
-            }
+            // Spot, omni, and an area light with no area (its far field: a cosine spot).
+            _ => LightShape::Point,
         };
         let mut srgb = [0.0; 256];
         for (i, s) in srgb.iter_mut().enumerate() {
@@ -492,15 +479,22 @@ impl<'a> ReferenceTracer<'a> {
     fn direct(&self, p: Vec3, ng: Vec3, ns: Vec3, samples: u32, rng: &mut Rng) -> Vec3 {
         let origin = p + ng * self.eps;
         match &self.shape {
-            LightShape::Point { i0, spot } => {
-                let axis = self.light.direction;
-                self.point_irradiance(p, origin, ng, ns, self.light.position, |l| {
-                    if *spot {
-                        *i0 * (-l).dot(axis).max(0.0)
-                    } else {
-                        *i0
-                    }
+            LightShape::Point => {
+                let light = &self.light;
+                self.point_irradiance(p, origin, ng, ns, light.position, |l| {
+                    light.intensity_toward(-l)
                 })
+            }
+            LightShape::Sun => {
+                let l = -self.light.axis();
+                let cos_r = ns.dot(l);
+                if cos_r <= 0.0 || ng.dot(l) <= 0.0 {
+                    return Vec3::ZERO;
+                }
+                if self.bvh.any_hit(origin, l, 0.0, f32::INFINITY) {
+                    return Vec3::ZERO;
+                }
+                self.light.power * cos_r
             }
             LightShape::Rect {
                 half_u,

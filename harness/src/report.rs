@@ -1104,6 +1104,7 @@ mod tests {
                 frames_in_flight: 2,
             }),
             counters: BTreeMap::from([("shadow maps".to_string(), stats(1.0))]),
+            prepare_ms: None,
             quality: None,
             images: vec!["frame.png".into()],
         }

@@ -97,6 +97,10 @@ pub struct RunResult {
     /// Per-stage counters averaged over measured frames (e.g. shadow maps rendered).
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub counters: BTreeMap<String, Stats>,
+    /// Wall time of the technique's once-per-scene preparation (`TechniqueInfo::prepare`),
+    /// milliseconds; shared by the timing passes and the quality pass.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub prepare_ms: Option<f64>,
     /// Error against the CPU reference (`gibench run --quality`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub quality: Option<crate::metrics::QualitySummary>,

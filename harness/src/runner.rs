@@ -19,8 +19,26 @@ use crate::profiler::{ProfileMode, Profiler};
 use crate::quality::{CapturedFrame, QualityConfig, QualityImages, ReferenceCache};
 use crate::results::{FrameRange, RunResult, SCHEMA_VERSION};
 use crate::scene::Scene;
-use crate::technique::{FrameContext, Params, PrepareContext, Technique, TechniqueInfo};
+use crate::technique::{
+    FrameContext, Params, PrepareContext, Prepared, SceneContext, Technique, TechniqueInfo,
+};
 use crate::{Error, Result};
+
+/// Stage: the camera's G-buffer.
+pub const STAGE_GBUFFER: &str = "gbuffer";
+/// Stage: the primary light's shadow map.
+pub const STAGE_DIRECT_SHADOW_MAP: &str = "direct-shadow-map";
+/// Stage: direct irradiance with PCF.
+pub const STAGE_DIRECT_LIGHT: &str = "direct-light";
+/// Stage: composing radiance and its display image.
+pub const STAGE_COMPOSE: &str = "compose";
+
+/// A technique's once-per-scene preparation and how long it took.
+pub struct PreparedTechnique {
+    pub prepared: Prepared,
+    /// Wall time of `prepare`, milliseconds.
+    pub ms: f64,
+}
 
 /// Which timings a run takes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -192,17 +210,47 @@ impl<'a> Harness<'a> {
         })
     }
 
-    fn prepare_context(&self, config: &RunConfig) -> PrepareContext<'_> {
-        PrepareContext {
+    /// The fields every technique call sees.
+    pub fn scene_context(&self) -> SceneContext<'_> {
+        SceneContext {
             gpu: self.gpu,
             scene: self.scene,
             bvh: &self.bvh,
             gpu_scene: &self.gpu_scene,
             gbuffer: &self.gbuffer,
             uniforms: &self.uniforms,
+            direct: &self.direct,
+        }
+    }
+
+    fn prepare_context(&self, config: &RunConfig) -> PrepareContext<'_> {
+        PrepareContext {
+            base: self.scene_context(),
             resolution: config.resolution,
             seed: config.seed,
         }
+    }
+
+    /// Runs `info`'s once-per-scene preparation (after checking the adapter meets its needs) and
+    /// times it; pass the result to every [`Harness::build`], [`Harness::run`] and
+    /// [`Harness::measure_quality`] of the same technique, parameters and scene.
+    pub fn prepare(
+        &self,
+        info: &TechniqueInfo,
+        params: &Params,
+        config: &RunConfig,
+    ) -> Result<PreparedTechnique> {
+        self.gpu.check_requirements(
+            &format!("technique '{}'", info.name),
+            info.required_features,
+            &(info.required_limits)(),
+        )?;
+        let start = std::time::Instant::now();
+        let prepared = (info.prepare)(params, &self.prepare_context(config))?;
+        Ok(PreparedTechnique {
+            prepared,
+            ms: start.elapsed().as_secs_f64() * 1e3,
+        })
     }
 
     /// Records one frame: shared passes, the technique's stages, compose.
@@ -217,44 +265,35 @@ impl<'a> Harness<'a> {
         let gpu = self.gpu;
         profiler.begin_frame(measured);
         self.uniforms.write(&gpu.queue, frame);
-        profiler.gpu_stage(gpu, "gbuffer", |enc| {
+        profiler.gpu_stage(gpu, STAGE_GBUFFER, |enc| {
             self.gbuffer.encode(enc, &self.gpu_scene, &self.uniforms)
         })?;
-        let faces = profiler.gpu_stage(gpu, "direct-shadow-map", |enc| {
+        let faces = profiler.gpu_stage(gpu, STAGE_DIRECT_SHADOW_MAP, |enc| {
             self.direct
                 .encode_shadow_map(enc, &self.gpu_scene, &self.uniforms, &frame.light)
         })?;
         profiler.count("direct-shadow-faces", faces as f64);
-        profiler.gpu_stage(gpu, "direct-light", |enc| {
+        profiler.gpu_stage(gpu, STAGE_DIRECT_LIGHT, |enc| {
             self.direct.encode_lighting(enc, &self.gbuffer)
         })?;
         technique.render(&mut FrameContext {
-            gpu,
-            scene: self.scene,
-            bvh: &self.bvh,
-            gpu_scene: &self.gpu_scene,
-            gbuffer: &self.gbuffer,
-            uniforms: &self.uniforms,
+            base: self.scene_context(),
             frame,
             profiler,
         })?;
-        profiler.gpu_stage(gpu, "compose", |enc| compose.encode(enc, &self.gbuffer))?;
+        profiler.gpu_stage(gpu, STAGE_COMPOSE, |enc| compose.encode(enc, &self.gbuffer))?;
         profiler.end_frame(gpu)
     }
 
-    /// Builds a fresh technique and the compose pass bound to its output.
+    /// Builds a fresh technique from its preparation and the compose pass bound to its output.
     pub fn build(
         &self,
         info: &TechniqueInfo,
         params: &Params,
         config: &RunConfig,
+        prepared: &PreparedTechnique,
     ) -> Result<(Box<dyn Technique>, Compose)> {
-        self.gpu.check_requirements(
-            &format!("technique '{}'", info.name),
-            info.required_features,
-            &(info.required_limits)(),
-        )?;
-        let technique = (info.create)(params, &self.prepare_context(config))?;
+        let technique = (info.create)(params, &self.prepare_context(config), &prepared.prepared)?;
         let compose = Compose::new(
             self.gpu,
             &self.gbuffer,
@@ -273,6 +312,7 @@ impl<'a> Harness<'a> {
         info: &TechniqueInfo,
         params: &Params,
         config: &RunConfig,
+        prepared: &PreparedTechnique,
         progress: &mut dyn FnMut(),
     ) -> Result<(RunResult, FrameImages)> {
         let mut stages = Vec::new();
@@ -280,7 +320,7 @@ impl<'a> Harness<'a> {
         let mut frame_result = None;
         let mut images = None;
         for &mode in config.timing.passes() {
-            let (mut technique, compose) = self.build(info, params, config)?;
+            let (mut technique, compose) = self.build(info, params, config, prepared)?;
             let mut profiler = Profiler::new(self.gpu, mode);
             let total = config.warmup + config.frames;
             for i in 0..total {
@@ -340,6 +380,7 @@ impl<'a> Harness<'a> {
             stages,
             frame: frame_result,
             counters,
+            prepare_ms: Some(prepared.ms),
             quality: None,
             images: Vec::new(),
         };
@@ -347,17 +388,21 @@ impl<'a> Harness<'a> {
     }
 
     /// Runs the technique once more over the frames, untimed, capturing its images at the
-    /// frames `quality` chooses, and compares them with the (cached) reference.
+    /// frames `quality` chooses, and compares them with the (cached) reference's component
+    /// that `quality` names, or else the one the technique declares.
+    #[allow(clippy::too_many_arguments)]
     pub fn measure_quality(
         &self,
         info: &TechniqueInfo,
         params: &Params,
         config: &RunConfig,
+        prepared: &PreparedTechnique,
         quality: &QualityConfig,
         cache: &ReferenceCache,
         progress: &mut dyn FnMut(),
     ) -> Result<(QualitySummary, QualityImages)> {
-        let (mut technique, compose) = self.build(info, params, config)?;
+        let quality = &quality.for_technique(info);
+        let (mut technique, compose) = self.build(info, params, config, prepared)?;
         let mut profiler = Profiler::new(self.gpu, ProfileMode::Frame);
         let targets = quality.capture_frames(config.first_frame + config.warmup, config.frames);
         let last = targets.last().map(|t| t.0).unwrap_or(config.first_frame);

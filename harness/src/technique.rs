@@ -1,7 +1,9 @@
 //! The technique interface: plain structs built from named, typed parameters (in the spirit of
-//! Mitsuba's plugin properties: a parameter nobody declared is an error that names it), that
-//! declare the GPU features and limits they need, prepare once per scene, and then each frame
-//! record named stages and return the indirect irradiance texture.
+//! Mitsuba's plugin properties: a parameter nobody declared is an error that names it; each
+//! technique reads them once into its own typed settings struct), that declare the GPU
+//! features and limits they need, the reference component they approximate and their
+//! conformance bounds, prepare once per scene, and then each frame record named stages and
+//! return the indirect irradiance texture.
 
 use std::collections::BTreeMap;
 
@@ -10,8 +12,9 @@ use serde_json::Value;
 use crate::anim::FrameState;
 use crate::bvh::SceneBvh;
 use crate::gpu::GpuContext;
-use crate::passes::{FrameUniforms, GBuffer, GpuScene};
+use crate::passes::{DirectLight, FrameUniforms, GBuffer, GpuScene};
 use crate::profiler::Profiler;
+use crate::quality::IndirectComponent;
 use crate::scene::Scene;
 use crate::{Error, Result};
 
@@ -136,6 +139,11 @@ impl Params {
         self.values.clone()
     }
 
+    /// Whether `name` was declared.
+    pub fn has(&self, name: &str) -> bool {
+        self.values.contains_key(name)
+    }
+
     fn get(&self, name: &str) -> &Value {
         self.values
             .get(name)
@@ -163,30 +171,51 @@ impl Params {
     }
 }
 
-/// What a technique gets once per scene.
-pub struct PrepareContext<'a> {
+/// What every technique call sees of the scene and the shared passes (the fields
+/// [`PrepareContext`] and [`FrameContext`] share; both deref to it).
+#[derive(Clone, Copy)]
+pub struct SceneContext<'a> {
     pub gpu: &'a GpuContext,
+    /// The scene, with its per-scene constants in [`Scene::extent`].
     pub scene: &'a Scene,
+    /// CPU ray casts over the static mesh.
     pub bvh: &'a SceneBvh,
     pub gpu_scene: &'a GpuScene,
     pub gbuffer: &'a GBuffer,
     pub uniforms: &'a FrameUniforms,
+    /// The primary light's shadow map and direct irradiance ([`DirectLight::wgsl`] and
+    /// [`DirectLight::light_group`] give technique shaders the same lookup).
+    pub direct: &'a DirectLight,
+}
+
+/// What a technique gets once per scene and when it is built.
+pub struct PrepareContext<'a> {
+    pub base: SceneContext<'a>,
     pub resolution: [u32; 2],
     pub seed: u64,
 }
 
+impl<'a> std::ops::Deref for PrepareContext<'a> {
+    type Target = SceneContext<'a>;
+    fn deref(&self) -> &SceneContext<'a> {
+        &self.base
+    }
+}
+
 /// What a technique gets every frame.
 pub struct FrameContext<'a> {
-    pub gpu: &'a GpuContext,
-    pub scene: &'a Scene,
-    pub bvh: &'a SceneBvh,
-    pub gpu_scene: &'a GpuScene,
-    pub gbuffer: &'a GBuffer,
-    pub uniforms: &'a FrameUniforms,
+    pub base: SceneContext<'a>,
     pub frame: &'a FrameState,
     /// Record stages through this: `profiler.gpu_stage(gpu, "name", |encoder| ...)` and
     /// `profiler.cpu_stage("name", || ...)`.
     pub profiler: &'a mut Profiler,
+}
+
+impl<'a> std::ops::Deref for FrameContext<'a> {
+    type Target = SceneContext<'a>;
+    fn deref(&self) -> &SceneContext<'a> {
+        &self.base
+    }
 }
 
 /// A real-time indirect-illumination technique.
@@ -198,17 +227,47 @@ pub trait Technique {
     fn output(&self) -> &wgpu::TextureView;
 }
 
+/// What a technique prepares once per scene (PRT transfer, point sets, voxel tables, …): made
+/// by [`TechniqueInfo::prepare`], shared by both timing passes and the quality pass, and timed
+/// as its own figure (`prepare_ms` in the results).
+pub type Prepared = Box<dyn std::any::Any + Send + Sync>;
+
+/// The `prepare` of a technique that prepares nothing.
+pub fn prepare_nothing(_: &Params, _: &PrepareContext) -> Result<Prepared> {
+    Ok(Box::new(()))
+}
+
+/// What the conformance test (`tests/conformance.rs`) demands of a technique on the Cornell box,
+/// beyond finite output, zero where no geometry is hit and identical output from two builds:
+/// its indirect irradiance against its [`TechniqueInfo::reference`] component.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Conformance {
+    /// Largest relative MSE (over pixels that hit geometry).
+    pub max_rel_mse: f64,
+    /// Range of the mean indirect irradiance relative to the reference's.
+    pub mean_ratio: (f64, f64),
+}
+
 /// A registry entry: how to list and build a technique.
 pub struct TechniqueInfo {
     pub name: &'static str,
     pub description: &'static str,
-    pub params: &'static [ParamSpec],
+    /// Declared parameters, composed from shared sets (e.g. the kit's gather parameters) and
+    /// the technique's own; names are unique across the groups.
+    pub params: &'static [&'static [ParamSpec]],
     /// GPU features the technique cannot run without.
     pub required_features: wgpu::Features,
     /// Limits the technique needs (checked before it is built).
     pub required_limits: fn() -> wgpu::Limits,
-    /// Builds the technique for one scene.
-    pub create: fn(&Params, &PrepareContext) -> Result<Box<dyn Technique>>,
+    /// The reference component its indirect irradiance approximates (`--quality` compares
+    /// with it unless `--quality-reference` overrides).
+    pub reference: IndirectComponent,
+    /// Its conformance bounds.
+    pub conformance: Conformance,
+    /// Per-scene preparation, once per scene and parameter set ([`prepare_nothing`] if none).
+    pub prepare: fn(&Params, &PrepareContext) -> Result<Prepared>,
+    /// Builds the technique for one scene from what `prepare` made.
+    pub create: fn(&Params, &PrepareContext, &Prepared) -> Result<Box<dyn Technique>>,
 }
 
 impl TechniqueInfo {
@@ -221,6 +280,22 @@ impl TechniqueInfo {
                 known.join(", ")
             ))
         })
+    }
+
+    /// Every declared parameter, in declaration order.
+    pub fn param_specs(&self) -> impl Iterator<Item = &'static ParamSpec> + '_ {
+        self.params.iter().flat_map(|g| g.iter())
+    }
+
+    /// Parses `key=value` pairs against this technique's parameters (see [`Params::parse`]).
+    pub fn parse_params(&self, given: &[(String, String)]) -> Result<Params> {
+        let specs: Vec<ParamSpec> = self.param_specs().copied().collect();
+        Params::parse(self.name, &specs, given)
+    }
+
+    /// Whether it declares a parameter `name`.
+    pub fn has_param(&self, name: &str) -> bool {
+        self.param_specs().any(|p| p.name == name)
     }
 }
 

@@ -15,22 +15,17 @@
 //! point with index `h = first_path + i` ([`halton`]), so incremental techniques continue the
 //! sequence by advancing `first_path`:
 //!
-//! * **First direction** (Halton dims 0, 1):
-//!   * spot (180° cone, I(θ) = Φ/π cos θ): a point on the unit disc ([`square_to_disc`]) lifted
-//!     to the hemisphere around the spot direction ([`disc_to_hemisphere`]); by the Nusselt
-//!     analog this is the cosine distribution the spot emits (Laine et al. 2007, §4.1 and
-//!     Figure 3a/b). [`Vpl::sample`] keeps the disc point as `(x, y, 0)`, in the spot's frame
-//!     [`frame_from_normal`]`(direction)`;
-//!   * omni (I = Φ/4π): a uniform direction on the unit sphere ([`square_to_sphere`], Laine's
-//!     Figure 3c); [`Vpl::sample`] is that world-space direction;
-//!   * area (one-sided Lambertian rectangle, the same rectangle and tangent frame as
-//!     [`crate::reference`]): a uniform point on the rectangle from Halton dims 2, 3 and a
-//!     cosine direction about its normal from dims 0, 1; [`Vpl::sample`] is the world-space
-//!     direction. A rectangle with no area is treated as a spot light (its far field), as in
-//!     the reference.
+//! * **First ray**: [`LightPose::emit`] (the one light model, [`crate::light`]) for Halton
+//!   index `h`: spot lights lift a disc point to the hemisphere (Nusselt analog, Laine et al.
+//!   2007 §4.1, Figure 3a/b); omni lights take a uniform direction (Figure 3c); area lights a
+//!   uniform point on the rectangle and a cosine direction about its normal; the sun a uniform
+//!   point on the disc covering the scene's bounding sphere, along its direction.
+//!   [`Vpl::sample`] is the ray's point in the light's sampling domain (the unit disc, or the
+//!   unit sphere for omni lights).
 //!
-//!   Every path carries `Φ / normalisation_paths` from the light. A path whose first ray
-//!   leaves the scene gives no VPL and its energy is *not* redistributed (it left the scene).
+//!   Every path carries [`LightPose::emitted_flux`]` / normalisation_paths` from the light (Φ,
+//!   or the sun's E⊥ · πR²). A path whose first ray leaves the scene gives no VPL and its
+//!   energy is *not* redistributed (it left the scene).
 //! * **First hit** y₁: a VPL with flux `Φ / normalisation_paths · ρ(y₁)`, where ρ is the hit
 //!   material's [`Material::average_color`](crate::scene::Material::average_color).
 //! * **Further bounces** (Keller's fractional absorption, with the scene's average reflectance
@@ -43,8 +38,9 @@
 //!   is Φ ρ^j in a closed scene of uniform albedo. A continuation ray that misses the scene or
 //!   points below the geometric surface (possible with interpolated normals) ends the path.
 //!
-//! Rays start `ε` = 10⁻⁴ × the static mesh's bounding-box diagonal ([`ray_epsilon`], the same
-//! ε as the reference) off their origin: light rays ignore hits closer than ε to the light,
+//! Rays start `ε` = 10⁻⁴ × the static mesh's bounding-box diagonal
+//! ([`SceneExtent::ray_epsilon`](crate::scene::SceneExtent), computed once at load; the same
+//! rule as the reference's) off their origin: light rays ignore hits closer than ε to the light,
 //! continuation rays start ε off the surface along the geometric normal.
 //!
 //! Everything is deterministic (no random numbers) and never panics: an empty mesh, zero paths
@@ -59,7 +55,6 @@ use glam::{Vec2, Vec3};
 
 use crate::anim::LightPose;
 use crate::bvh::{Hit, SceneBvh};
-use crate::scene::descriptor::LightKind;
 use crate::scene::Scene;
 
 /// The first 64 primes: the Halton bases of dims 0..64. Higher dims compute their prime.
@@ -224,11 +219,10 @@ pub struct Vpl {
     pub bounce: u32,
     /// The light path's Halton index (`first_path + i`).
     pub path: u64,
-    /// The path's first-direction sampling point in its 2D domain (Laine et al. 2007,
-    /// Figure 3): spot lights `(x, y, 0)` on the unit disc in the spot's frame
-    /// ([`frame_from_normal`]`(direction)`, z along the spot direction); omni and area lights
-    /// the unit direction of the first ray in world space. Convert with
-    /// [`sample_to_direction`] / [`direction_to_sample`].
+    /// The path's first ray as a point of the light's sampling domain (Laine et al. 2007,
+    /// Figure 3; see [`crate::light`]): `(x, y, 0)` on the unit disc for spot, area and sun
+    /// lights, the unit direction for omni lights. Convert with
+    /// [`LightPose::ray_of_sample`] / [`LightPose::sample_of_point`].
     pub sample: Vec3,
 }
 
@@ -276,18 +270,6 @@ impl Default for VplSettings {
     }
 }
 
-/// The ray offset ε: 10⁻⁴ × the bounding-box diagonal of the static mesh (the reference
-/// renderer's ε), or 10⁻⁶ for an empty or degenerate mesh.
-pub fn ray_epsilon(scene: &Scene) -> f32 {
-    let (lo, hi) = scene.mesh.bounds();
-    let diagonal = (hi - lo).length();
-    if diagonal.is_finite() && diagonal > 0.0 {
-        1e-4 * diagonal
-    } else {
-        1e-6
-    }
-}
-
 /// Keller's ρ̄ for `scene`: the mean of the RGB channels of [`Scene::average_reflectance`].
 pub fn mean_reflectance(scene: &Scene) -> f32 {
     let r = scene.average_reflectance();
@@ -315,95 +297,12 @@ pub fn continuing_paths(average_reflectance: f32, paths: u32, vertex: u32) -> u3
     (n.max(0.0) as u32).min(paths)
 }
 
-/// The light's unit axis (spot direction, area normal), −Y if unusable.
-fn light_axis(light: &LightPose) -> Vec3 {
-    light.direction.normalize_or(Vec3::NEG_Y)
-}
-
-/// An area light's half-extent vectors (width, height), in the reference's tangent frame, or
-/// `None` when it is a point light or has no area.
-fn area_half_extents(light: &LightPose) -> Option<(Vec3, Vec3)> {
-    if light.kind != LightKind::Area {
-        return None;
-    }
-    let [w, h] = light.size;
-    if !(w > 0.0 && h > 0.0 && w.is_finite() && h.is_finite()) {
-        return None;
-    }
-    let n = light_axis(light);
-    let up = if n.y.abs() > 0.999 { Vec3::Z } else { Vec3::Y };
-    let u = up.cross(n).normalize();
-    let v = n.cross(u);
-    Some((0.5 * w * u, 0.5 * h * v))
-}
-
-/// Whether the light samples directions on the unit disc (spot lights and area lights with no
-/// area) rather than on the unit sphere / world directions.
-fn samples_disc(light: &LightPose) -> bool {
-    match light.kind {
-        LightKind::Spot => true,
-        LightKind::Omni => false,
-        LightKind::Area => area_half_extents(light).is_none(),
-    }
-}
-
-/// The unit world-space direction of a [`Vpl::sample`] point for `light`: spot lights lift the
-/// disc point to the hemisphere around the spot direction; omni and area lights normalise it.
-pub fn sample_to_direction(light: &LightPose, sample: Vec3) -> Vec3 {
-    if samples_disc(light) {
-        let axis = light_axis(light);
-        to_world(disc_to_hemisphere(sample.truncate()), axis).normalize_or(axis)
-    } else {
-        sample.normalize_or(light_axis(light))
-    }
-}
-
-/// The [`Vpl::sample`] point of world direction `dir` for `light` (Laine's Figure 3): spot
-/// lights `(x, y, 0)` of the normalised direction in the spot's frame (directions behind the
-/// spot land on the disc too, mirrored); omni and area lights the normalised direction.
-pub fn direction_to_sample(light: &LightPose, dir: Vec3) -> Vec3 {
-    let d = dir.normalize_or(light_axis(light));
-    if samples_disc(light) {
-        hemisphere_to_disc(to_local(d, light_axis(light))).extend(0.0)
-    } else {
-        d
-    }
-}
-
-/// Path `h`'s first ray from the light: (origin, unit direction, sample point).
-fn light_ray(light: &LightPose, h: u64) -> (Vec3, Vec3, Vec3) {
-    let (u0, u1) = (halton(h, 0), halton(h, 1));
-    let axis = light_axis(light);
-    match (light.kind, area_half_extents(light)) {
-        (LightKind::Omni, _) => {
-            let d = square_to_sphere(u0, u1);
-            (light.position, d, d)
-        }
-        (LightKind::Area, Some((half_u, half_v))) => {
-            let (u2, u3) = (halton(h, 2) as f32, halton(h, 3) as f32);
-            let origin = light.position + (2.0 * u2 - 1.0) * half_u + (2.0 * u3 - 1.0) * half_v;
-            let d = cosine_direction(axis, u0, u1);
-            (origin, d, d)
-        }
-        _ => {
-            let p = square_to_disc(u0, u1);
-            let d = to_world(disc_to_hemisphere(p), axis).normalize_or(axis);
-            (light.position, d, p.extend(0.0))
-        }
-    }
-}
-
 /// The albedo ρ a VPL uses for `material` (black when unknown).
 fn albedo(scene: &Scene, material: u32) -> Vec3 {
     scene
         .materials
         .get(material as usize)
         .map_or(Vec3::ZERO, |m| m.average_color)
-}
-
-/// The light's power with non-finite channels replaced by 0.
-fn sanitized_power(light: &LightPose) -> Vec3 {
-    Vec3::select(light.power.is_finite_mask(), light.power, Vec3::ZERO)
 }
 
 fn make_vpl(scene: &Scene, hit: &Hit, incoming: Vec3, bounce: u32, path: u64, sample: Vec3) -> Vpl {
@@ -419,10 +318,11 @@ fn make_vpl(scene: &Scene, hit: &Hit, incoming: Vec3, bounce: u32, path: u64, sa
     }
 }
 
-/// A single first-bounce VPL from the light through the sampling point `sample` (the
-/// [`Vpl::sample`] domain of `light`), carrying `path_flux` · ρ; `None` if the ray leaves the
-/// scene. For area lights the ray starts at the rectangle's centre. Laine's incremental method
-/// uses this to place a VPL at a chosen sampling point; `path` is only recorded.
+/// A single first-bounce VPL from the light through the sampling point `sample` of the light's
+/// [`SampleDomain`](crate::light::SampleDomain) ([`LightPose::ray_of_sample`]), carrying
+/// `path_flux` · ρ; `None` if the ray leaves the scene. For area lights the ray starts at the
+/// rectangle's centre. Laine's incremental method uses this to place a VPL at a chosen
+/// sampling point; `path` is only recorded.
 pub fn vpl_from_sample(
     scene: &Scene,
     bvh: &SceneBvh,
@@ -431,16 +331,15 @@ pub fn vpl_from_sample(
     path_flux: Vec3,
     path: u64,
 ) -> Option<Vpl> {
-    let dir = sample_to_direction(light, sample);
-    let hit = bvh.closest_hit(light.position, dir, ray_epsilon(scene), f32::INFINITY)?;
+    let (origin, dir) = light.ray_of_sample(sample, &scene.extent);
+    let hit = bvh.closest_hit(origin, dir, scene.extent.ray_epsilon, f32::INFINITY)?;
     Some(make_vpl(scene, &hit, path_flux, 1, path, sample))
 }
 
 /// Traces `settings.paths` light paths from `light` through the static geometry in `bvh` and
 /// returns their VPLs, path by path (each path's VPLs in bounce order). See the module docs
 /// for the sampling, the flux of each VPL and the fractional absorption. Costs one pass over
-/// the mesh's vertices (ε) and, without `settings.average_reflectance`, one over its
-/// triangles (ρ̄).
+/// the mesh's triangles (ρ̄) unless `settings.average_reflectance` is given.
 pub fn generate(
     scene: &Scene,
     bvh: &SceneBvh,
@@ -456,8 +355,8 @@ pub fn generate(
     } else {
         settings.normalisation_paths
     };
-    let path_flux = sanitized_power(light) / normalisation as f32;
-    let eps = ray_epsilon(scene);
+    let path_flux = light.emitted_flux(&scene.extent) / normalisation as f32;
+    let eps = scene.extent.ray_epsilon;
     // Keller's ρ̄ as the continuation probability (only needed for more than one bounce).
     let q = if settings.bounces > 1 {
         continuation_probability(
@@ -471,7 +370,8 @@ pub fn generate(
     let mut vpls = Vec::with_capacity(paths as usize);
     for i in 0..paths {
         let h = settings.first_path.wrapping_add(i as u64);
-        let (origin, dir, sample) = light_ray(light, h);
+        let ray = light.emit(h, &scene.extent);
+        let (origin, dir, sample) = (ray.origin, ray.direction, ray.sample);
         let Some(mut hit) = bvh.closest_hit(origin, dir, eps, f32::INFINITY) else {
             continue;
         };
@@ -561,21 +461,5 @@ mod tests {
         assert_eq!(continuing_paths(0.0, 100, 2), 0);
         assert_eq!(continuing_paths(f32::NAN, 100, 2), 0);
         assert_eq!(continuing_paths(0.9, 100, u32::MAX), 0);
-    }
-
-    #[test]
-    fn sample_direction_round_trip() {
-        let light = LightPose {
-            kind: LightKind::Spot,
-            position: Vec3::ZERO,
-            direction: Vec3::new(0.2, -1.0, 0.1).normalize(),
-            power: Vec3::ONE,
-            size: [0.0, 0.0],
-        };
-        for h in 1..50 {
-            let (_, d, s) = light_ray(&light, h);
-            assert!((sample_to_direction(&light, s) - d).length() < 1e-5);
-            assert!((direction_to_sample(&light, d) - s).length() < 1e-5);
-        }
     }
 }

@@ -4,7 +4,7 @@
 
 use gibench_harness::assets::AssetPaths;
 use gibench_harness::gpu::{GpuContext, GpuOptions};
-use gibench_harness::passes::light_axis_intensity;
+
 use gibench_harness::runner::{Harness, RunConfig, TimingMode};
 use gibench_harness::scene::descriptor::LightKind;
 use gibench_harness::scene::Scene;
@@ -39,7 +39,7 @@ fn direct_irradiance(backend: &str, frame_index: u32) -> Vec<Option<(f32, f32)>>
     let g = h.gbuffer.export(&gpu).unwrap();
     let light = frame.light;
     assert_eq!(light.kind, LightKind::Spot);
-    let i0 = light_axis_intensity(&light).x;
+    let i0 = light.axis_intensity().x;
     (0..g.positions.len())
         .map(|i| {
             let p = g.positions[i]?;
@@ -66,8 +66,18 @@ fn direct_irradiance(backend: &str, frame_index: u32) -> Vec<Option<(f32, f32)>>
 /// shadow boundary of the reference (the 16-tap PCF penumbra is 4 shadow-map texels wide).
 #[test]
 fn direct_pass_matches_reference_direct() {
+    direct_pass_matches_reference_direct_on("cornell");
+}
+
+/// The same bound for the sun (directional light, orthographic shadow map fitted to the scene).
+#[test]
+fn direct_pass_matches_reference_direct_sun() {
+    direct_pass_matches_reference_direct_on("cornell-sun");
+}
+
+fn direct_pass_matches_reference_direct_on(scene_name: &str) {
     use gibench_harness::reference::{render_reference, ReferenceSettings};
-    let scene = Scene::load_named("cornell", &AssetPaths::standard(None)).unwrap();
+    let scene = Scene::load_named(scene_name, &AssetPaths::standard(None)).unwrap();
     let gpu = GpuContext::new(&GpuOptions {
         backend: Some("vulkan".into()),
         adapter: None,
@@ -84,10 +94,11 @@ fn direct_pass_matches_reference_direct() {
         shadow_size: 512,
     };
     let harness = Harness::new(&gpu, &scene, &config).unwrap();
-    let params = gibench_harness::technique::Params::parse("direct", &[], &[]).unwrap();
+    let info = gibench_direct_info();
+    let params = info.parse_params(&[]).unwrap();
     for frame_index in [0, 40] {
-        let info = gibench_direct_info();
-        let (mut technique, compose) = harness.build(&info, &params, &config).unwrap();
+        let prepared = harness.prepare(&info, &params, &config).unwrap();
+        let (mut technique, compose) = harness.build(&info, &params, &config, &prepared).unwrap();
         let mut profiler = gibench_harness::profiler::Profiler::new(
             &gpu,
             gibench_harness::profiler::ProfileMode::Stages,
@@ -127,7 +138,9 @@ fn direct_pass_matches_reference_direct() {
             }
         }
         let mean_rel = sum_rel / n as f64;
-        eprintln!("frame {frame_index}: mean relative error {mean_rel:.5} over {n} pixels");
+        eprintln!(
+            "{scene_name} frame {frame_index}: mean relative error {mean_rel:.5} over {n} pixels"
+        );
         assert!(
             n > 2000,
             "frame {frame_index}: only {n} lit interior pixels"

@@ -6,9 +6,8 @@
 use gibench_harness::assets::AssetPaths;
 use gibench_harness::glam::Vec3;
 use gibench_harness::gpu::{GpuContext, GpuOptions};
-use gibench_harness::passes::{
-    shader_module, FilterSettings, GBufferTexels, Interleave, INTERLEAVE_WGSL,
-};
+use gibench_harness::ir::interleave::{FilterSettings, Interleave, INTERLEAVE_WGSL};
+use gibench_harness::passes::{shader_module, GBufferTexels};
 use gibench_harness::runner::{Harness, RunConfig, TimingMode};
 use gibench_harness::scene::Scene;
 use gibench_harness::wgpu;

@@ -10,9 +10,8 @@ use gibench_harness::glam::{Vec2, Vec3};
 use gibench_harness::scene::descriptor::LightKind;
 use gibench_harness::scene::{Mesh, Scene};
 use gibench_harness::vpl::{
-    continuing_paths, direction_to_sample, disc_to_hemisphere, generate, halton,
-    hemisphere_to_disc, mean_reflectance, radical_inverse, ray_epsilon, square_to_disc,
-    square_to_sphere, to_local, total_flux, Vpl, VplSettings,
+    continuing_paths, disc_to_hemisphere, generate, halton, hemisphere_to_disc, mean_reflectance,
+    radical_inverse, square_to_disc, square_to_sphere, to_local, total_flux, Vpl, VplSettings,
 };
 
 mod support;
@@ -255,9 +254,12 @@ fn vpl_closed_box_area_light_flux() {
     assert_eq!(vpls.len(), 512);
     assert_rel(total_flux(&vpls), l.power * ALBEDO, 1e-4, "area light flux");
     for v in &vpls {
-        // Cosine directions about −Y: all go down from the rectangle.
-        assert!(v.sample.y < 0.0);
-        assert!((v.sample.length() - 1.0).abs() < 1e-5);
+        // Samples live on the unit disc (the light's domain) and map to cosine directions
+        // about −Y: every ray goes down from the rectangle.
+        assert_eq!(v.sample.z, 0.0);
+        assert!(v.sample.truncate().length() <= 1.0 + 1e-6);
+        let (_, d) = l.ray_of_sample(v.sample, &s.extent);
+        assert!(d.y < 0.0, "{d}");
         assert!(v.position.y < l.position.y);
     }
 }
@@ -322,7 +324,7 @@ fn vpl_cornell_spot_vpls_lie_on_the_mesh_and_face_the_light() {
     let l = FrameClock::new(&s.descriptor).frame(0).light;
     assert_eq!(l.kind, LightKind::Spot);
     let bvh = SceneBvh::new(&s.mesh);
-    let eps = ray_epsilon(&s);
+    let eps = s.extent.ray_epsilon;
     let vpls = generate(&s, &bvh, &l, &settings(256, 1, 0));
     assert!(vpls.len() > 200, "{} VPLs", vpls.len());
     let max_albedo = s
@@ -365,7 +367,7 @@ fn vpl_cornell_spot_vpls_lie_on_the_mesh_and_face_the_light() {
             "{local} vs {}",
             v.sample
         );
-        assert!((direction_to_sample(&l, to_vpl) - v.sample).length() < 1e-3);
+        assert!((l.sample_of_point(v.position, &s.extent) - v.sample).length() < 1e-3);
     }
 }
 

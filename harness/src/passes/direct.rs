@@ -37,8 +37,11 @@ pub const CUBE_FACES: [(Vec3, Vec3); 6] = [
 /// those whose frustum reaches into the lit hemisphere (a corner direction with a positive
 /// component along the light's axis).
 pub fn needed_cube_faces(light: &LightPose) -> [bool; 6] {
-    if light.kind == LightKind::Omni {
-        return [true; 6];
+    match light.kind {
+        LightKind::Omni => return [true; 6],
+        // The sun's one orthographic map sits in face 0's place.
+        LightKind::Sun => return [true, false, false, false, false, false],
+        _ => {}
     }
     let mut out = [false; 6];
     for (f, (dir, up)) in CUBE_FACES.iter().enumerate() {
@@ -50,6 +53,10 @@ pub fn needed_cube_faces(light: &LightPose) -> [bool; 6] {
     out
 }
 
+/// The direct light's WGSL for any shader: `direct_shadow(p, n)` (PCF visibility) and
+/// `direct_irradiance(p, n)`; it expects the bindings [`DirectLight::wgsl`] declares.
+pub const DIRECT_LIGHT_WGSL: &str = include_str!("shaders/direct_light.wgsl");
+
 /// The direct-light passes and their targets.
 pub struct DirectLight {
     pub shadow_map: wgpu::Texture,
@@ -57,7 +64,10 @@ pub struct DirectLight {
     face_size: u32,
     depth_pipeline: wgpu::RenderPipeline,
     light_pipeline: wgpu::RenderPipeline,
-    light_group: wgpu::BindGroup,
+    /// Binding 0: the `Light` uniform; binding 1: the shadow atlas (unfilterable float, 2D);
+    /// visible to fragment and compute shaders. Bind [`DirectLight::light_group`] with it.
+    pub light_layout: wgpu::BindGroupLayout,
+    pub light_group: wgpu::BindGroup,
     /// Direct irradiance (Rgba16Float).
     pub irradiance: wgpu::Texture,
     pub irradiance_view: wgpu::TextureView,
@@ -122,7 +132,12 @@ impl DirectLight {
                 },
             ],
         });
-        let module = shader_module(device, "direct light", include_str!("shaders/direct.wgsl"));
+        let source = format!(
+            "{}\n{}",
+            DirectLight::wgsl(1),
+            include_str!("shaders/direct.wgsl")
+        );
+        let module = shader_module(device, "direct light", &source);
         let light_pipeline = fullscreen_pipeline(
             device,
             "direct light",
@@ -138,10 +153,22 @@ impl DirectLight {
             face_size: s,
             depth_pipeline,
             light_pipeline,
+            light_layout,
             light_group,
             irradiance,
             irradiance_view,
         }
+    }
+
+    /// The direct light for a technique's shader that binds [`DirectLight::light_group`] at
+    /// `group`: the bindings `light` and `direct_shadow_map`, then [`DIRECT_LIGHT_WGSL`]
+    /// (`direct_shadow(p, n)`, `direct_irradiance(p, n)`). Prepend it after `common.wgsl`.
+    pub fn wgsl(group: u32) -> String {
+        format!(
+            "@group({group}) @binding(0) var<uniform> light: Light;\n\
+             @group({group}) @binding(1) var direct_shadow_map: texture_2d<f32>;\n\
+             {DIRECT_LIGHT_WGSL}"
+        )
     }
 
     /// Records the shadow-map faces the light needs; returns how many were rendered.
@@ -178,8 +205,8 @@ impl DirectLight {
             let (x, y) = ((f as u32 % 3) * s, (f as u32 / 3) * s);
             pass.set_viewport(x as f32, y as f32, s as f32, s as f32, 0.0, 1.0);
             pass.set_scissor_rect(x, y, s, s);
-            pass.set_bind_group(0, &uniforms.view_group, &[uniforms.view_offset(1 + f)]);
-            scene.draw(&mut pass, uniforms, 1, false);
+            pass.set_bind_group(0, uniforms.views.group(), &[uniforms.views.offset(1 + f)]);
+            scene.draw(&mut pass, uniforms, 1, super::DrawSet::StaticAndMovers);
             rendered += 1;
         }
         rendered

@@ -48,7 +48,11 @@ pub struct GBufferTexels {
 }
 
 /// A pipeline drawing the scene's meshes (geometry.wgsl) with the shared layouts.
-pub(crate) fn scene_pipeline(
+/// A render pipeline drawing scene meshes with `geometry.wgsl`'s `vertex_entry` (and, if given,
+/// fragment entry and colour targets) into a [`DEPTH_FORMAT`] reversed-Z depth target (compare
+/// Greater, no culling). Groups: 0 a [`super::ViewSet`] view (dynamic offset), 1 the object
+/// uniforms (drawn by [`GpuScene::draw`]), 2 the scene's materials.
+pub fn scene_pipeline(
     device: &wgpu::Device,
     label: &str,
     scene: &GpuScene,
@@ -254,11 +258,11 @@ impl GBuffer {
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(
             0,
-            &uniforms.view_group,
-            &[uniforms.view_offset(super::scene_gpu::CAMERA_SLOT)],
+            uniforms.views.group(),
+            &[uniforms.views.offset(super::scene_gpu::CAMERA_SLOT)],
         );
         pass.set_bind_group(2, &scene.material_group, &[]);
-        scene.draw(&mut pass, uniforms, 1, false);
+        scene.draw(&mut pass, uniforms, 1, super::DrawSet::StaticAndMovers);
     }
 
     /// Copies the current G-buffer to the CPU (flushes the queue; not for timed frames).

@@ -2,27 +2,27 @@
 //! what it reads and writes in its docs, and the runner scopes each one as a profiler stage).
 //!
 //! * [`GpuScene`]: the scene's meshes, materials and textures on the GPU, and how to draw them.
-//! * [`FrameUniforms`]: per-frame camera, cube-face, object and light uniforms.
+//! * [`FrameUniforms`]: per-frame camera, cube-face, object and light uniforms; [`ViewSet`]:
+//!   a set of [`View`]s (the harness's, or a technique's own); [`DrawSet`]: what a draw includes;
+//!   [`scene_pipeline`]: a pipeline drawing the scene with any vertex/fragment entry.
 //! * [`GBuffer`]: reversed-Z depth, normal and albedo of the camera view; world positions are
 //!   reconstructed from depth (Rgba32Float is not renderable on GL).
-//! * [`DirectLight`]: cube shadow map of the primary light and direct irradiance with 16-tap PCF.
+//! * [`DirectLight`]: the primary light's shadow map (cube, or the sun's orthographic map) and
+//!   direct irradiance with 16-tap PCF; [`DirectLight::wgsl`] gives any shader the same lookup.
 //! * [`Compose`]: outgoing radiance and its display encoding.
 
 mod compose;
 mod direct;
 mod gbuffer;
-mod interleave;
 mod scene_gpu;
-mod vpl_lighting;
 
 pub use compose::Compose;
-pub use direct::{needed_cube_faces, DirectLight, CUBE_FACES};
-pub use gbuffer::{GBuffer, GBufferTexels};
-pub use interleave::{FilterSettings, Interleave, INTERLEAVE_WGSL};
+pub use direct::{needed_cube_faces, DirectLight, CUBE_FACES, DIRECT_LIGHT_WGSL};
+pub use gbuffer::{scene_pipeline, GBuffer, GBufferTexels, DEPTH_FORMAT};
 pub use scene_gpu::{
-    cube_face_matrix, light_axis_intensity, FrameUniforms, GpuScene, Vertex, MAX_MATERIALS,
+    cube_face_matrix, sun_view_matrix, DrawSet, FrameUniforms, GpuScene, Vertex, View, ViewSet,
+    CAMERA_SLOT, MAX_MATERIALS,
 };
-pub use vpl_lighting::{VplLighting, VplMapKind, VplShadowSettings, VPL_COMMON_WGSL};
 
 /// WGSL declared once and prepended to every shader (View, Light, helpers).
 pub const COMMON_WGSL: &str = include_str!("shaders/common.wgsl");

@@ -4,8 +4,7 @@ use glam::{Mat4, Vec3, Vec4};
 use wgpu::util::DeviceExt;
 
 use crate::anim::{FrameState, LightPose};
-use crate::scene::descriptor::LightKind;
-use crate::scene::{Mesh, Scene, Texture};
+use crate::scene::{Mesh, Scene, SceneExtent, Texture};
 use crate::{Error, Result};
 
 use super::{texture_entry, uniform_entry};
@@ -79,8 +78,8 @@ pub struct GpuScene {
     pub movers: Vec<GpuMesh>,
     pub material_layout: wgpu::BindGroupLayout,
     pub material_group: wgpu::BindGroup,
-    /// Scene bounds (static mesh).
-    pub bounds: (Vec3, Vec3),
+    /// Bounds, diagonal and bounding sphere of the static mesh.
+    pub extent: SceneExtent,
 }
 
 fn srgb_texel_bilinear(t: &Texture, u: f32, v: f32) -> [f32; 4] {
@@ -255,7 +254,7 @@ impl GpuScene {
                 .collect(),
             material_layout,
             material_group,
-            bounds: scene.mesh.bounds(),
+            extent: scene.extent,
         })
     }
 
@@ -266,47 +265,28 @@ impl GpuScene {
 
     /// Length of the scene's bounding-box diagonal.
     pub fn diagonal(&self) -> f32 {
-        (self.bounds.1 - self.bounds.0).length().max(1e-6)
+        self.extent.diagonal
     }
 
-    /// Draws every object: the static mesh (or its shadow-caster copy when `shadow_casters`)
-    /// and the movers, binding each one's object uniforms at `object_group_index`.
-    /// Draws only the static geometry's shadow-caster copy (object slot 0): what VPL shadow
-    /// maps hold, since they are reused across frames and indirect light bounces off static
-    /// geometry only (Laine et al. 2007, Section 7).
-    pub fn draw_static_casters(
-        &self,
-        pass: &mut wgpu::RenderPass,
-        uniforms: &FrameUniforms,
-        object_group_index: u32,
-    ) {
-        let mesh = self.shadow_mesh.as_ref().unwrap_or(&self.static_mesh);
-        pass.set_bind_group(
-            object_group_index,
-            &uniforms.object_group,
-            &[uniforms.object_offset(0)],
-        );
-        pass.set_vertex_buffer(0, mesh.vertices.slice(..));
-        pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
-        pass.draw_indexed(0..mesh.index_count, 0, 0..1);
-    }
-
+    /// Draws `set` (see [`DrawSet`]), binding each object's uniforms (from `uniforms`) at bind
+    /// group `object_group_index` with its dynamic offset; the caller binds everything else.
     pub fn draw(
         &self,
         pass: &mut wgpu::RenderPass,
         uniforms: &FrameUniforms,
         object_group_index: u32,
-        shadow_casters: bool,
+        set: DrawSet,
     ) {
-        let statics = if shadow_casters {
-            self.shadow_mesh.as_ref().unwrap_or(&self.static_mesh)
-        } else {
-            &self.static_mesh
+        let statics = match set {
+            DrawSet::StaticCasters => self.shadow_mesh.as_ref().unwrap_or(&self.static_mesh),
+            DrawSet::Static | DrawSet::StaticAndMovers => &self.static_mesh,
         };
-        for (slot, mesh) in std::iter::once(statics)
-            .chain(self.movers.iter())
-            .enumerate()
-        {
+        let movers = if set == DrawSet::StaticAndMovers {
+            &self.movers[..]
+        } else {
+            &[]
+        };
+        for (slot, mesh) in std::iter::once(statics).chain(movers.iter()).enumerate() {
             pass.set_bind_group(
                 object_group_index,
                 &uniforms.object_group,
@@ -316,6 +296,120 @@ impl GpuScene {
             pass.set_index_buffer(mesh.indices.slice(..), wgpu::IndexFormat::Uint32);
             pass.draw_indexed(0..mesh.index_count, 0, 0..1);
         }
+    }
+}
+
+/// What a scene draw includes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DrawSet {
+    /// The static mesh's shadow-caster copy (tessellated where the scene has one) only: what VPL
+    /// maps reused across frames hold (indirect light bounces off static geometry only; Laine
+    /// et al. 2007 §7).
+    StaticCasters,
+    /// The static mesh only.
+    Static,
+    /// The static mesh and every mover (the camera view, the direct light's shadow map).
+    StaticAndMovers,
+}
+
+/// A view for drawing the scene: the `View` uniform of `common.wgsl`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct View {
+    /// World → clip (reversed Z).
+    pub view_proj: Mat4,
+    /// Eye position.
+    pub eye: Vec3,
+    /// Target size in pixels.
+    pub size: [f32; 2],
+    /// Near plane (0 for orthographic views).
+    pub near: f32,
+}
+
+/// A set of [`View`] uniforms in one buffer, each bound with a dynamic offset; the harness's
+/// camera and light views are one, and a technique may own others (e.g. orthographic views).
+/// Written with `queue.write_buffer`; never re-created.
+pub struct ViewSet {
+    buffer: wgpu::Buffer,
+    group: wgpu::BindGroup,
+    count: usize,
+}
+
+impl ViewSet {
+    /// `count` views bound through `layout` ([`FrameUniforms::view_layout`], which every
+    /// scene pipeline uses at group 0).
+    pub fn new(
+        device: &wgpu::Device,
+        layout: &wgpu::BindGroupLayout,
+        count: usize,
+        label: &str,
+    ) -> ViewSet {
+        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: count.max(1) as u64 * SLOT,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some(label),
+            layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer: &buffer,
+                    offset: 0,
+                    size: wgpu::BufferSize::new(std::mem::size_of::<ViewData>() as u64),
+                }),
+            }],
+        });
+        ViewSet {
+            buffer,
+            group,
+            count,
+        }
+    }
+
+    /// Number of views.
+    pub fn len(&self) -> usize {
+        self.count
+    }
+    pub fn is_empty(&self) -> bool {
+        self.count == 0
+    }
+
+    /// Uploads `views` into slots 0.. (at most [`ViewSet::len`]).
+    pub fn write(&self, queue: &wgpu::Queue, views: &[View]) {
+        let n = views.len().min(self.count);
+        let mut bytes = vec![0u8; n * SLOT as usize];
+        for (slot, v) in views[..n].iter().enumerate() {
+            let d = ViewData {
+                view_proj: v.view_proj.to_cols_array(),
+                inv_view_proj: v.view_proj.inverse().to_cols_array(),
+                eye: v.eye.extend(1.0).to_array(),
+                params: [v.size[0], v.size[1], v.near, 0.0],
+            };
+            let o = slot * SLOT as usize;
+            bytes[o..o + std::mem::size_of::<ViewData>()].copy_from_slice(bytemuck::bytes_of(&d));
+        }
+        queue.write_buffer(&self.buffer, 0, &bytes);
+    }
+
+    /// The bind group; bind it with [`ViewSet::offset`] of the view to use.
+    pub fn group(&self) -> &wgpu::BindGroup {
+        &self.group
+    }
+
+    /// Dynamic offset of view `slot`.
+    pub fn offset(&self, slot: usize) -> u32 {
+        (slot as u64 * SLOT) as u32
+    }
+
+    /// View `slot`'s uniform range, for bind groups that take it without a dynamic offset.
+    pub fn binding(&self, slot: usize) -> wgpu::BindingResource<'_> {
+        wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+            buffer: &self.buffer,
+            offset: slot as u64 * SLOT,
+            size: wgpu::BufferSize::new(std::mem::size_of::<ViewData>() as u64),
+        })
     }
 }
 
@@ -346,10 +440,12 @@ pub const CAMERA_SLOT: usize = 0;
 /// Per-frame uniforms shared by all passes: views (camera and cube faces), object transforms
 /// and the primary light. Written with `queue.write_buffer` each frame; never re-created.
 pub struct FrameUniforms {
-    pub view_buffer: wgpu::Buffer,
+    /// Layout of a [`ViewSet`] (one `View` uniform, dynamic offset): group 0 of every scene
+    /// pipeline.
     pub view_layout: wgpu::BindGroupLayout,
-    /// The view uniforms with a dynamic offset (`view_offset(slot)`).
-    pub view_group: wgpu::BindGroup,
+    /// Slot [`CAMERA_SLOT`]: the camera; 1..=6: the primary light's cube faces (the sun: its
+    /// orthographic view in slot 1).
+    pub views: ViewSet,
     pub object_buffer: wgpu::Buffer,
     pub object_layout: wgpu::BindGroupLayout,
     pub object_group: wgpu::BindGroup,
@@ -361,6 +457,8 @@ pub struct FrameUniforms {
     /// Shadow-map size and PCF settings written into the light uniform.
     pub shadow_size: u32,
     pub shadow_bias: f32,
+    /// The scene's extent (the sun's orthographic map covers its bounding sphere).
+    extent: SceneExtent,
 }
 
 /// View-projection of cube face `face` (+X, −X, +Y, −Y, +Z, −Z) around `eye`, reversed-Z.
@@ -370,12 +468,24 @@ pub fn cube_face_matrix(eye: Vec3, face: usize, near: f32) -> Mat4 {
         * crate::anim::look_at(eye, eye + dir, up)
 }
 
-/// On-axis radiant intensity of the primary light (see the harness's radiometric convention).
-pub fn light_axis_intensity(light: &LightPose) -> Vec3 {
-    match light.kind {
-        LightKind::Omni => light.power / (4.0 * std::f32::consts::PI),
-        LightKind::Spot | LightKind::Area => light.power / std::f32::consts::PI,
-    }
+/// The sun's shadow view: an orthographic, reversed-Z view-projection along the light's axis
+/// that covers the scene's bounding sphere (depth 1 at the sun's disc, 0 a diameter further).
+pub fn sun_view_matrix(light: &LightPose, extent: &SceneExtent) -> Mat4 {
+    let (eye, r) = light.sun_disc(extent);
+    let axis = light.axis();
+    let up = if axis.y.abs() > 0.999 {
+        Vec3::Z
+    } else {
+        Vec3::Y
+    };
+    // The disc sits 2r upstream of the centre; depth covers [r, 3r] along the axis.
+    let proj = Mat4::from_cols(
+        Vec4::new(1.0 / r, 0.0, 0.0, 0.0),
+        Vec4::new(0.0, 1.0 / r, 0.0, 0.0),
+        Vec4::new(0.0, 0.0, 0.5 / r, 0.0),
+        Vec4::new(0.0, 0.0, 1.5, 1.0),
+    );
+    proj * crate::anim::look_at(eye, eye + axis, up)
 }
 
 impl FrameUniforms {
@@ -388,28 +498,11 @@ impl FrameUniforms {
     ) -> FrameUniforms {
         let objects = scene.object_count();
         let all = wgpu::ShaderStages::VERTEX_FRAGMENT | wgpu::ShaderStages::COMPUTE;
-        let view_buffer = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("views"),
-            size: 7 * SLOT,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
         let view_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("view"),
             entries: &[uniform_entry(0, all, true)],
         });
-        let view_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("views"),
-            layout: &view_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                    buffer: &view_buffer,
-                    offset: 0,
-                    size: wgpu::BufferSize::new(std::mem::size_of::<ViewData>() as u64),
-                }),
-            }],
-        });
+        let views = ViewSet::new(device, &view_layout, 7, "views");
         let object_buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("objects"),
             size: objects as u64 * SLOT,
@@ -439,9 +532,8 @@ impl FrameUniforms {
             mapped_at_creation: false,
         });
         FrameUniforms {
-            view_buffer,
             view_layout,
-            view_group,
+            views,
             object_buffer,
             object_layout,
             object_group,
@@ -451,24 +543,17 @@ impl FrameUniforms {
             shadow_near: scene.diagonal() * 1e-3,
             shadow_size,
             shadow_bias,
+            extent: scene.extent,
         }
     }
 
-    /// Dynamic offset of view slot `slot` (0 camera, 1 + f cube face f).
-    pub fn view_offset(&self, slot: usize) -> u32 {
-        (slot as u64 * SLOT) as u32
-    }
     /// Dynamic offset of object slot `slot` (0 static mesh, 1 + i mover i).
     pub fn object_offset(&self, slot: usize) -> u32 {
         (slot as u64 * SLOT) as u32
     }
     /// The camera's uniform range, for bind groups that take it without a dynamic offset.
     pub fn camera_binding(&self) -> wgpu::BindingResource<'_> {
-        wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-            buffer: &self.view_buffer,
-            offset: 0,
-            size: wgpu::BufferSize::new(std::mem::size_of::<ViewData>() as u64),
-        })
+        self.views.binding(CAMERA_SLOT)
     }
 
     /// The camera's view-projection for `frame`.
@@ -479,35 +564,39 @@ impl FrameUniforms {
 
     /// Uploads this frame's camera, cube faces, object transforms and light.
     pub fn write(&self, queue: &wgpu::Queue, frame: &FrameState) {
-        let mut views = vec![0u8; 7 * SLOT as usize];
-        let vp = self.camera_view_proj(frame);
         let [w, h] = self.resolution;
-        let mut put_view = |slot: usize, m: Mat4, eye: Vec3, near: f32, size: [f32; 2]| {
-            let d = ViewData {
-                view_proj: m.to_cols_array(),
-                inv_view_proj: m.inverse().to_cols_array(),
-                eye: eye.extend(1.0).to_array(),
-                params: [size[0], size[1], near, 0.0],
-            };
-            let o = slot * SLOT as usize;
-            views[o..o + std::mem::size_of::<ViewData>()].copy_from_slice(bytemuck::bytes_of(&d));
-        };
-        put_view(
-            CAMERA_SLOT,
-            vp,
-            frame.camera.position,
-            frame.camera.near,
-            [w as f32, h as f32],
-        );
+        let mut views = vec![View {
+            view_proj: self.camera_view_proj(frame),
+            eye: frame.camera.position,
+            size: [w as f32, h as f32],
+            near: frame.camera.near,
+        }];
         let light = &frame.light;
         let mut faces = [[0f32; 16]; 6];
-        for (f, face) in faces.iter_mut().enumerate() {
-            let m = cube_face_matrix(light.position, f, self.shadow_near);
-            *face = m.to_cols_array();
-            let s = self.shadow_size as f32;
-            put_view(1 + f, m, light.position, self.shadow_near, [s, s]);
+        let s = self.shadow_size as f32;
+        if light.is_directional() {
+            // The sun: one orthographic map in face 0's place.
+            let m = sun_view_matrix(light, &self.extent);
+            faces[0] = m.to_cols_array();
+            views.push(View {
+                view_proj: m,
+                eye: light.sun_disc(&self.extent).0,
+                size: [s, s],
+                near: 0.0,
+            });
+        } else {
+            for (f, face) in faces.iter_mut().enumerate() {
+                let m = cube_face_matrix(light.position, f, self.shadow_near);
+                *face = m.to_cols_array();
+                views.push(View {
+                    view_proj: m,
+                    eye: light.position,
+                    size: [s, s],
+                    near: self.shadow_near,
+                });
+            }
         }
-        queue.write_buffer(&self.view_buffer, 0, &views);
+        self.views.write(queue, &views);
 
         let mut objects = vec![0u8; self.objects * SLOT as usize];
         for slot in 0..self.objects {
@@ -527,15 +616,20 @@ impl FrameUniforms {
         }
         queue.write_buffer(&self.object_buffer, 0, &objects);
 
-        let kind = match light.kind {
-            LightKind::Spot => 0.0,
-            LightKind::Omni => 1.0,
-            LightKind::Area => 2.0,
+        let position = if light.is_directional() {
+            light.sun_disc(&self.extent).0
+        } else {
+            light.position
         };
         let data = LightData {
-            position: light.position.extend(kind).to_array(),
-            direction: light.direction.extend(0.0).to_array(),
-            intensity: light_axis_intensity(light).extend(0.0).to_array(),
+            position: position
+                .extend(crate::light::gpu_kind(light.kind))
+                .to_array(),
+            direction: light
+                .axis()
+                .extend(light.sun_disc(&self.extent).1)
+                .to_array(),
+            intensity: light.axis_intensity().extend(0.0).to_array(),
             shadow: Vec4::new(
                 self.shadow_size as f32,
                 self.shadow_bias,

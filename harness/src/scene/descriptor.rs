@@ -84,13 +84,17 @@ pub enum LightKind {
     Omni,
     /// One-sided Lambertian rectangle of `size`, facing its target.
     Area,
+    /// Directional light (the sun): parallel rays along position → target; `power` is the
+    /// irradiance E⊥ it gives a surface facing it (see [`crate::light`]).
+    Sun,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LightDesc {
     pub kind: LightKind,
-    /// Total emitted flux Φ, linear RGB (see the harness's radiometric convention).
+    /// Total emitted flux Φ, linear RGB (see the harness's radiometric convention); for a
+    /// `sun`, the irradiance E⊥ on a surface facing it.
     pub power: [f32; 3],
     /// Area lights: width and height in scene units.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -204,6 +208,10 @@ const BUILTINS: &[(&str, &str)] = &[
     (
         "cornell-omni",
         include_str!("../../../scenes/cornell-omni.json"),
+    ),
+    (
+        "cornell-sun",
+        include_str!("../../../scenes/cornell-sun.json"),
     ),
     ("sibenik", include_str!("../../../scenes/sibenik.json")),
     (
@@ -332,7 +340,7 @@ impl SceneDescriptor {
                     format!("width and height must be positive, got {size:?}"),
                 ));
             }
-            (LightKind::Spot | LightKind::Omni, Some(_)) => {
+            (LightKind::Spot | LightKind::Omni | LightKind::Sun, Some(_)) => {
                 return Err(invalid(p, "light.size", "only area lights have a size"));
             }
             _ => {}
@@ -341,6 +349,9 @@ impl SceneDescriptor {
             LightKind::Omni => TargetRule::Optional,
             LightKind::Spot => TargetRule::Required("spot lights point at their target"),
             LightKind::Area => TargetRule::Required("area lights face their target"),
+            LightKind::Sun => {
+                TargetRule::Required("the sun shines from its position towards its target")
+            }
         };
         validate_path(p, "light.path", &light.path, rule)?;
 

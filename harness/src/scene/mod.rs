@@ -191,6 +191,44 @@ pub struct Mover {
     pub mesh: Mesh,
 }
 
+/// Per-scene constants computed once at load from the static mesh's bounds: the bounding box,
+/// its diagonal and bounding sphere, and the ray offset ε every CPU ray uses (VPL generation,
+/// Laine's management; the reference uses the same rule over its per-frame mesh).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SceneExtent {
+    pub min: Vec3,
+    pub max: Vec3,
+    /// Length of the bounding-box diagonal (at least 10⁻⁶).
+    pub diagonal: f32,
+    /// Centre of the bounding box.
+    pub centre: Vec3,
+    /// Half the diagonal: the radius of a sphere around `centre` holding the whole mesh.
+    pub radius: f32,
+    /// 10⁻⁴ × the diagonal, or 10⁻⁶ for an empty or degenerate mesh.
+    pub ray_epsilon: f32,
+}
+
+impl SceneExtent {
+    /// The extent of `mesh` (one pass over its vertices).
+    pub fn of(mesh: &Mesh) -> SceneExtent {
+        let (lo, hi) = mesh.bounds();
+        SceneExtent::from_bounds(lo, hi)
+    }
+    /// The extent of the box `[min, max]`.
+    pub fn from_bounds(min: Vec3, max: Vec3) -> SceneExtent {
+        let d = (max - min).length();
+        let ok = d.is_finite() && d > 0.0;
+        SceneExtent {
+            min,
+            max,
+            diagonal: if ok { d } else { 1e-6 },
+            centre: 0.5 * (min + max),
+            radius: if ok { 0.5 * d } else { 5e-7 },
+            ray_epsilon: if ok { 1e-4 * d } else { 1e-6 },
+        }
+    }
+}
+
 /// The whole scene.
 #[derive(Clone, Debug)]
 pub struct Scene {
@@ -207,6 +245,8 @@ pub struct Scene {
     pub movers: Vec<Mover>,
     /// Punctual lights found in the static mesh's glTF file.
     pub gltf_lights: Vec<PunctualLight>,
+    /// Bounds, diagonal and ray ε of [`Scene::mesh`], computed once at load.
+    pub extent: SceneExtent,
 }
 
 /// A mesh built from a [`MeshSource`], with materials and textures indexed from zero.
@@ -378,6 +418,7 @@ impl Scene {
 
         Ok(Scene {
             descriptor: desc.clone(),
+            extent: SceneExtent::of(&mesh),
             mesh,
             shadow_mesh,
             materials,

@@ -46,6 +46,7 @@ pub fn quad(mesh: &mut Mesh, c: [Vec3; 4], n: Vec3, material: u32) {
 pub fn scene(mesh: Mesh, materials: Vec<Material>) -> Scene {
     Scene {
         descriptor: descriptor(),
+        extent: gibench_harness::scene::SceneExtent::of(&mesh),
         mesh,
         shadow_mesh: None,
         materials,

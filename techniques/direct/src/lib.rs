@@ -4,7 +4,11 @@
 //!
 //! Needs: no optional GPU features, WebGL2-level limits.
 
-use gibench_harness::technique::{FrameContext, Params, PrepareContext, Technique, TechniqueInfo};
+use gibench_harness::quality::IndirectComponent;
+use gibench_harness::technique::{
+    prepare_nothing, Conformance, FrameContext, Params, PrepareContext, Prepared, Technique,
+    TechniqueInfo,
+};
 use gibench_harness::wgpu;
 use gibench_harness::Result;
 
@@ -15,6 +19,13 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     params: &[],
     required_features: wgpu::Features::empty(),
     required_limits: wgpu::Limits::downlevel_webgl2_defaults,
+    reference: IndirectComponent::OneBounce,
+    // No indirect light at all: the mean ratio must be exactly zero.
+    conformance: Conformance {
+        max_rel_mse: f64::INFINITY,
+        mean_ratio: (0.0, 0.0),
+    },
+    prepare: prepare_nothing,
     create,
 };
 
@@ -23,7 +34,7 @@ pub struct Direct {
     view: wgpu::TextureView,
 }
 
-fn create(_params: &Params, ctx: &PrepareContext) -> Result<Box<dyn Technique>> {
+fn create(_params: &Params, ctx: &PrepareContext, _: &Prepared) -> Result<Box<dyn Technique>> {
     // Zero-initialised by wgpu and never written: the indirect irradiance is zero.
     let texture = gibench_harness::passes::indirect_target(&ctx.gpu.device, ctx.resolution, false);
     Ok(Box::new(Direct {

@@ -20,65 +20,66 @@
 //!
 //! Needs: compute shaders and storage buffers (GL ES 3.1 / Vulkan), no optional features.
 
-use gibench_harness::gather::{VplGather, GATHER_PARAMS};
+use gibench_harness::ir::gather::{GatherParams, VplGather, GATHER_PARAMS};
+use gibench_harness::ir::raster::AtlasClear;
+use gibench_harness::passes::DrawSet;
+use gibench_harness::quality::IndirectComponent;
 use gibench_harness::technique::{
-    FrameContext, ParamKind, ParamSpec, Params, PrepareContext, Technique, TechniqueInfo,
+    Conformance, FrameContext, ParamKind, ParamSpec, Params, PrepareContext, Prepared, Technique,
+    TechniqueInfo,
 };
 use gibench_harness::vpl::{self, Vpl, VplSettings};
-use gibench_harness::{wgpu, Result};
+use gibench_harness::{wgpu, Error, Result};
 
 const BOUNCES: ParamSpec = ParamSpec {
-        name: "bounces",
-        kind: ParamKind::Int { min: 1, max: 8 },
-        default: "1",
-        doc: "path vertices per light path (1 = single bounce as in Laine; more use Keller's fractional absorption)",
-    };
+    name: "bounces",
+    kind: ParamKind::Int { min: 1, max: 8 },
+    default: "1",
+    doc: "path vertices per light path (1 = single bounce as in Laine; more use Keller's fractional absorption)",
+};
 
-const FULL_PARAMS: [ParamSpec; 7] = {
-    let mut p = [ParamSpec {
+const FULL_OWN: &[ParamSpec] = &[
+    ParamSpec {
         name: "vpls",
         kind: ParamKind::Int { min: 1, max: 4096 },
         default: "64",
         doc: "light paths traced per frame (= first-bounce VPLs; Laine's comparison: 256)",
-    }; 7];
-    p[1] = BOUNCES;
-    let mut i = 0;
-    while i < 5 {
-        p[i + 2] = GATHER_PARAMS[i];
-        i += 1;
-    }
-    p
-};
+    },
+    BOUNCES,
+];
 
-const INCREMENTAL_PARAMS: [ParamSpec; 8] = {
-    let mut p = [ParamSpec {
+const INCREMENTAL_OWN: &[ParamSpec] = &[
+    ParamSpec {
         name: "vpls",
         kind: ParamKind::Int { min: 1, max: 4096 },
         default: "64",
         doc: "light paths kept (N); the first frame traces all of them",
-    }; 8];
-    p[1] = ParamSpec {
+    },
+    ParamSpec {
         name: "budget",
         kind: ParamKind::Int { min: 1, max: 4096 },
         default: "4",
         doc: "oldest paths replaced by new ones each frame",
-    };
-    p[2] = BOUNCES;
-    let mut i = 0;
-    while i < 5 {
-        p[i + 3] = GATHER_PARAMS[i];
-        i += 1;
-    }
-    p
+    },
+    BOUNCES,
+];
+
+/// Conformance on the Cornell box against the one-bounce reference (64 paths, 4x4 tiles).
+const CONFORMANCE: Conformance = Conformance {
+    max_rel_mse: 0.6,
+    mean_ratio: (0.85, 1.05),
 };
 
 /// `keller-full` registry entry.
 pub const FULL: TechniqueInfo = TechniqueInfo {
     name: "keller-full",
     description: "Keller instant radiosity: all VPLs and their shadow maps recomputed every frame",
-    params: &FULL_PARAMS,
+    params: &[FULL_OWN, GATHER_PARAMS],
     required_features: wgpu::Features::empty(),
     required_limits: wgpu::Limits::downlevel_defaults,
+    reference: IndirectComponent::OneBounce,
+    conformance: CONFORMANCE,
+    prepare,
     create: create_full,
 };
 
@@ -86,11 +87,61 @@ pub const FULL: TechniqueInfo = TechniqueInfo {
 pub const INCREMENTAL: TechniqueInfo = TechniqueInfo {
     name: "keller-incremental",
     description: "Keller instant radiosity: keep the last N paths, replace the oldest `budget` per frame, accumulate",
-    params: &INCREMENTAL_PARAMS,
+    params: &[INCREMENTAL_OWN, GATHER_PARAMS],
     required_features: wgpu::Features::empty(),
     required_limits: wgpu::Limits::downlevel_defaults,
+    reference: IndirectComponent::OneBounce,
+    conformance: CONFORMANCE,
+    prepare,
     create: create_incremental,
 };
+
+/// The parameters of both Keller techniques, read once.
+#[derive(Clone, Copy, Debug)]
+pub struct KellerParams {
+    /// N: light paths per frame (full) or kept (incremental).
+    pub paths: u32,
+    pub bounces: u32,
+    /// Paths replaced per frame (incremental; at most `paths`).
+    pub budget: u32,
+    pub gather: GatherParams,
+}
+
+impl KellerParams {
+    pub fn from_params(params: &Params) -> Result<KellerParams> {
+        let paths = params.int("vpls") as u32;
+        let budget = if params.has("budget") {
+            params.int("budget") as u32
+        } else {
+            paths
+        };
+        Ok(KellerParams {
+            paths,
+            bounces: params.int("bounces") as u32,
+            budget: budget.min(paths),
+            gather: GatherParams::from_params(params)?,
+        })
+    }
+}
+
+/// What both Keller techniques prepare once per scene: Keller's ρ̄ (the mean of the channels of
+/// the scene's area-weighted average reflectance, one pass over the static mesh).
+struct KellerPrepared {
+    average_reflectance: f32,
+}
+
+fn prepare(_: &Params, ctx: &PrepareContext) -> Result<Prepared> {
+    Ok(Box::new(KellerPrepared {
+        average_reflectance: vpl::mean_reflectance(ctx.scene),
+    }))
+}
+
+fn prepared_rho(prepared: &Prepared) -> Result<f32> {
+    prepared
+        .downcast_ref::<KellerPrepared>()
+        .map(|p| p.average_reflectance)
+        .ok_or_else(|| Error::Invalid("keller: built without its preparation".into()))
+}
 
 /// `keller-full`.
 pub struct KellerFull {
@@ -98,24 +149,21 @@ pub struct KellerFull {
     settings: VplSettings,
 }
 
-/// Keller's ρ̄: the mean of the channels of the scene's area-weighted average reflectance.
-fn average_reflectance(ctx: &PrepareContext) -> f32 {
-    let r = ctx.scene.average_reflectance();
-    (r.x + r.y + r.z) / 3.0
-}
-
-fn create_full(params: &Params, ctx: &PrepareContext) -> Result<Box<dyn Technique>> {
-    let paths = params.int("vpls") as u32;
-    let bounces = params.int("bounces") as u32;
-    let gather = VplGather::new(params, ctx, paths * bounces)?;
+fn create_full(
+    params: &Params,
+    ctx: &PrepareContext,
+    prepared: &Prepared,
+) -> Result<Box<dyn Technique>> {
+    let p = KellerParams::from_params(params)?;
+    let gather = VplGather::new(&p.gather, ctx, p.paths * p.bounces, DrawSet::StaticCasters)?;
     Ok(Box::new(KellerFull {
         gather,
         settings: VplSettings {
-            paths,
-            bounces,
+            paths: p.paths,
+            bounces: p.bounces,
             first_path: 0,
-            normalisation_paths: paths,
-            average_reflectance: Some(average_reflectance(ctx)),
+            normalisation_paths: p.paths,
+            average_reflectance: Some(prepared_rho(prepared)?),
         },
     }))
 }
@@ -124,21 +172,15 @@ impl Technique for KellerFull {
     fn render(&mut self, ctx: &mut FrameContext) -> Result<()> {
         let (scene, bvh, light) = (ctx.scene, ctx.bvh, ctx.frame.light);
         let settings = self.settings;
-        let lighting = &self.gather.lighting;
-        let queue = &ctx.gpu.queue;
         let vpls: Vec<(u32, Vpl)> = ctx.profiler.cpu_stage("vpl-generation", || {
-            let vpls: Vec<(u32, Vpl)> = vpl::generate(scene, bvh, &light, &settings)
+            vpl::generate(scene, bvh, &light, &settings)
                 .into_iter()
                 .enumerate()
                 .map(|(i, v)| (i as u32, v))
-                .collect();
-            for (slot, v) in &vpls {
-                lighting.write_view(queue, *slot, v);
-            }
-            vpls
+                .collect()
         });
-        let slots: Vec<u32> = vpls.iter().map(|(s, _)| *s).collect();
-        self.gather.render_maps(ctx, &slots, true)?;
+        // Every map is re-rendered: clear the whole atlas.
+        self.gather.render_maps(ctx, &vpls, AtlasClear::Whole)?;
         self.gather.gather(ctx, &vpls)
     }
 
@@ -162,20 +204,22 @@ pub struct KellerIncremental {
     average_reflectance: f32,
 }
 
-fn create_incremental(params: &Params, ctx: &PrepareContext) -> Result<Box<dyn Technique>> {
-    let paths = params.int("vpls") as u32;
-    let bounces = params.int("bounces") as u32;
-    let budget = (params.int("budget") as u32).min(paths);
-    let gather = VplGather::new(params, ctx, paths * bounces)?;
+fn create_incremental(
+    params: &Params,
+    ctx: &PrepareContext,
+    prepared: &Prepared,
+) -> Result<Box<dyn Technique>> {
+    let p = KellerParams::from_params(params)?;
+    let gather = VplGather::new(&p.gather, ctx, p.paths * p.bounces, DrawSet::StaticCasters)?;
     Ok(Box::new(KellerIncremental {
         gather,
-        paths,
-        budget,
-        bounces,
+        paths: p.paths,
+        budget: p.budget,
+        bounces: p.bounces,
         ring: Vec::new(),
         oldest: 0,
         next_path: 0,
-        average_reflectance: average_reflectance(ctx),
+        average_reflectance: prepared_rho(prepared)?,
     }))
 }
 
@@ -185,10 +229,8 @@ impl Technique for KellerIncremental {
         let first = self.ring.is_empty();
         let count = if first { self.paths } else { self.budget };
         let (paths, bounces, rho) = (self.paths, self.bounces, self.average_reflectance);
-        let lighting = &self.gather.lighting;
-        let queue = &ctx.gpu.queue;
         let (ring, oldest, next_path) = (&mut self.ring, &mut self.oldest, &mut self.next_path);
-        let slots: Vec<u32> = ctx.profiler.cpu_stage("vpl-generation", || {
+        let new_vpls: Vec<(u32, Vpl)> = ctx.profiler.cpu_stage("vpl-generation", || {
             if ring.is_empty() {
                 ring.resize(paths as usize, Vec::new());
             }
@@ -202,7 +244,7 @@ impl Technique for KellerIncremental {
                 average_reflectance: Some(rho),
             };
             let batch = vpl::generate(scene, bvh, &light, &settings);
-            let mut slots = Vec::new();
+            let mut new_vpls = Vec::new();
             for k in 0..count as u64 {
                 let p = *oldest;
                 *oldest = (*oldest + 1) % paths;
@@ -212,14 +254,12 @@ impl Technique for KellerIncremental {
                     .copied()
                     .collect();
                 for (b, v) in path_vpls.iter().enumerate() {
-                    let slot = p * bounces + b as u32;
-                    lighting.write_view(queue, slot, v);
-                    slots.push(slot);
+                    new_vpls.push((p * bounces + b as u32, *v));
                 }
                 ring[p as usize] = path_vpls;
             }
             *next_path += count as u64;
-            slots
+            new_vpls
         });
         let vpls: Vec<(u32, Vpl)> = self
             .ring
@@ -231,7 +271,13 @@ impl Technique for KellerIncremental {
                     .map(move |(b, v)| (p as u32 * bounces + b as u32, *v))
             })
             .collect();
-        self.gather.render_maps(ctx, &slots, first)?;
+        // The first frame renders every map; later frames only the replaced paths' maps.
+        let clear = if first {
+            AtlasClear::Whole
+        } else {
+            AtlasClear::RenderedSlots
+        };
+        self.gather.render_maps(ctx, &new_vpls, clear)?;
         self.gather.gather(ctx, &vpls)
     }
 

@@ -36,52 +36,77 @@ pub mod domain;
 use domain::{DomainKind, SamplingDomain};
 use gibench_harness::anim::LightPose;
 use gibench_harness::bvh::SceneBvh;
-use gibench_harness::gather::{VplGather, GATHER_PARAMS};
 use gibench_harness::glam::Vec3;
-use gibench_harness::scene::descriptor::LightKind;
+use gibench_harness::ir::gather::{GatherParams, VplGather, GATHER_PARAMS};
+use gibench_harness::ir::raster::AtlasClear;
+use gibench_harness::light::SampleDomain;
+use gibench_harness::passes::DrawSet;
+use gibench_harness::quality::IndirectComponent;
 use gibench_harness::scene::Scene;
 use gibench_harness::technique::{
-    FrameContext, ParamKind, ParamSpec, Params, PrepareContext, Technique, TechniqueInfo,
+    prepare_nothing, Conformance, FrameContext, ParamKind, ParamSpec, Params, PrepareContext,
+    Prepared, Technique, TechniqueInfo,
 };
 use gibench_harness::vpl::{self, Vpl};
 use gibench_harness::{wgpu, Result};
 
-const PARAMS: [ParamSpec; 8] = {
-    let mut p = [ParamSpec {
+const OWN_PARAMS: &[ParamSpec] = &[
+    ParamSpec {
         name: "max-lights",
         kind: ParamKind::Int { min: 1, max: 4096 },
         default: "256",
         doc: "maximum number of VPLs (Laine: 256)",
-    }; 8];
-    p[1] = ParamSpec {
+    },
+    ParamSpec {
         name: "recalc-min",
         kind: ParamKind::Int { min: 0, max: 4096 },
         default: "4",
         doc: "VPLs deleted each frame at least (free slots kept), the least-useful first",
-    };
-    p[2] = ParamSpec {
+    },
+    ParamSpec {
         name: "recalc-max",
         kind: ParamKind::Int { min: 1, max: 4096 },
         default: "8",
         doc: "new sampling points (and shadow maps) per frame at most",
-    };
-    let mut i = 0;
-    while i < 5 {
-        p[i + 3] = GATHER_PARAMS[i];
-        i += 1;
-    }
-    p
-};
+    },
+];
 
 /// `laine` registry entry.
 pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "laine",
     description: "Laine et al. 2007 incremental instant radiosity: reuse valid VPLs, recompute a few per frame",
-    params: &PARAMS,
+    params: &[OWN_PARAMS, GATHER_PARAMS],
     required_features: wgpu::Features::empty(),
     required_limits: wgpu::Limits::downlevel_defaults,
+    reference: IndirectComponent::OneBounce,
+    // On the Cornell box against the one-bounce reference (256 VPLs, 4x4 tiles).
+    conformance: Conformance {
+        max_rel_mse: 0.6,
+        mean_ratio: (0.85, 1.05),
+    },
+    prepare: prepare_nothing,
     create,
 };
+
+/// `laine`'s parameters, read once.
+#[derive(Clone, Copy, Debug)]
+pub struct LaineParams {
+    pub max_lights: u32,
+    pub recalc_min: u32,
+    pub recalc_max: u32,
+    pub gather: GatherParams,
+}
+
+impl LaineParams {
+    pub fn from_params(params: &Params) -> Result<LaineParams> {
+        Ok(LaineParams {
+            max_lights: params.int("max-lights") as u32,
+            recalc_min: params.int("recalc-min") as u32,
+            recalc_max: params.int("recalc-max") as u32,
+            gather: GatherParams::from_params(params)?,
+        })
+    }
+}
 
 /// A managed VPL.
 #[derive(Clone, Copy, Debug)]
@@ -115,46 +140,33 @@ pub struct Laine {
     manager: Manager,
 }
 
-fn create(params: &Params, ctx: &PrepareContext) -> Result<Box<dyn Technique>> {
-    let max_lights = params.int("max-lights") as u32;
-    let gather = VplGather::new(params, ctx, max_lights)?;
-    let manager = Manager::new(
-        max_lights,
-        params.int("recalc-min") as u32,
-        params.int("recalc-max") as u32,
-    );
+fn create(params: &Params, ctx: &PrepareContext, _: &Prepared) -> Result<Box<dyn Technique>> {
+    let p = LaineParams::from_params(params)?;
+    let gather = VplGather::new(&p.gather, ctx, p.max_lights, DrawSet::StaticCasters)?;
+    let manager = Manager::new(p.max_lights, p.recalc_min, p.recalc_max);
     Ok(Box::new(Laine { gather, manager }))
 }
 
 fn domain_kind(light: &LightPose) -> DomainKind {
-    if light.kind == LightKind::Omni {
-        DomainKind::Sphere
-    } else {
-        DomainKind::Disc
+    match light.domain() {
+        SampleDomain::Sphere => DomainKind::Sphere,
+        SampleDomain::Disc => DomainKind::Disc,
     }
 }
 
-/// Domain area: π for the disc, 4π for the sphere.
-fn domain_area(kind: DomainKind) -> f64 {
-    match kind {
-        DomainKind::Disc => std::f64::consts::PI,
-        DomainKind::Sphere => 4.0 * std::f64::consts::PI,
-    }
-}
-
-/// Whether a VPL is still lit by the light at its new position (§4.4).
-fn still_valid(bvh: &SceneBvh, light: &LightPose, v: &Vpl) -> bool {
-    let to_vpl = v.position - light.position;
-    // Strictly behind the spot's plane: sampling points on the disc's boundary circle (which the
-    // largest-empty-circle search produces) lie exactly in it and stay valid.
-    let len = to_vpl.length();
-    if light.kind != LightKind::Omni && to_vpl.dot(light.direction) < -1e-5 * len {
+/// Whether a VPL is still lit by the light at its new position (§4.4): in front of a spot's
+/// (or area light's) plane — sampling points on the disc's boundary circle, which the
+/// largest-empty-circle search produces, lie exactly in it and stay valid —, its surface
+/// facing the light, and no static geometry in between.
+fn still_valid(bvh: &SceneBvh, light: &LightPose, v: &Vpl, eps: f32) -> bool {
+    if !light.in_front(v.position) {
         return false;
     }
-    if v.normal.dot(-to_vpl) < -1e-5 * len {
+    let (to_light, _) = light.toward_light(v.position);
+    if v.normal.dot(to_light) < -1e-5 {
         return false;
     }
-    !bvh.occluded(light.position, v.position, 1e-4)
+    light.unoccluded(bvh, v.position, eps)
 }
 
 /// What one frame's management did.
@@ -198,13 +210,16 @@ impl Manager {
     /// §4.4–§4.7 for one frame with the light at `light`.
     pub fn step(&mut self, scene: &Scene, bvh: &SceneBvh, light: LightPose) -> Step {
         let kind = domain_kind(&light);
+        let (extent, eps) = (&scene.extent, scene.extent.ray_epsilon);
         let mut deleted = 0;
         // 1. Validity, and the surviving VPLs' sampling points from the new light position.
         let mut domain = SamplingDomain::new(kind);
         let mut kept = Vec::with_capacity(self.vpls.len());
         for m in self.vpls.drain(..) {
-            let sample = vpl::direction_to_sample(&light, m.vpl.position - light.position);
-            if still_valid(bvh, &light, &m.vpl) && domain.insert(m.id, sample.as_dvec3()).is_ok() {
+            let sample = light.sample_of_point(m.vpl.position, extent);
+            if still_valid(bvh, &light, &m.vpl, eps)
+                && domain.insert(m.id, sample.as_dvec3()).is_ok()
+            {
                 kept.push(Managed {
                     vpl: Vpl { sample, ..m.vpl },
                     ..m
@@ -216,11 +231,9 @@ impl Manager {
         }
         self.vpls = kept;
         // Missed sampling points stay (fixed relative to the light) while their ray still misses.
-        let eps = vpl::ray_epsilon(scene);
         self.misses.retain(|(id, sample)| {
-            let dir = vpl::sample_to_direction(&light, *sample);
-            bvh.closest_hit(light.position, dir, eps, f32::INFINITY)
-                .is_none()
+            let (origin, dir) = light.ray_of_sample(*sample, extent);
+            bvh.closest_hit(origin, dir, eps, f32::INFINITY).is_none()
                 && domain.insert(*id, sample.as_dvec3()).is_ok()
         });
         // 2. Deletion of redundant VPLs until recalc-min slots are free.
@@ -268,8 +281,8 @@ impl Manager {
             }
         }
         // 4. Intensities: Voronoi areas over the domain's area.
-        let total = domain_area(kind);
-        let power = light.power;
+        let total = light.domain().area();
+        let power = light.emitted_flux(extent);
         let areas: std::collections::HashMap<u64, f64> =
             domain.voronoi_areas().into_iter().collect();
         for m in &mut self.vpls {
@@ -287,25 +300,24 @@ impl Manager {
 
 impl Technique for Laine {
     fn render(&mut self, ctx: &mut FrameContext) -> Result<()> {
-        let (scene, bvh, light, queue) = (ctx.scene, ctx.bvh, ctx.frame.light, &ctx.gpu.queue);
-        let (manager, lighting) = (&mut self.manager, &self.gather.lighting);
+        let (scene, bvh, light) = (ctx.scene, ctx.bvh, ctx.frame.light);
+        let manager = &mut self.manager;
         let (step, list) = ctx.profiler.cpu_stage("vpl-management", || {
             let step = manager.step(scene, bvh, light);
-            let list = manager.vpls();
-            for (slot, v) in list
-                .iter()
-                .filter(|(slot, _)| step.new_slots.contains(slot))
-            {
-                lighting.write_view(queue, *slot, v);
-            }
-            (step, list)
+            (step, manager.vpls())
         });
         ctx.profiler
             .count("new-sampling-points", step.created as f64);
         ctx.profiler.count("deleted-vpls", step.deleted as f64);
         ctx.profiler.count("dispersion", self.manager.dispersion());
-        let first = step.new_slots.len() == list.len();
-        self.gather.render_maps(ctx, &step.new_slots, first)?;
+        let new: Vec<(u32, Vpl)> = list
+            .iter()
+            .filter(|(slot, _)| step.new_slots.contains(slot))
+            .copied()
+            .collect();
+        // Only the new VPLs' maps are rendered; every other map is kept.
+        self.gather
+            .render_maps(ctx, &new, AtlasClear::RenderedSlots)?;
         self.gather.gather(ctx, &list)
     }
 

@@ -15,23 +15,34 @@ struct Object {
 };
 
 struct Light {
-    // xyz: position; w: kind (0 spot, 1 omni, 2 area)
+    // xyz: position (the sun: the centre of its disc); w: kind (0 spot, 1 omni, 2 area, 3 sun)
     position: vec4<f32>,
-    // xyz: unit direction (spot axis / area normal)
+    // xyz: unit direction (spot axis / area normal / sun direction); w: the sun's disc radius
     direction: vec4<f32>,
-    // rgb: on-axis radiant intensity (spot/area: Φ/π; omni: Φ/4π)
+    // rgb: on-axis radiant intensity (spot/area: Φ/π; omni: Φ/4π); the sun: irradiance E⊥
     intensity: vec4<f32>,
     // x: shadow map size; y: depth bias (fraction of distance); z: shadow near plane; w: PCF taps per side
     shadow: vec4<f32>,
     faces: array<mat4x4<f32>, 6>,
 };
 
-// Radiant intensity of the primary light towards unit direction `dir_from_light`.
+// Radiant intensity of the primary light towards unit direction `dir_from_light` (the sun:
+// its irradiance E⊥).
 fn light_intensity(light: Light, dir_from_light: vec3<f32>) -> vec3<f32> {
-    if (light.position.w == 1.0) {
+    if (light.position.w == 1.0 || light.position.w == 3.0) {
         return light.intensity.rgb;
     }
     return light.intensity.rgb * max(dot(dir_from_light, light.direction.xyz), 0.0);
+}
+
+// Unit direction from `p` to the primary light (xyz) and its 1/r² factor (w; 1 for the sun).
+fn light_incidence(light: Light, p: vec3<f32>) -> vec4<f32> {
+    if (light.position.w == 3.0) {
+        return vec4<f32>(-light.direction.xyz, 1.0);
+    }
+    let d = light.position.xyz - p;
+    let r2 = max(dot(d, d), 1e-30);
+    return vec4<f32>(d * inverseSqrt(r2), 1.0 / r2);
 }
 
 // Cube-map face whose frustum contains direction `v` (+X, -X, +Y, -Y, +Z, -Z).

@@ -1,6 +1,7 @@
-//! `gibench reproduce`: regenerate the per-stage timing tables of Laine et al. 2007 with the
-//! harness, printing the paper's figures (from `results/papers/laine2007.json`, labelled with
-//! their source) beside ours.
+//! Laine, Saransaari, Kontkanen, Lehtinen and Aila 2007, "Incremental Instant Radiosity for
+//! Real-Time Indirect Illumination": its Tables 1 and 2, the VPL management cost of §6 and the
+//! dispersion of the sampling points, regenerated through the typed run API with the paper's
+//! figures (`results/papers/laine2007.json`, labelled with their source) beside ours.
 //!
 //! * `laine-table1`: per scene × resolution, `laine` and its comparison method `keller-full` on
 //!   the same frames: direct illumination (shadow map + PCF), G-buffer, Σ common (split,
@@ -10,51 +11,61 @@
 //! * `laine-table2`: split, accumulate, combine, filter and Σ common per resolution.
 //! * `laine-management`: VPL management cost on the CPU, spot vs omni, at 256 and 1024 VPLs
 //!   (median and p99 per frame), the figures of the paper's §6.
+//! * `laine-dispersion`: the sampling points' dispersion over the animation.
 //!
 //! Paper sizes (1024×768 and 1600×1200, 256 VPLs with 256² maps, 1000 frames) are the
 //! defaults, for a GPU; `--quick` runs small sizes that finish on a CPU adapter.
 
-use std::path::PathBuf;
-
-use clap::Args;
+use gibench_harness::ir::gather::{COMMON_STAGES, STAGE_VPL_SHADOW_MAPS};
 use gibench_harness::report::{self, Cell, Table};
 use gibench_harness::results::RunResult;
-use gibench_harness::runner::Harness;
+use gibench_harness::runner::{
+    RunConfig, TimingMode, STAGE_DIRECT_LIGHT, STAGE_DIRECT_SHADOW_MAP, STAGE_GBUFFER,
+};
+use gibench_harness::session::{RunSpec, TechniqueRun};
+use gibench_harness::technique::TechniqueInfo;
 use gibench_harness::{Error, Result};
 
-use crate::{announce, open_gpu, plan, progress_bar, run_one, RunArgs};
+use super::{device_note, load_scene, paper_cells, ReproduceArgs, Reproduction};
 
-#[derive(Args)]
-pub struct ReproduceArgs {
-    /// laine-table1, laine-table2, laine-tables (both from one set of runs), laine-management or
-    /// laine-dispersion.
-    pub target: String,
-    /// Small sizes for machines without a GPU: 256x192 and 400x300, 256 VPLs with 128² maps
-    /// (64² on Maze and Sibenik), 12 frames after 2 warm-up frames.
-    #[arg(long)]
-    pub quick: bool,
-    /// Scenes (default: the paper's cornell, maze, sibenik).
-    #[arg(long, value_delimiter = ',')]
-    pub scenes: Vec<String>,
-    /// Output directory.
-    #[arg(long, default_value = "results/laine")]
-    pub out: PathBuf,
-    /// Override the measured frame count (e.g. for a smoke test).
-    #[arg(long)]
-    pub frames: Option<u32>,
-    /// Restrict the adapter to one backend.
-    #[arg(long, env = "GIBENCH_BACKEND")]
-    pub backend: Option<String>,
-    /// Use the adapter whose name contains this.
-    #[arg(long, env = "GIBENCH_ADAPTER")]
-    pub adapter: Option<String>,
+/// The targets of this paper.
+pub const TARGETS: &[&str] = &[
+    "laine-table1",
+    "laine-table2",
+    "laine-tables",
+    "laine-management",
+    "laine-dispersion",
+];
+
+/// Regenerates `target` (one of [`TARGETS`]).
+pub fn reproduce(target: &str, args: &ReproduceArgs) -> Result<Vec<Reproduction>> {
+    Ok(match target {
+        "laine-table1" => vec![(table1(&run_pairs(args)?)?, "laine-table1")],
+        "laine-table2" => vec![(table2(&run_pairs(args)?)?, "laine-table2")],
+        "laine-tables" => {
+            let pairs = run_pairs(args)?;
+            vec![
+                (table1(&pairs)?, "laine-table1"),
+                (table2(&pairs)?, "laine-table2"),
+            ]
+        }
+        "laine-management" => vec![(management(args)?, "laine-management")],
+        "laine-dispersion" => vec![(dispersion(args)?, "laine-dispersion")],
+        other => {
+            return Err(Error::param(
+                "target",
+                format!("not a Laine 2007 target: '{other}'"),
+            ))
+        }
+    })
 }
 
 /// The paper's published figures.
 fn paper() -> Result<serde_json::Value> {
-    let text = include_str!("../results/papers/laine2007.json");
-    serde_json::from_str(text)
-        .map_err(|e| Error::Invalid(format!("results/papers/laine2007.json: {e}")))
+    super::paper(
+        "laine2007",
+        include_str!("../../results/papers/laine2007.json"),
+    )
 }
 
 struct Sizes {
@@ -79,21 +90,17 @@ fn sizes(quick: bool) -> Sizes {
     }
 }
 
-/// VPL settings per scene: the paper's 256 VPLs with 256² maps, or quick ones.
-fn vpl_params(scene: &str, quick: bool) -> Vec<String> {
-    let (vpls, size) = match (quick, scene) {
-        (false, _) => (256, 256),
-        (true, "sibenik" | "maze") => (256, 64),
-        (true, _) => (256, 128),
-    };
-    vec![
-        format!("keller-full.vpls={vpls}"),
-        format!("laine.max-lights={vpls}"),
-        format!("shadow-size={size}"),
-        "tiles=4x4".into(),
-        "depth-bits=16".into(),
-    ]
+/// VPL map size per scene: the paper's 256², or quick ones.
+fn map_size(scene: &str, quick: bool) -> u32 {
+    match (quick, scene) {
+        (false, _) => 256,
+        (true, "sibenik" | "maze") => 64,
+        (true, _) => 128,
+    }
 }
+
+/// The paper's VPL count.
+const VPLS: u32 = 256;
 
 /// One table row's runs: (scene, resolution, `laine` result, `keller-full` result).
 type Pair = (String, [u32; 2], RunResult, RunResult);
@@ -110,51 +117,65 @@ fn run_pairs(args: &ReproduceArgs) -> Result<Vec<Pair>> {
     } else {
         args.scenes.clone()
     };
-    let shadow = if args.quick { 256 } else { 1024 };
-    let mut out = Vec::new();
-    for scene in &scenes {
+    let shadow_size = if args.quick { 256 } else { 1024 };
+    let laine = TechniqueInfo::find(crate::registry::all(), "laine")?;
+    let keller = TechniqueInfo::find(crate::registry::all(), "keller-full")?;
+    // Everything that can be checked is checked before the first frame.
+    let loaded = scenes
+        .iter()
+        .map(|name| load_scene(name, args))
+        .collect::<Result<Vec<_>>>()?;
+    let mut specs = Vec::new();
+    for (name, scene) in scenes.iter().zip(&loaded) {
+        let size = map_size(name, args.quick).to_string();
+        let vpls = VPLS.to_string();
+        let gather = [
+            ("vpl-map-size", size.as_str()),
+            ("tiles", "4x4"),
+            ("depth-bits", "16"),
+        ];
         for res in &s.resolutions {
-            let mut argv: Vec<String> = vec!["gibench".into(), "--scene".into(), scene.clone()];
-            argv.extend(["--technique", "laine,keller-full"].map(String::from));
-            argv.extend(["--resolution".into(), format!("{}x{}", res[0], res[1])]);
-            argv.extend([
-                "--frames".into(),
-                s.frames.to_string(),
-                "--warmup".into(),
-                s.warmup.to_string(),
-            ]);
-            argv.extend([
-                "--shadow-size".into(),
-                shadow.to_string(),
-                "--no-images".into(),
-            ]);
-            argv.extend(["--out".into(), args.out.join("runs").display().to_string()]);
-            for p in vpl_params(scene, args.quick) {
-                argv.extend(["--param".into(), p]);
-            }
-            if let Some(b) = &args.backend {
-                argv.extend(["--backend".into(), b.clone()]);
-            }
-            if let Some(a) = &args.adapter {
-                argv.extend(["--adapter".into(), a.clone()]);
-            }
-            let run_args = RunArgs::parse_args(argv);
-            let p = plan(&run_args, &[])?;
-            let gpu = open_gpu(&run_args)?;
-            let harness = Harness::new(&gpu, &p.scene, &p.config)?;
-            announce(&p, &gpu);
-            let bar = progress_bar(&run_args, &p, 2);
-            let mut results = Vec::new();
-            for (info, params) in p.techniques.iter().zip(&p.params) {
-                bar.set_message(info.name.to_string());
-                let stem = format!("{}-{}-{}x{}", p.desc.name, info.name, res[0], res[1]);
-                results.push(run_one(&run_args, &p, &harness, info, params, &stem, &bar)?);
-            }
-            bar.finish_and_clear();
-            let keller = results.pop().expect("two runs");
-            let laine = results.pop().expect("two runs");
-            out.push((scene.clone(), *res, laine, keller));
+            let stem = |t: &str| format!("{}-{t}-{}x{}", scene.descriptor.name, res[0], res[1]);
+            let mut lp = vec![("max-lights", vpls.as_str())];
+            lp.extend(gather);
+            let mut kp = vec![("vpls", vpls.as_str())];
+            kp.extend(gather);
+            specs.push((
+                name.clone(),
+                *res,
+                RunSpec {
+                    scene,
+                    runs: vec![
+                        TechniqueRun::new(laine, &lp, stem(laine.name))?,
+                        TechniqueRun::new(keller, &kp, stem(keller.name))?,
+                    ],
+                    config: RunConfig {
+                        resolution: *res,
+                        frames: s.frames,
+                        warmup: s.warmup,
+                        first_frame: 0,
+                        timing: TimingMode::Both,
+                        seed: 1,
+                        shadow_size,
+                    },
+                    quality: None,
+                    cache: Default::default(),
+                    out: args.out.join("runs"),
+                    images: false,
+                },
+            ));
         }
+    }
+    for (_, _, spec) in &specs {
+        spec.validate()?;
+    }
+    let gpu = super::open_gpu(args)?;
+    let mut out = Vec::new();
+    for (name, res, spec) in &specs {
+        let mut results = crate::execute_with_bar(args.quiet, &gpu, spec)?;
+        let keller = results.pop().expect("two runs");
+        let laine = results.pop().expect("two runs");
+        out.push((name.clone(), *res, laine, keller));
     }
     Ok(out)
 }
@@ -165,33 +186,6 @@ fn ms(r: &RunResult, stage: &str) -> Option<f64> {
 
 fn sum(r: &RunResult, stages: &[&str]) -> Option<f64> {
     stages.iter().map(|s| ms(r, s)).sum()
-}
-
-const COMMON: [&str; 4] = ["split", "accumulate", "combine", "filter"];
-
-fn device_note(runs: &[&RunResult]) -> String {
-    let mut devices: Vec<String> = runs
-        .iter()
-        .map(|r| {
-            format!(
-                "{} ({}, driver {})",
-                r.device.adapter, r.device.backend, r.device.driver
-            )
-        })
-        .collect();
-    devices.dedup();
-    format!(
-        "Ours: {}; git {}.",
-        devices.join("; "),
-        runs.first().map(|r| r.git_commit.as_str()).unwrap_or("?")
-    )
-}
-
-fn paper_cells(values: &serde_json::Value) -> Vec<Cell> {
-    values
-        .as_array()
-        .map(|a| a.iter().map(|v| Cell::Num(v.as_f64(), 1)).collect())
-        .unwrap_or_default()
 }
 
 fn table1(pairs: &[Pair]) -> Result<Table> {
@@ -214,7 +208,7 @@ fn table1(pairs: &[Pair]) -> Result<Table> {
     );
     let mut rows = Vec::new();
     for (scene, res, laine, keller) in pairs {
-        let direct = sum(laine, &["direct-shadow-map", "direct-light"]);
+        let direct = sum(laine, &[STAGE_DIRECT_SHADOW_MAP, STAGE_DIRECT_LIGHT]);
         let fps = |r: &RunResult| r.frame.as_ref().map(|f| f.fps);
         let (fc, fo) = (fps(keller), fps(laine));
         let speedup_indirect = match (fc, fo, direct) {
@@ -227,10 +221,10 @@ fn table1(pairs: &[Pair]) -> Result<Table> {
             Cell::text(scene),
             Cell::text(format!("{}x{}", res[0], res[1])),
             Cell::Ms(direct),
-            Cell::Ms(ms(laine, "gbuffer")),
-            Cell::Ms(sum(laine, &COMMON)),
-            Cell::Ms(ms(laine, "vpl-shadow-maps")),
-            Cell::Ms(ms(keller, "vpl-shadow-maps")),
+            Cell::Ms(ms(laine, STAGE_GBUFFER)),
+            Cell::Ms(sum(laine, &COMMON_STAGES)),
+            Cell::Ms(ms(laine, STAGE_VPL_SHADOW_MAPS)),
+            Cell::Ms(ms(keller, STAGE_VPL_SHADOW_MAPS)),
             Cell::Ms(ms(laine, "vpl-management")),
             Cell::Num(fc, 1),
             Cell::Num(fo, 1),
@@ -301,8 +295,8 @@ fn table2(pairs: &[Pair]) -> Result<Table> {
             Cell::text(scene),
             Cell::text(format!("{}x{}", res[0], res[1])),
         ];
-        row.extend(COMMON.iter().map(|s| Cell::Ms(ms(laine, s))));
-        row.push(Cell::Ms(sum(laine, &COMMON)));
+        row.extend(COMMON_STAGES.iter().map(|s| Cell::Ms(ms(laine, s))));
+        row.push(Cell::Ms(sum(laine, &COMMON_STAGES)));
         rows.push(row);
         if !seen.contains(res) {
             seen.push(*res);
@@ -341,27 +335,24 @@ fn table2(pairs: &[Pair]) -> Result<Table> {
     })
 }
 
-/// The scene a CPU-only target runs on (the first `--scenes` entry, else `default`), with its
-/// descriptor and the BVH of its static geometry.
+/// The scene a CPU-only target runs on (the first `--scenes` entry, else `default`) and the
+/// BVH of its static geometry.
 fn cpu_scene(
     args: &ReproduceArgs,
     default: &str,
 ) -> Result<(
     String,
-    gibench_harness::scene::SceneDescriptor,
     gibench_harness::scene::Scene,
     gibench_harness::bvh::SceneBvh,
 )> {
-    use gibench_harness::scene::{Scene, SceneDescriptor};
     let name = args
         .scenes
         .first()
         .cloned()
         .unwrap_or_else(|| default.to_string());
-    let desc = SceneDescriptor::resolve(&name)?;
-    let scene = Scene::load(&desc, &gibench_harness::assets::AssetPaths::standard(None))?;
+    let scene = load_scene(&name, args)?;
     let bvh = gibench_harness::bvh::SceneBvh::new(&scene.mesh);
-    Ok((name, desc, scene, bvh))
+    Ok((name, scene, bvh))
 }
 
 /// VPL management cost per frame on the CPU (spot and omni, 256 and 1024 VPLs) on Sibenik's
@@ -371,12 +362,12 @@ fn management(args: &ReproduceArgs) -> Result<Table> {
     use gibench_harness::scene::descriptor::LightKind;
     use gibench_harness::stats::Stats;
     let frames = args.frames.unwrap_or(if args.quick { 100 } else { 1000 });
-    let (name, desc, scene, bvh) = cpu_scene(args, "sibenik")?;
+    let (name, scene, bvh) = cpu_scene(args, "sibenik")?;
     let paper = paper()?;
     let mut rows = Vec::new();
     let mut records = serde_json::Map::new();
     for kind in [LightKind::Spot, LightKind::Omni] {
-        let mut d = desc.clone();
+        let mut d = scene.descriptor.clone();
         d.light.kind = kind;
         let clock = FrameClock::new(&d);
         for vpls in [256u32, 1024] {
@@ -443,12 +434,12 @@ fn dispersion(args: &ReproduceArgs) -> Result<Table> {
     use gibench_harness::scene::descriptor::LightKind;
     use gibench_harness::stats::Stats;
     let frames = args.frames.unwrap_or(if args.quick { 120 } else { 600 });
-    let (name, desc, scene, bvh) = cpu_scene(args, "cornell")?;
+    let (name, scene, bvh) = cpu_scene(args, "cornell")?;
     let mut lines = Vec::new();
     let mut rows = Vec::new();
     let mut records = serde_json::Map::new();
     for kind in [LightKind::Spot, LightKind::Omni] {
-        let mut d = desc.clone();
+        let mut d = scene.descriptor.clone();
         d.light.kind = kind;
         let clock = FrameClock::new(&d);
         for moving in [true, false] {
@@ -502,39 +493,4 @@ fn dispersion(args: &ReproduceArgs) -> Result<Table> {
                 .into(),
         ],
     })
-}
-
-pub fn reproduce(args: &ReproduceArgs) -> Result<()> {
-    let tables = match args.target.as_str() {
-        "laine-table1" => vec![(table1(&run_pairs(args)?)?, "laine-table1")],
-        "laine-table2" => vec![(table2(&run_pairs(args)?)?, "laine-table2")],
-        "laine-tables" => {
-            let pairs = run_pairs(args)?;
-            vec![(table1(&pairs)?, "laine-table1"), (table2(&pairs)?, "laine-table2")]
-        }
-        "laine-management" => vec![(management(args)?, "laine-management")],
-        "laine-dispersion" => vec![(dispersion(args)?, "laine-dispersion")],
-        other => {
-            return Err(Error::param(
-                "target",
-                format!(
-                    "unknown target '{other}'; expected laine-table1, laine-table2, laine-tables (both from one set of \
-                     runs), laine-management or laine-dispersion"
-                ),
-            ))
-        }
-    };
-    for (table, stem) in tables {
-        println!("{}", table.to_terminal());
-        let written = report::write_tables(&table, &args.out, stem)?;
-        eprintln!(
-            "wrote {}",
-            written
-                .iter()
-                .map(|p| p.display().to_string())
-                .collect::<Vec<_>>()
-                .join(", ")
-        );
-    }
-    Ok(())
 }

@@ -42,10 +42,10 @@ use bytemuck::{Pod, Zeroable};
 use crate::gpu::GpuContext;
 use crate::{Error, Result};
 
-use super::{shader_module, uniform_entry, GBuffer, HDR_FORMAT};
+use crate::passes::{shader_module, uniform_entry, GBuffer, HDR_FORMAT};
 
 /// WGSL declarations a technique prepends to its accumulate shader (after `common.wgsl`, which
-/// [`super::shader_module`] adds): `struct InterleaveParams { full, tiles, tile_size, split:
+/// [`crate::passes::shader_module`] adds): `struct InterleaveParams { full, tiles, tile_size, split:
 /// vec2<u32>, thresholds: vec4<f32> }`, the group-0 bindings `interleave`, `split_position`,
 /// `split_normal`, `split_irradiance`, and the helpers `split_in_range`, `split_index`,
 /// `split_tile`, `split_original_pixel`, `split_valid` and `split_texel_of_pixel`.

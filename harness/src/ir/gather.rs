@@ -1,0 +1,203 @@
+//! **Gather**: the kit wired for the common case — a CPU-managed VPL list, a rasterised depth
+//! atlas of the static shadow casters, interleaved accumulation and the geometry-aware filter —
+//! built from one set of named parameters ([`GATHER_PARAMS`], parsed once into
+//! [`GatherParams`]) and recorded as the same profiler stages by every technique that uses it
+//! (`keller-full`, `keller-incremental`, `laine`).
+//!
+//! Reads: the technique's VPLs (slot, [`Vpl`]), the G-buffer, the scene.
+//! Writes: the technique's indirect-irradiance output (Rgba16Float, the G-buffer's size).
+//! Stages: [`STAGE_VPL_SHADOW_MAPS`], [`STAGE_SPLIT`], [`STAGE_ACCUMULATE`],
+//! [`STAGE_COMBINE`], [`STAGE_FILTER`]; counters `shadow-maps` and `vpls`.
+
+use super::accumulate::Accumulation;
+use super::atlas::{AtlasFormat, AtlasSettings, MapKind, ShadowAtlas};
+use super::interleave::{FilterSettings, Interleave};
+use super::raster::{AtlasClear, AtlasRasteriser};
+use super::store::VplStore;
+use crate::passes::DrawSet;
+use crate::technique::{FrameContext, ParamKind, ParamSpec, Params, PrepareContext};
+use crate::vpl::Vpl;
+use crate::Result;
+
+/// Stage: rendering VPL maps (view upload included).
+pub const STAGE_VPL_SHADOW_MAPS: &str = "vpl-shadow-maps";
+/// Stage: splitting the G-buffer into tiles.
+pub const STAGE_SPLIT: &str = "split";
+/// Stage: accumulating VPL irradiance per tile.
+pub const STAGE_ACCUMULATE: &str = "accumulate";
+/// Stage: combining the tiles back.
+pub const STAGE_COMBINE: &str = "combine";
+/// Stage: the geometry-aware filter.
+pub const STAGE_FILTER: &str = "filter";
+/// The gathering stages Laine et al. 2007's Table 2 sums as "Σ common", in order.
+pub const COMMON_STAGES: [&str; 4] = [STAGE_SPLIT, STAGE_ACCUMULATE, STAGE_COMBINE, STAGE_FILTER];
+
+/// Parameters of every VPL technique's gathering.
+pub const GATHER_PARAMS: &[ParamSpec] = &[
+    ParamSpec {
+        name: "tiles",
+        kind: ParamKind::Tiles,
+        default: "4x4",
+        doc: "interleaved-sampling tiles NxM (Laine: 4x4); 1x1 = no interleaving",
+    },
+    ParamSpec {
+        name: "vpl-map",
+        kind: ParamKind::Choice(MapKind::NAMES),
+        default: "paraboloid",
+        doc: "VPL shadow-map parameterisation",
+    },
+    ParamSpec {
+        name: "vpl-map-size",
+        kind: ParamKind::Int { min: 8, max: 4096 },
+        default: "128",
+        doc: "VPL shadow-map edge in texels (Laine: 256)",
+    },
+    ParamSpec {
+        name: "depth-bits",
+        kind: ParamKind::Choice(&["16", "32"]),
+        default: "16",
+        doc: "VPL shadow-map depth format: 16 (Laine) or 32",
+    },
+    ParamSpec {
+        name: "clamp",
+        kind: ParamKind::Float { min: 0.0, max: 1.0 },
+        default: "0.02",
+        doc: "minimum VPL-receiver distance in 1/r^2, as a fraction of the scene's bounding-box diagonal",
+    },
+];
+
+/// [`GATHER_PARAMS`], parsed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GatherParams {
+    pub tiles: (u32, u32),
+    pub map: MapKind,
+    pub map_size: u32,
+    pub format: AtlasFormat,
+    /// Fraction of the scene diagonal.
+    pub clamp: f32,
+}
+
+impl GatherParams {
+    /// Reads the gather parameters (declared with [`GATHER_PARAMS`]) from `params`.
+    pub fn from_params(params: &Params) -> Result<GatherParams> {
+        Ok(GatherParams {
+            tiles: params.tiles("tiles"),
+            map: MapKind::parse(params.choice("vpl-map"))?,
+            map_size: params.int("vpl-map-size") as u32,
+            format: AtlasFormat::from_depth_bits(params.choice("depth-bits").parse().unwrap_or(0))?,
+            clamp: params.float("clamp") as f32,
+        })
+    }
+}
+
+/// The common-case gather (see the module docs).
+pub struct VplGather {
+    /// Kept alive for the view and the filter's storage binding.
+    _output: wgpu::Texture,
+    view: wgpu::TextureView,
+    pub interleave: Interleave,
+    pub store: VplStore,
+    pub atlas: ShadowAtlas,
+    pub raster: AtlasRasteriser,
+    pub accumulation: Accumulation,
+}
+
+impl VplGather {
+    /// Builds the gather for at most `capacity` VPLs with `settings`, rasterising `draw_set`.
+    pub fn new(
+        settings: &GatherParams,
+        ctx: &PrepareContext,
+        capacity: u32,
+        draw_set: DrawSet,
+    ) -> Result<VplGather> {
+        let gpu = ctx.gpu;
+        let output = crate::passes::indirect_target(&gpu.device, ctx.resolution, true);
+        let scene_settings = &ctx.scene.descriptor.settings;
+        let interleave = Interleave::new(
+            gpu,
+            ctx.gbuffer,
+            settings.tiles,
+            FilterSettings {
+                alpha: scene_settings.filter_distance,
+                beta: scene_settings.filter_normal,
+            },
+            &output,
+        )?;
+        let store = VplStore::new(gpu, capacity)?;
+        let atlas = ShadowAtlas::new(
+            gpu,
+            &ctx.scene.extent,
+            AtlasSettings {
+                kind: settings.map,
+                format: settings.format,
+                size: settings.map_size,
+                capacity,
+                bias: scene_settings.shadow_bias,
+            },
+        )?;
+        let raster = AtlasRasteriser::new(gpu, &atlas, ctx.uniforms, draw_set)?;
+        let accumulation = Accumulation::new(
+            gpu,
+            &interleave,
+            &store,
+            &atlas,
+            settings.clamp * ctx.scene.extent.diagonal,
+        )?;
+        let view = output.create_view(&Default::default());
+        Ok(VplGather {
+            _output: output,
+            view,
+            interleave,
+            store,
+            atlas,
+            raster,
+            accumulation,
+        })
+    }
+
+    /// Records the maps of `vpls` (slot, VPL) as the `vpl-shadow-maps` stage (views uploaded
+    /// inside it) and counts them as `shadow-maps`.
+    pub fn render_maps(
+        &self,
+        ctx: &mut FrameContext,
+        vpls: &[(u32, Vpl)],
+        clear: AtlasClear,
+    ) -> Result<()> {
+        let (gpu, scene, uniforms) = (ctx.gpu, ctx.gpu_scene, ctx.uniforms);
+        let n = ctx.profiler.gpu_stage(gpu, STAGE_VPL_SHADOW_MAPS, |enc| {
+            self.raster
+                .render(gpu, enc, &self.atlas, scene, uniforms, vpls, clear)
+        })?;
+        ctx.profiler.count("shadow-maps", n as f64);
+        Ok(())
+    }
+
+    /// Uploads `vpls` (slot, VPL) into the store and records the gathering stages.
+    pub fn gather(&self, ctx: &mut FrameContext, vpls: &[(u32, Vpl)]) -> Result<()> {
+        self.store.write(&ctx.gpu.queue, vpls);
+        ctx.profiler.count("vpls", vpls.len() as f64);
+        self.gather_store(ctx)
+    }
+
+    /// Records split, accumulate, combine and filter over the store as it is (filled by the
+    /// CPU or by a GPU pass earlier in the frame).
+    pub fn gather_store(&self, ctx: &mut FrameContext) -> Result<()> {
+        let gpu = ctx.gpu;
+        let il = &self.interleave;
+        ctx.profiler
+            .gpu_stage(gpu, STAGE_SPLIT, |enc| il.encode_split(enc))?;
+        ctx.profiler.gpu_stage(gpu, STAGE_ACCUMULATE, |enc| {
+            self.accumulation.encode(enc, il, &self.atlas)
+        })?;
+        ctx.profiler
+            .gpu_stage(gpu, STAGE_COMBINE, |enc| il.encode_combine(enc))?;
+        ctx.profiler
+            .gpu_stage(gpu, STAGE_FILTER, |enc| il.encode_filter(enc))?;
+        Ok(())
+    }
+
+    /// The indirect-irradiance output.
+    pub fn output(&self) -> &wgpu::TextureView {
+        &self.view
+    }
+}

@@ -1,0 +1,38 @@
+//! # The instant-radiosity kit
+//!
+//! The parts every VPL technique composes, each owning what it reads and writes (documented at
+//! the top of its file), wired by a few lines in the technique — no render graph:
+//!
+//! ```text
+//!  VPLs (CPU list, or a GPU pass)        scene meshes (DrawSet)
+//!        │                                     │
+//!        ▼                                     ▼
+//!   ┌──────────┐   slot, VPL views     ┌────────────────┐
+//!   │ VplStore │ ───────────────────▶  │ AtlasRasteriser│ ──▶ ┌─────────────┐
+//!   └──────────┘                       └────────────────┘     │ ShadowAtlas │ ◀── other writers
+//!        │                                                    └─────────────┘     (point splats,
+//!        │             G-buffer ──▶ Interleave::split               │              pull-push)
+//!        │                               │                          │
+//!        └──────────────▶  Accumulation  ◀──────────────────────────┘
+//!                               │ split irradiance
+//!                               ▼
+//!                 Interleave::combine ──▶ Interleave::filter ──▶ indirect irradiance
+//! ```
+//!
+//! * [`store::VplStore`] — slot-indexed VPLs on the GPU, written by the CPU or a GPU pass.
+//! * [`atlas::ShadowAtlas`] — one visibility map per slot (paraboloid or cube; 16/32-bit depth
+//!   or a 32-bit float texture), its parameters and its WGSL lookup.
+//! * [`raster::AtlasRasteriser`] — renders chosen slots of a depth atlas from a
+//!   [`DrawSet`](crate::passes::DrawSet), uploading its own views.
+//! * [`interleave::Interleave`] — split, combine and the geometry-aware filter (Laine et al.
+//!   2007 §5).
+//! * [`accumulate::Accumulation`] — a store and an atlas through the interleaving.
+//! * [`gather::VplGather`] — the common case wired: CPU list, rasterised static casters,
+//!   interleaved gathering, with the shared parameters and stage names.
+
+pub mod accumulate;
+pub mod atlas;
+pub mod gather;
+pub mod interleave;
+pub mod raster;
+pub mod store;

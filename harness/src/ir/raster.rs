@@ -1,0 +1,268 @@
+//! **Atlas rasteriser**: renders chosen slots of a depth [`ShadowAtlas`] from a chosen
+//! [`DrawSet`] by triangle rasterisation.
+//!
+//! Reads: the VPLs of the slots to render, the scene's meshes ([`GpuScene`]) and object
+//! transforms ([`FrameUniforms`]).
+//! Writes: its own per-slot view uniforms (uploaded inside the call, so their cost is part of
+//! the caller's `vpl-shadow-maps` stage) and those slots' blocks of the atlas. With
+//! [`AtlasClear::Whole`] the whole atlas is cleared first (every map empty); with
+//! [`AtlasClear::RenderedSlots`] only the rendered slots' blocks are cleared, and every other
+//! map is kept as it was.
+//!
+//! Paraboloid maps are rendered with the VPL's frame in the vertex shader (Brabec et al. 2002)
+//! and back-hemisphere fragments discarded; cube maps with one 90° view per face.
+
+use bytemuck::{Pod, Zeroable};
+use glam::Mat4;
+
+use super::atlas::{MapKind, ShadowAtlas};
+use crate::gpu::GpuContext;
+use crate::passes::{
+    cube_face_matrix, shader_module, uniform_entry, DrawSet, FrameUniforms, GpuScene, Vertex,
+};
+use crate::vpl::{frame_from_normal, Vpl};
+use crate::{Error, Result};
+
+/// What the rasteriser clears before rendering.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AtlasClear {
+    /// The whole atlas (every map not rendered now becomes empty).
+    Whole,
+    /// Only the blocks of the slots rendered now; other maps are kept.
+    RenderedSlots,
+}
+
+/// GPU layout of `VplView` in `vpl_shadow.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct ViewData {
+    view_proj: [f32; 16],
+    position: [f32; 4],
+    tangent: [f32; 4],
+    bitangent: [f32; 4],
+    normal: [f32; 4],
+}
+
+/// Uniform slots are this far apart (the largest minimum dynamic-offset alignment in practice).
+const VIEW_STRIDE: u64 = 256;
+
+/// Renders VPL maps into a depth atlas (see the module docs).
+pub struct AtlasRasteriser {
+    kind: MapKind,
+    draw_set: DrawSet,
+    capacity: u32,
+    view_buffer: wgpu::Buffer,
+    view_group: wgpu::BindGroup,
+    map_pipeline: wgpu::RenderPipeline,
+    clear_pipeline: wgpu::RenderPipeline,
+}
+
+impl AtlasRasteriser {
+    /// A rasteriser for `atlas` (which must have a depth format) drawing `draw_set`.
+    pub fn new(
+        gpu: &GpuContext,
+        atlas: &ShadowAtlas,
+        uniforms: &FrameUniforms,
+        draw_set: DrawSet,
+    ) -> Result<AtlasRasteriser> {
+        let device = &gpu.device;
+        let settings = atlas.settings;
+        if !settings.format.is_depth() {
+            return Err(Error::Invalid(format!(
+                "the atlas rasteriser renders depth atlases; this atlas is {:?}",
+                settings.format
+            )));
+        }
+        let format = settings.format.texture_format();
+        let faces = settings.kind.faces() as u64;
+        let view_buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("vpl views"),
+            size: settings.capacity as u64 * faces * VIEW_STRIDE,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let view_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("vpl view"),
+            entries: &[uniform_entry(0, wgpu::ShaderStages::VERTEX_FRAGMENT, true)],
+        });
+        let view_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("vpl views"),
+            layout: &view_layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer: &view_buffer,
+                    offset: 0,
+                    size: wgpu::BufferSize::new(std::mem::size_of::<ViewData>() as u64),
+                }),
+            }],
+        });
+        let module = shader_module(
+            device,
+            "vpl shadow maps",
+            include_str!("shaders/vpl_shadow.wgsl"),
+        );
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("vpl shadow maps"),
+            bind_group_layouts: &[Some(&view_layout), Some(&uniforms.object_layout)],
+            immediate_size: 0,
+        });
+        let position_only = wgpu::VertexBufferLayout {
+            array_stride: std::mem::size_of::<Vertex>() as u64,
+            step_mode: wgpu::VertexStepMode::Vertex,
+            attributes: &wgpu::vertex_attr_array![0 => Float32x3],
+        };
+        let depth_state = |compare| wgpu::DepthStencilState {
+            format,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(compare),
+            stencil: Default::default(),
+            bias: Default::default(),
+        };
+        let (vs, fs) = match settings.kind {
+            MapKind::Paraboloid => ("vs_paraboloid", Some("fs_paraboloid")),
+            MapKind::Cube => ("vs_cube", None),
+        };
+        let map_pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("vpl shadow map"),
+            layout: Some(&layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some(vs),
+                compilation_options: Default::default(),
+                buffers: &[Some(position_only.clone())],
+            },
+            primitive: wgpu::PrimitiveState::default(),
+            depth_stencil: Some(depth_state(wgpu::CompareFunction::Greater)),
+            multisample: Default::default(),
+            fragment: fs.map(|entry| wgpu::FragmentState {
+                module: &module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                targets: &[],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        let clear_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("vpl tile clear"),
+            bind_group_layouts: &[],
+            immediate_size: 0,
+        });
+        let clear_pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("vpl tile clear"),
+            layout: Some(&clear_layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_clear"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: wgpu::PrimitiveState::default(),
+            depth_stencil: Some(depth_state(wgpu::CompareFunction::Always)),
+            multisample: Default::default(),
+            fragment: None,
+            multiview_mask: None,
+            cache: None,
+        });
+        gpu.check_errors()?;
+        Ok(AtlasRasteriser {
+            kind: settings.kind,
+            draw_set,
+            capacity: settings.capacity,
+            view_buffer,
+            view_group,
+            map_pipeline,
+            clear_pipeline,
+        })
+    }
+
+    /// Uploads the view(s) of `vpl` for `slot`.
+    fn write_view(&self, queue: &wgpu::Queue, atlas: &ShadowAtlas, slot: u32, vpl: &Vpl) {
+        let (t, b) = frame_from_normal(vpl.normal);
+        let eye = vpl.position + vpl.normal * atlas.lift;
+        let faces = self.kind.faces() as usize;
+        let mut bytes = vec![0u8; faces * VIEW_STRIDE as usize];
+        for f in 0..faces {
+            let view_proj = match self.kind {
+                MapKind::Cube => cube_face_matrix(eye, f, atlas.near),
+                MapKind::Paraboloid => Mat4::IDENTITY,
+            };
+            let d = ViewData {
+                view_proj: view_proj.to_cols_array(),
+                position: eye.extend(atlas.far).to_array(),
+                tangent: t.extend(0.0).to_array(),
+                bitangent: b.extend(0.0).to_array(),
+                normal: vpl.normal.extend(0.0).to_array(),
+            };
+            let o = f * VIEW_STRIDE as usize;
+            bytes[o..o + std::mem::size_of::<ViewData>()].copy_from_slice(bytemuck::bytes_of(&d));
+        }
+        queue.write_buffer(
+            &self.view_buffer,
+            slot as u64 * faces as u64 * VIEW_STRIDE,
+            &bytes,
+        );
+    }
+
+    /// Uploads the views of `vpls` (slot, VPL) and records their maps into `atlas` after the
+    /// clear `clear` asks for. Slots beyond the capacity are skipped. Returns the number of
+    /// maps rendered.
+    #[allow(clippy::too_many_arguments)]
+    pub fn render(
+        &self,
+        gpu: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        atlas: &ShadowAtlas,
+        scene: &GpuScene,
+        uniforms: &FrameUniforms,
+        vpls: &[(u32, Vpl)],
+        clear: AtlasClear,
+    ) -> u32 {
+        let vpls: Vec<&(u32, Vpl)> = vpls.iter().filter(|(s, _)| *s < self.capacity).collect();
+        for (slot, vpl) in &vpls {
+            self.write_view(&gpu.queue, atlas, *slot, vpl);
+        }
+        let load = match clear {
+            AtlasClear::Whole => wgpu::LoadOp::Clear(0.0),
+            AtlasClear::RenderedSlots => wgpu::LoadOp::Load,
+        };
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("vpl shadow maps"),
+            color_attachments: &[],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: atlas.view(),
+                depth_ops: Some(wgpu::Operations {
+                    load,
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        let s = atlas.settings.size;
+        let faces = self.kind.faces();
+        for (slot, _) in &vpls {
+            let slot = *slot;
+            if clear == AtlasClear::RenderedSlots {
+                let ([x, y], [w, h]) = atlas.block(slot);
+                pass.set_viewport(x as f32, y as f32, w as f32, h as f32, 0.0, 1.0);
+                pass.set_scissor_rect(x, y, w, h);
+                pass.set_pipeline(&self.clear_pipeline);
+                pass.draw(0..3, 0..1);
+            }
+            pass.set_pipeline(&self.map_pipeline);
+            for f in 0..faces {
+                let [x, y] = atlas.face_origin(slot, f);
+                pass.set_viewport(x as f32, y as f32, s as f32, s as f32, 0.0, 1.0);
+                pass.set_scissor_rect(x, y, s, s);
+                let offset = ((slot * faces + f) as u64 * VIEW_STRIDE) as u32;
+                pass.set_bind_group(0, &self.view_group, &[offset]);
+                scene.draw(&mut pass, uniforms, 1, self.draw_set);
+            }
+        }
+        vpls.len() as u32
+    }
+}

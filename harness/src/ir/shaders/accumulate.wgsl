@@ -1,0 +1,52 @@
+// Interleaved accumulation of VPL irradiance (Laine et al. 2007, Section 5.1): every texel of
+// the split G-buffer gathers from the VPLs assigned to its tile (the VPL in slot k goes to tile
+// k mod T) with a visibility lookup each. Each tile sees 1/T of the VPLs, so its sum is scaled
+// by T: after the n x m filter averages the T tiles, every pixel has the full estimate.
+// Prepended: INTERLEAVE_WGSL (group 0), the store (group 1, binding 0), the atlas (group 2).
+
+struct AccumulateParams {
+    // x: minimum VPL-receiver distance in 1/r^2 (the clamp of the singularity)
+    distances: vec4<f32>,
+};
+
+@group(1) @binding(1) var<uniform> accumulate_params: AccumulateParams;
+
+// Irradiance at `p` (unit normal `n`) from VPL `v`, including visibility.
+fn vpl_irradiance(v: GpuVpl, p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    // Empty slots carry no flux: skip them before any lookup.
+    if (all(v.flux.rgb == vec3<f32>(0.0))) {
+        return vec3<f32>(0.0);
+    }
+    let d = p - v.position.xyz;
+    let r2 = dot(d, d);
+    let dir = d * inverseSqrt(max(r2, 1e-30));
+    let cos_v = dot(v.normal.xyz, dir);
+    let cos_r = -dot(n, dir);
+    if (cos_v <= 0.0 || cos_r <= 0.0) {
+        return vec3<f32>(0.0);
+    }
+    let min_d = accumulate_params.distances.x;
+    let g = cos_v * cos_r / max(r2, min_d * min_d);
+    return v.flux.rgb * (g / 3.14159265358979) * vpl_visibility(v, p, n);
+}
+
+@compute @workgroup_size(8, 8)
+fn accumulate(@builtin(global_invocation_id) id: vec3<u32>) {
+    if (id.x >= interleave.split.x || id.y >= interleave.split.y) {
+        return;
+    }
+    let i = id.y * interleave.split.x + id.x;
+    let pos = split_position[i];
+    if (pos.w == 0.0) {
+        split_irradiance[i] = vec4<f32>(0.0);
+        return;
+    }
+    let n = split_normal[i].xyz;
+    let tiles = interleave.tiles.x * interleave.tiles.y;
+    let count = min(vpl_store.header.x, arrayLength(&vpl_store.items));
+    var e = vec3<f32>(0.0);
+    for (var k = split_tile(id.x, id.y); k < count; k += tiles) {
+        e += vpl_irradiance(vpl_store.items[k], pos.xyz, n);
+    }
+    split_irradiance[i] = vec4<f32>(e * f32(tiles), 1.0);
+}

@@ -1,0 +1,55 @@
+// Visibility lookups in a VPL shadow atlas (ShadowAtlas): one map per slot, paraboloid
+// (Brabec et al. 2002, as Laine et al. 2007 use) or cube (3x2 faces). Stored values are reversed
+// depth: 1 near, 0 far/empty (paraboloid: 1 - distance / far; cube: reversed-Z NDC depth).
+// Expects `GpuVpl` (VPL_STORE_WGSL) and the bindings `atlas_params` and `vpl_atlas` that
+// ShadowAtlas::wgsl declares.
+
+struct AtlasParams {
+    // x: slots per atlas row; y: map size (texels); z: parameterisation (0 paraboloid, 1 cube)
+    counts: vec4<u32>,
+    // x: far distance; y: depth bias (fraction of distance); z: cube near plane; w: lift (the
+    // map's centre sits this far off the VPL's surface along its normal)
+    distances: vec4<f32>,
+    // Cube faces: projection * rotation, for a VPL at the origin.
+    cube_faces: array<mat4x4<f32>, 6>,
+};
+
+// Top-left texel of the tile of `slot` (cube: of face 0 of its 3x2 block) in the atlas.
+fn vpl_tile_origin(slot: u32, tile_w: u32, tile_h: u32) -> vec2<i32> {
+    let cols = atlas_params.counts.x;
+    return vec2<i32>(i32((slot % cols) * tile_w), i32((slot / cols) * tile_h));
+}
+
+// 1 if receiver `p` (unit normal `n`) is visible from VPL `v` according to its map, else 0.
+// The receiver is first moved off its surface by about two map texels (normal offset), so that
+// surfaces tilted away from the VPL do not shadow themselves.
+fn vpl_visibility(v: GpuVpl, p_surface: vec3<f32>, n: vec3<f32>) -> f32 {
+    let size = atlas_params.counts.y;
+    let slot = u32(v.position.w);
+    let eye = v.position.xyz + v.normal.xyz * atlas_params.distances.w;
+    let p = p_surface + n * (4.0 * length(p_surface - eye) / f32(size));
+    let d = p - eye;
+    let len = length(d);
+    let far = atlas_params.distances.x;
+    let bias = atlas_params.distances.y;
+    if (atlas_params.counts.z == 0u) {
+        let local = vec3<f32>(dot(d, v.tangent.xyz), dot(d, v.bitangent.xyz), dot(d, v.normal.xyz)) / max(len, 1e-20);
+        if (local.z <= 0.0) {
+            return 0.0;
+        }
+        let uv = local.xy / (1.0 + local.z);
+        let st = vec2<i32>(floor(vec2<f32>(uv.x * 0.5 + 0.5, 0.5 - uv.y * 0.5) * f32(size)));
+        let t = clamp(st, vec2<i32>(0), vec2<i32>(i32(size) - 1));
+        let stored = textureLoad(vpl_atlas, vpl_tile_origin(slot, size, size) + t, 0).r;
+        let receiver = 1.0 - len * (1.0 - bias) / far;
+        return select(0.0, 1.0, receiver >= stored);
+    }
+    let face = cube_face(d);
+    let clip = atlas_params.cube_faces[face] * vec4<f32>(d * (1.0 - bias), 1.0);
+    let ndc = clip.xyz / clip.w;
+    let st = vec2<i32>(floor(vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5) * f32(size)));
+    let t = clamp(st, vec2<i32>(0), vec2<i32>(i32(size) - 1));
+    let origin = vpl_tile_origin(slot, 3u * size, 2u * size) + vec2<i32>(i32((face % 3u) * size), i32((face / 3u) * size));
+    let stored = textureLoad(vpl_atlas, origin + t, 0).r;
+    return select(0.0, 1.0, ndc.z >= stored);
+}

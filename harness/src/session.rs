@@ -1,0 +1,166 @@
+//! The typed run API: a [`RunSpec`] in (a loaded scene, techniques with parsed parameters,
+//! frame settings, optional quality, where the files go), [`RunResult`]s out. The CLI's `run`
+//! and `sweep` and every paper reproduction go through [`execute`]; nothing round-trips through
+//! command-line strings.
+//!
+//! Per technique: its preparation once ([`Harness::prepare`], timed as `prepare_ms`), the
+//! timing passes ([`Harness::run`]), the quality pass if asked ([`Harness::measure_quality`]),
+//! then its files in `out`: `{stem}.json` (written last, atomically), and unless `images` is off
+//! `{stem}.png`, `{stem}-indirect.exr`, `{stem}-direct.exr` (and with quality
+//! `{stem}-reference.png`, `{stem}-flip.png`).
+
+use std::path::{Path, PathBuf};
+
+use crate::gpu::GpuContext;
+use crate::image_io::{write_exr, write_png};
+use crate::quality::{QualityConfig, ReferenceCache};
+use crate::results::RunResult;
+use crate::runner::{Harness, RunConfig, TimingMode};
+use crate::scene::Scene;
+use crate::technique::{Params, TechniqueInfo};
+use crate::{Error, Result};
+
+/// One technique of a run.
+pub struct TechniqueRun {
+    pub info: &'static TechniqueInfo,
+    pub params: Params,
+    /// File name stem of its outputs (unique within the run).
+    pub stem: String,
+}
+
+impl TechniqueRun {
+    /// `info` with `params` given as (name, value) pairs (defaults for the rest), its files
+    /// named `stem`.
+    pub fn new(
+        info: &'static TechniqueInfo,
+        params: &[(&str, &str)],
+        stem: impl Into<String>,
+    ) -> Result<TechniqueRun> {
+        let given: Vec<(String, String)> = params
+            .iter()
+            .map(|(k, v)| (k.to_string(), v.to_string()))
+            .collect();
+        Ok(TechniqueRun {
+            info,
+            params: info.parse_params(&given)?,
+            stem: stem.into(),
+        })
+    }
+}
+
+/// Everything a run needs (see the module docs).
+pub struct RunSpec<'s> {
+    pub scene: &'s Scene,
+    pub runs: Vec<TechniqueRun>,
+    pub config: RunConfig,
+    pub quality: Option<QualityConfig>,
+    pub cache: ReferenceCache,
+    /// Where results and images go.
+    pub out: PathBuf,
+    /// Write images (PNG, EXR) beside the results.
+    pub images: bool,
+}
+
+/// What [`execute`] reports as it goes.
+pub enum Progress<'a> {
+    /// A technique's pass starts (its name, and "(quality)" for the quality pass).
+    Technique(&'a str),
+    /// One frame was rendered.
+    Frame,
+}
+
+impl RunSpec<'_> {
+    /// Checks what needs no GPU: the settings and unique stems.
+    pub fn validate(&self) -> Result<()> {
+        self.config.validate()?;
+        for (i, r) in self.runs.iter().enumerate() {
+            if self.runs[..i].iter().any(|o| o.stem == r.stem) {
+                return Err(Error::Invalid(format!(
+                    "two runs would write the same files '{}'",
+                    r.stem
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// Frames [`execute`] renders in all (for progress bars).
+    pub fn total_frames(&self) -> u64 {
+        let passes = if self.config.timing == TimingMode::Both {
+            2
+        } else {
+            1
+        } + self.quality.is_some() as u64;
+        self.runs.len() as u64 * passes * (self.config.frames + self.config.warmup) as u64
+    }
+}
+
+fn file_name(p: &Path) -> String {
+    p.file_name()
+        .map(|f| f.to_string_lossy().into_owned())
+        .unwrap_or_default()
+}
+
+/// Runs every technique of `spec` on `gpu` and writes its files; returns the results in order.
+pub fn execute(
+    gpu: &GpuContext,
+    spec: &RunSpec,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<Vec<RunResult>> {
+    spec.validate()?;
+    let harness = Harness::new(gpu, spec.scene, &spec.config)?;
+    let mut results = Vec::with_capacity(spec.runs.len());
+    for run in &spec.runs {
+        results.push(execute_one(&harness, spec, run, progress)?);
+    }
+    Ok(results)
+}
+
+fn execute_one(
+    harness: &Harness,
+    spec: &RunSpec,
+    run: &TechniqueRun,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<RunResult> {
+    let (info, params, config) = (run.info, &run.params, &spec.config);
+    let out = |suffix: &str| spec.out.join(format!("{}{suffix}", run.stem));
+    progress(Progress::Technique(info.name));
+    let prepared = harness.prepare(info, params, config)?;
+    let (mut result, images) = harness.run(info, params, config, &prepared, &mut || {
+        progress(Progress::Frame)
+    })?;
+    let mut extra_images = Vec::new();
+    if let Some(q) = &spec.quality {
+        let label = format!("{} (quality)", info.name);
+        progress(Progress::Technique(&label));
+        let (summary, qimages) = harness.measure_quality(
+            info,
+            params,
+            config,
+            &prepared,
+            q,
+            &spec.cache,
+            &mut || progress(Progress::Frame),
+        )?;
+        result.quality = Some(summary);
+        if spec.images {
+            let reference_png = out("-reference.png");
+            write_png(&reference_png, qimages.size, &qimages.reference_display)?;
+            let flip_png = out("-flip.png");
+            write_png(&flip_png, qimages.size, &qimages.flip_map)?;
+            extra_images = vec![file_name(&reference_png), file_name(&flip_png)];
+        }
+    }
+    if spec.images {
+        let png = out(".png");
+        write_png(&png, images.size, &images.display)?;
+        let exr = out("-indirect.exr");
+        write_exr(&exr, images.size, &images.indirect)?;
+        let direct = out("-direct.exr");
+        write_exr(&direct, images.size, &images.direct)?;
+        result.images = vec![file_name(&png), file_name(&exr), file_name(&direct)];
+        result.images.extend(extra_images);
+    }
+    result.write(&out(".json"))?;
+    Ok(result)
+}

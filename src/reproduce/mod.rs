@@ -1,0 +1,129 @@
+//! `gibench reproduce TARGET`: regenerate a paper's tables, one module per paper over the typed
+//! run API ([`gibench_harness::session`]), with the paper's published figures read from
+//! `results/papers/<paper>.json` and printed beside ours, each labelled with its source.
+//!
+//! * [`laine2007`]: Laine et al. 2007, Tables 1 and 2, VPL management, dispersion.
+
+pub mod laine2007;
+
+use std::path::PathBuf;
+
+use clap::Args;
+use gibench_harness::assets::AssetPaths;
+use gibench_harness::gpu::{GpuContext, GpuOptions};
+use gibench_harness::report::{self, Cell, Table};
+use gibench_harness::results::RunResult;
+use gibench_harness::scene::{Scene, SceneDescriptor};
+use gibench_harness::{Error, Result};
+
+#[derive(Args)]
+pub struct ReproduceArgs {
+    /// What to regenerate: laine-table1, laine-table2, laine-tables (both from one set of runs),
+    /// laine-management or laine-dispersion.
+    pub target: String,
+    /// Small sizes for machines without a GPU (each target says which).
+    #[arg(long)]
+    pub quick: bool,
+    /// Scenes (default: the paper's).
+    #[arg(long, value_delimiter = ',')]
+    pub scenes: Vec<String>,
+    /// Output directory.
+    #[arg(long, default_value = "results/laine")]
+    pub out: PathBuf,
+    /// Override the measured frame count (e.g. for a smoke test).
+    #[arg(long)]
+    pub frames: Option<u32>,
+    /// Extra directory searched first for scene assets (glTF files).
+    #[arg(long)]
+    pub assets: Option<PathBuf>,
+    /// Do not show a progress bar.
+    #[arg(long)]
+    pub quiet: bool,
+    /// Restrict the adapter to one backend.
+    #[arg(long, env = "GIBENCH_BACKEND")]
+    pub backend: Option<String>,
+    /// Use the adapter whose name contains this.
+    #[arg(long, env = "GIBENCH_ADAPTER")]
+    pub adapter: Option<String>,
+}
+
+/// A table and the file stem it is written under.
+pub type Reproduction = (Table, &'static str);
+
+/// A paper's published figures (`results/papers/{name}.json`, embedded at build time).
+pub fn paper(name: &str, text: &str) -> Result<serde_json::Value> {
+    serde_json::from_str(text)
+        .map_err(|e| Error::Invalid(format!("results/papers/{name}.json: {e}")))
+}
+
+/// A built-in scene or descriptor file, loaded with the asset search path (`--assets` first).
+pub fn load_scene(name: &str, args: &ReproduceArgs) -> Result<Scene> {
+    Scene::load(
+        &SceneDescriptor::resolve(name)?,
+        &AssetPaths::standard(args.assets.as_deref()),
+    )
+}
+
+/// The adapter `args` asks for.
+pub fn open_gpu(args: &ReproduceArgs) -> Result<GpuContext> {
+    GpuContext::new(&GpuOptions {
+        backend: args.backend.clone(),
+        adapter: args.adapter.clone(),
+    })
+}
+
+/// "Ours: adapter (backend, driver); git commit." for a table's notes.
+pub fn device_note(runs: &[&RunResult]) -> String {
+    let mut devices: Vec<String> = runs
+        .iter()
+        .map(|r| {
+            format!(
+                "{} ({}, driver {})",
+                r.device.adapter, r.device.backend, r.device.driver
+            )
+        })
+        .collect();
+    devices.dedup();
+    format!(
+        "Ours: {}; git {}.",
+        devices.join("; "),
+        runs.first().map(|r| r.git_commit.as_str()).unwrap_or("?")
+    )
+}
+
+/// A paper's row of numbers as one-decimal cells.
+pub fn paper_cells(values: &serde_json::Value) -> Vec<Cell> {
+    values
+        .as_array()
+        .map(|a| a.iter().map(|v| Cell::Num(v.as_f64(), 1)).collect())
+        .unwrap_or_default()
+}
+
+/// Runs `args.target` and writes its tables (Markdown, CSV, LaTeX) into `args.out`.
+pub fn reproduce(args: &ReproduceArgs) -> Result<()> {
+    let target = args.target.as_str();
+    let tables = if laine2007::TARGETS.contains(&target) {
+        laine2007::reproduce(target, args)?
+    } else {
+        return Err(Error::param(
+            "target",
+            format!(
+                "unknown target '{target}'; expected one of: {}",
+                laine2007::TARGETS.join(", ")
+            ),
+        ));
+    };
+    for (table, stem) in tables {
+        println!("{}", table.to_terminal());
+        let written = report::write_tables(&table, &args.out, stem)?;
+        eprintln!(
+            "wrote {}",
+            written
+                .iter()
+                .map(|p| p.display().to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
+    Ok(())
+}
