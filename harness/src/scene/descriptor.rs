@@ -213,6 +213,10 @@ const BUILTINS: &[(&str, &str)] = &[
         "cornell-sun",
         include_str!("../../../scenes/cornell-sun.json"),
     ),
+    (
+        "cornell-area",
+        include_str!("../../../scenes/cornell-area.json"),
+    ),
     ("sibenik", include_str!("../../../scenes/sibenik.json")),
     (
         "sibenik-omni",

