@@ -225,7 +225,7 @@ fn table1(pairs: &[Pair]) -> Result<Table> {
             Cell::Ms(sum(laine, &COMMON_STAGES)),
             Cell::Ms(ms(laine, STAGE_VPL_SHADOW_MAPS)),
             Cell::Ms(ms(keller, STAGE_VPL_SHADOW_MAPS)),
-            Cell::Ms(ms(laine, "vpl-management")),
+            Cell::Ms(ms(laine, gibench_laine::STAGE_VPL_MANAGEMENT)),
             Cell::Num(fc, 1),
             Cell::Num(fo, 1),
             Cell::Num(speedup_indirect, 1),

@@ -31,6 +31,9 @@ use gibench_harness::technique::{
 use gibench_harness::vpl::{self, Vpl, VplSettings};
 use gibench_harness::{wgpu, Error, Result};
 
+/// Stage: tracing light paths and placing VPLs on the CPU.
+pub const STAGE_VPL_GENERATION: &str = "vpl-generation";
+
 const BOUNCES: ParamSpec = ParamSpec {
     name: "bounces",
     kind: ParamKind::Int { min: 1, max: 8 },
@@ -174,7 +177,7 @@ impl Technique for KellerFull {
     fn render(&mut self, ctx: &mut FrameContext) -> Result<()> {
         let (scene, bvh, light) = (ctx.scene, ctx.bvh, ctx.frame.light);
         let settings = self.settings;
-        let vpls: Vec<(u32, Vpl)> = ctx.profiler.cpu_stage("vpl-generation", || {
+        let vpls: Vec<(u32, Vpl)> = ctx.profiler.cpu_stage(STAGE_VPL_GENERATION, || {
             vpl::generate(scene, bvh, &light, &settings)
                 .into_iter()
                 .enumerate()
@@ -232,7 +235,7 @@ impl Technique for KellerIncremental {
         let count = if first { self.paths } else { self.budget };
         let (paths, bounces, rho) = (self.paths, self.bounces, self.average_reflectance);
         let (ring, oldest, next_path) = (&mut self.ring, &mut self.oldest, &mut self.next_path);
-        let new_vpls: Vec<(u32, Vpl)> = ctx.profiler.cpu_stage("vpl-generation", || {
+        let new_vpls: Vec<(u32, Vpl)> = ctx.profiler.cpu_stage(STAGE_VPL_GENERATION, || {
             if ring.is_empty() {
                 ring.resize(paths as usize, Vec::new());
             }

@@ -50,6 +50,9 @@ use gibench_harness::technique::{
 use gibench_harness::vpl::{self, Vpl};
 use gibench_harness::{wgpu, Result};
 
+/// Stage: the CPU VPL management of §4 (validity, deletion, creation, intensities).
+pub const STAGE_VPL_MANAGEMENT: &str = "vpl-management";
+
 const OWN_PARAMS: &[ParamSpec] = &[
     ParamSpec {
         name: "max-lights",
@@ -304,7 +307,7 @@ impl Technique for Laine {
     fn render(&mut self, ctx: &mut FrameContext) -> Result<()> {
         let (scene, bvh, light) = (ctx.scene, ctx.bvh, ctx.frame.light);
         let manager = &mut self.manager;
-        let (step, list) = ctx.profiler.cpu_stage("vpl-management", || {
+        let (step, list) = ctx.profiler.cpu_stage(STAGE_VPL_MANAGEMENT, || {
             let step = manager.step(scene, bvh, light);
             (step, manager.vpls())
         });
