@@ -68,7 +68,7 @@ fn conform_on(gpu: &GpuContext, scene_name: &str, failures: &mut Vec<String>) {
         frames: FRAMES,
         warmup: 0,
         first_frame: 0,
-        timing: TimingMode::Frame,
+        timing: TimingMode::Stages,
         seed: 1,
         shadow_size: 256,
     };

@@ -63,6 +63,11 @@ fn cornell_run_writes_results_images_and_tables() {
     assert!(png.pixels().any(|p| p[0] > 64), "image is black");
 }
 
+/// Sibenik (found through the asset search path) with `laine` and `keller-full` at the same
+/// small VPL count: the results record the loaded scene's triangle counts (its tessellated
+/// shadow-map copy has more), both techniques light every frame with the same number of VPLs
+/// (`laine` with at most as many), and `laine` renders only its new VPLs' maps after the first
+/// frame while `keller-full` renders all of them.
 #[test]
 fn sibenik_loads_through_the_asset_search_path() {
     let tmp = tempfile::tempdir().unwrap();
@@ -70,18 +75,38 @@ fn sibenik_loads_through_the_asset_search_path() {
         &[
             "--scene",
             "sibenik",
+            "--technique",
+            "laine,keller-full",
+            "--param",
+            "vpls=16",
+            "--param",
+            "vpl-map-size=32",
+            "--resolution",
+            "64x48",
             "--frames",
-            "5",
+            "3",
             "--warmup",
-            "0",
+            "1",
             "--timing",
             "stages",
             "--no-images",
         ],
         tmp.path(),
     );
-    let r = RunResult::read(&tmp.path().join("sibenik-direct.json")).unwrap();
-    assert_eq!(r.scene, "sibenik");
+    let laine = RunResult::read(&tmp.path().join("sibenik-laine.json")).unwrap();
+    let keller = RunResult::read(&tmp.path().join("sibenik-keller-full.json")).unwrap();
+    let triangles = |r: &RunResult, key: &str| r.settings[key].as_u64().unwrap();
+    assert!(triangles(&laine, "scene_triangles") > 70_000);
+    assert!(triangles(&laine, "shadow_mesh_triangles") > triangles(&laine, "scene_triangles"));
+    let counter = |r: &RunResult, name: &str| r.counters[name].clone();
+    assert_eq!(counter(&keller, "vpls").min, 16.0);
+    assert!(counter(&laine, "vpls").max <= 16.0 && counter(&laine, "vpls").min >= 8.0);
+    assert_eq!(counter(&keller, "shadow-maps").mean, 16.0);
+    assert!(
+        counter(&laine, "shadow-maps").max <= 8.0,
+        "laine re-renders only new maps"
+    );
+    assert!(laine.stage("vpl-management").is_some());
 }
 
 #[test]

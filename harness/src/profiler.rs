@@ -62,7 +62,13 @@ pub struct Profiler {
     frame_commands: Vec<wgpu::CommandBuffer>,
     in_flight: VecDeque<wgpu::SubmissionIndex>,
     frame_start: Option<Instant>,
+    /// When the last frame's `end_frame` returned (the next frame could have started).
+    frame_end: Option<Instant>,
     frame_times: Vec<f64>,
+    /// Frames begun so far.
+    frames_begun: u64,
+    /// Sum of the first frame's stage times (stages mode): the fill frame.
+    first_frame_ms: f64,
 }
 
 impl Profiler {
@@ -101,7 +107,10 @@ impl Profiler {
             frame_commands: Vec::new(),
             in_flight: VecDeque::new(),
             frame_start: None,
+            frame_end: None,
             frame_times: Vec::new(),
+            frames_begun: 0,
+            first_frame_ms: 0.0,
         }
     }
 
@@ -134,6 +143,7 @@ impl Profiler {
                 }
             }
         }
+        self.frames_begun += 1;
         self.frame_start = Some(now);
         self.recording = measured;
         self.frame_queries.clear();
@@ -172,9 +182,7 @@ impl Profiler {
                 gpu.queue.submit([enc.finish()]);
                 gpu.flush()?;
                 let ms = t0.elapsed().as_secs_f64() * 1e3;
-                if self.recording {
-                    self.series[idx].wall.push(ms);
-                }
+                self.record_wall(idx, ms);
                 Ok(r)
             }
         }
@@ -186,10 +194,24 @@ impl Profiler {
         let t0 = Instant::now();
         let r = work();
         let ms = t0.elapsed().as_secs_f64() * 1e3;
-        if self.recording {
-            self.series[idx].wall.push(ms);
-        }
+        self.record_wall(idx, ms);
         r
+    }
+
+    fn record_wall(&mut self, series: usize, ms: f64) {
+        if self.frames_begun == 1 {
+            self.first_frame_ms += ms;
+        }
+        if self.recording {
+            self.series[series].wall.push(ms);
+        }
+    }
+
+    /// The first frame's time in stages mode: the sum of its stages' wall times (GPU stages
+    /// flushed; the fill frame, Laine et al.'s "stutter", when a technique fills all its maps
+    /// then). `None` in frame mode or before any frame.
+    pub fn first_frame_ms(&self) -> Option<f64> {
+        (self.mode == ProfileMode::Stages && self.frames_begun > 0).then_some(self.first_frame_ms)
     }
 
     /// Records a per-frame counter (e.g. shadow maps rendered this frame).
@@ -213,6 +235,7 @@ impl Profiler {
                     let oldest = self.in_flight.pop_front().expect("non-empty");
                     gpu.wait_for(oldest)?;
                 }
+                self.frame_end = Some(Instant::now());
                 gpu.check_errors()
             }
             ProfileMode::Stages => {
@@ -248,17 +271,31 @@ impl Profiler {
     /// Waits for everything queued (end of a frame-mode sequence). The last frame's duration is
     /// the time from its start to the end of all queued work.
     pub fn finish(&mut self, gpu: &GpuContext) -> Result<()> {
-        gpu.flush()?;
+        // The last frame's interval ends where the next frame could have begun (when its
+        // `end_frame` returned), not when all queued work is done: only complete intervals.
         if self.mode == ProfileMode::Frame && self.recording {
-            if let Some(start) = self.frame_start.take() {
-                self.frame_times.push(start.elapsed().as_secs_f64() * 1e3);
+            if let (Some(start), Some(end)) = (self.frame_start.take(), self.frame_end) {
+                if end >= start {
+                    self.frame_times
+                        .push(end.duration_since(start).as_secs_f64() * 1e3);
+                }
             }
         }
+        self.recording = false;
+        gpu.flush()?;
         self.in_flight.clear();
         Ok(())
     }
 
-    /// Per-stage statistics, in the order stages first ran.
+    /// Waits for every submitted frame (between the warm-up and the measured frames, so that
+    /// no warm-up frame's GPU work is waited for inside a measured interval).
+    pub fn drain(&mut self, gpu: &GpuContext) -> Result<()> {
+        gpu.flush()?;
+        self.in_flight.clear();
+        self.frame_start = None;
+        Ok(())
+    }
+
     pub fn stage_results(&self) -> Vec<StageResult> {
         self.series
             .iter()

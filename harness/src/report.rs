@@ -1105,6 +1105,7 @@ mod tests {
             }),
             counters: BTreeMap::from([("shadow maps".to_string(), stats(1.0))]),
             prepare_ms: None,
+            first_frame_ms: None,
             quality: None,
             images: vec!["frame.png".into()],
         }

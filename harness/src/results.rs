@@ -101,6 +101,11 @@ pub struct RunResult {
     /// milliseconds; shared by the timing passes and the quality pass.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub prepare_ms: Option<f64>,
+    /// The first frame rendered (warm-up included), in the stages pass: the sum of its stage
+    /// times, milliseconds. For `laine` it is the fill frame that renders every map (the
+    /// paper's "stutter").
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub first_frame_ms: Option<f64>,
     /// Error against the CPU reference (`gibench run --quality`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub quality: Option<crate::metrics::QualitySummary>,

@@ -120,6 +120,14 @@ impl RunConfig {
                 "at least one measured frame is needed (got 0)",
             ));
         }
+        if self.timing != TimingMode::Stages && self.warmup == 0 {
+            return Err(Error::param(
+                "warmup",
+                "timing whole frames needs at least one warm-up frame (the first frame fills \
+                 every map and is recorded on its own as the fill frame); use --warmup 1 or more, \
+                 or --timing stages",
+            ));
+        }
         if !(16..=MAX_RESOLUTION).contains(&self.shadow_size) {
             return Err(Error::param(
                 "shadow-size",
@@ -228,6 +236,7 @@ impl<'a> Harness<'a> {
             base: self.scene_context(),
             resolution: config.resolution,
             seed: config.seed,
+            first_frame: self.clock.frame(config.first_frame),
         }
     }
 
@@ -318,12 +327,17 @@ impl<'a> Harness<'a> {
         let mut stages = Vec::new();
         let mut counters = BTreeMap::new();
         let mut frame_result = None;
+        let mut first_frame_ms = None;
         let mut images = None;
         for &mode in config.timing.passes() {
             let (mut technique, compose) = self.build(info, params, config, prepared)?;
             let mut profiler = Profiler::new(self.gpu, mode);
             let total = config.warmup + config.frames;
             for i in 0..total {
+                if i == config.warmup && i > 0 {
+                    // Measured frames start with an idle queue.
+                    profiler.drain(self.gpu)?;
+                }
                 let frame = self.clock.frame(config.first_frame + i);
                 self.render_frame(
                     technique.as_mut(),
@@ -339,6 +353,7 @@ impl<'a> Harness<'a> {
                 ProfileMode::Stages => {
                     stages = profiler.stage_results();
                     counters = profiler.counter_results();
+                    first_frame_ms = profiler.first_frame_ms();
                 }
                 ProfileMode::Frame => {
                     frame_result = profiler.frame_result();
@@ -367,7 +382,18 @@ impl<'a> Harness<'a> {
             scene: self.scene.descriptor.name.clone(),
             technique: info.name.to_string(),
             parameters: params.to_map(),
-            settings: config.settings(),
+            settings: {
+                let mut s = config.settings();
+                s.insert(
+                    "scene_triangles".into(),
+                    Value::from(self.scene.mesh.triangle_count()),
+                );
+                s.insert(
+                    "shadow_mesh_triangles".into(),
+                    Value::from(self.scene.shadow_caster_mesh().triangle_count()),
+                );
+                s
+            },
             resolution: config.resolution,
             frames: FrameRange {
                 warmup: config.warmup,
@@ -381,6 +407,7 @@ impl<'a> Harness<'a> {
             frame: frame_result,
             counters,
             prepare_ms: Some(prepared.ms),
+            first_frame_ms,
             quality: None,
             images: Vec::new(),
         };

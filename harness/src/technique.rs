@@ -193,6 +193,8 @@ pub struct PrepareContext<'a> {
     pub base: SceneContext<'a>,
     pub resolution: [u32; 2],
     pub seed: u64,
+    /// The first animation frame the technique will render (warm-up included).
+    pub first_frame: FrameState,
 }
 
 impl<'a> std::ops::Deref for PrepareContext<'a> {

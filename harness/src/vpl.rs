@@ -30,13 +30,16 @@
 //!   material's [`Material::average_color`](crate::scene::Material::average_color).
 //! * **Further bounces** (Keller's fractional absorption, with the scene's average reflectance
 //!   ρ̄, the mean of the RGB channels of
-//!   [`Scene::average_reflectance`](crate::scene::Scene::average_reflectance)): path `i`
-//!   reaches vertex `j ≥ 2` only if `i < ⌊ρ̄^(j−1) · paths⌋` ([`continuing_paths`]), i.e. the
-//!   *first* paths of the call continue, deterministically. The new direction is
-//!   cosine-weighted about the previous VPL's normal (Halton dims `4 + 2(j−2)`, `5 + 2(j−2)`),
-//!   and the VPL at y_j carries `flux(y_{j−1}) · ρ(y_j) / ρ̄`, so the expected flux of bounce j
-//!   is Φ ρ^j in a closed scene of uniform albedo. A continuation ray that misses the scene or
-//!   points below the geometric surface (possible with interpolated normals) ends the path.
+//!   [`Scene::average_reflectance`](crate::scene::Scene::average_reflectance)): of the N =
+//!   `normalisation_paths` paths, C_j = ⌊ρ̄^(j−1) · N⌋ reach vertex j ([`continuing_paths`]):
+//!   the path with Halton index h continues to vertex j iff `h mod N < C_j`. A call with
+//!   `first_path = 0` and `paths = N` therefore continues its first C_j paths, and any N
+//!   consecutive Halton indices (the ring of `keller-incremental`, however it is refilled) hold
+//!   exactly the same counts. The new direction is cosine-weighted about the previous VPL's
+//!   normal (Halton dims `4 + 2(j−2)`, `5 + 2(j−2)`), and the VPL at y_j carries
+//!   Φ / C_j · ρ(y₁)…ρ(y_j) — Keller's weight N / C_j by the actual count — so bounce j carries
+//!   exactly Φ ρ^j in a closed scene of uniform albedo. A continuation ray that misses the scene
+//!   or points below the geometric surface (possible with interpolated normals) ends the path.
 //!
 //! Rays start `ε` = 10⁻⁴ × the static mesh's bounding-box diagonal
 //! ([`SceneExtent::ray_epsilon`](crate::scene::SceneExtent), computed once at load; the same
@@ -377,10 +380,14 @@ pub fn generate(
         };
         let mut vpl = make_vpl(scene, &hit, path_flux, 1, h, sample);
         vpls.push(vpl);
+        // The path's place among the N, and how many of the N reached the previous vertex.
+        let residue = h % normalisation as u64;
+        let mut reaching = normalisation;
         for j in 2..=settings.bounces {
-            // Keller's fractional absorption: the first ⌊ρ̄^(j−1) N⌋ paths reach vertex j
+            // Keller's fractional absorption: ⌊ρ̄^(j−1) N⌋ of the N paths reach vertex j
             // (so q > 0 below).
-            if i >= continuing_paths(q, paths, j) {
+            let continuing = continuing_paths(q, normalisation, j);
+            if residue >= continuing as u64 {
                 break;
             }
             let dim = 4 + 2 * (j as usize - 2);
@@ -393,11 +400,65 @@ pub fn generate(
                 break;
             };
             hit = next;
-            vpl = make_vpl(scene, &hit, vpl.flux / q, j, h, sample);
+            // Φ / C_j · ρ₁…ρ_j: the previous vertex's flux re-weighted from C_{j−1} to C_j.
+            let weight = reaching as f32 / continuing as f32;
+            vpl = make_vpl(scene, &hit, vpl.flux * weight, j, h, sample);
             vpls.push(vpl);
+            reaching = continuing;
         }
     }
     vpls
+}
+
+/// `keller-full`'s VPL count: the fewest light paths from Halton index 0 (each carrying
+/// Φ / paths, `bounces` vertices, Keller's ρ̄ = `average_reflectance`) that give at least
+/// `target` VPLs, and their VPLs. With one bounce the count is exactly `target` unless the
+/// scene is (nearly) missed: at most 64 × `target` paths are traced. The VPL count grows with
+/// the path count (each path's first hit is fixed by its Halton index), so the search is an
+/// estimate from the hit rate followed by bisection.
+pub fn generate_at_least(
+    scene: &Scene,
+    bvh: &SceneBvh,
+    light: &LightPose,
+    target: u32,
+    bounces: u32,
+    average_reflectance: f32,
+) -> (VplSettings, Vec<Vpl>) {
+    let settings = |paths: u32| VplSettings {
+        paths,
+        bounces,
+        first_path: 0,
+        normalisation_paths: paths,
+        average_reflectance: Some(average_reflectance),
+    };
+    let run = |paths: u32| generate(scene, bvh, light, &settings(paths));
+    let target = target.max(1);
+    let cap = target.saturating_mul(64);
+    // Grow from `target` paths by the observed yield until there are enough VPLs.
+    let (mut lo, mut hi) = (0u32, target);
+    let mut best = run(hi);
+    while (best.len() as u32) < target && hi < cap {
+        lo = hi;
+        let yield_per_path = best.len().max(1) as f64 / hi as f64;
+        let guess = (target as f64 / yield_per_path * 1.02).ceil() as u32;
+        hi = guess.clamp(hi + 1, cap);
+        best = run(hi);
+    }
+    if (best.len() as u32) < target {
+        return (settings(hi), best);
+    }
+    // The fewest paths in (lo, hi] with enough VPLs.
+    while hi - lo > 1 {
+        let mid = lo + (hi - lo) / 2;
+        let v = run(mid);
+        if v.len() as u32 >= target {
+            hi = mid;
+            best = v;
+        } else {
+            lo = mid;
+        }
+    }
+    (settings(hi), best)
 }
 
 /// The sum of the VPLs' fluxes.

@@ -1,6 +1,7 @@
-//! VPL depth maps, paraboloid and cube: rendering a VPL's map and looking receivers up in it is
-//! a round trip through the projection; its visibility must agree with CPU ray casts. Runs on
-//! Vulkan and GL.
+//! VPL depth maps, paraboloid and cube, at the shipped defaults (16-bit depth, 128² maps):
+//! rendering a VPL's map and looking receivers up in it is a round trip through the projection;
+//! away from shadow boundaries its visibility must agree with CPU ray casts on 98 % of the
+//! receivers. Runs on Vulkan and GL.
 
 use gibench_harness::assets::AssetPaths;
 use gibench_harness::glam::Vec3;
@@ -19,14 +20,15 @@ use gibench_harness::wgpu;
 /// How the atlas is filled.
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Fill {
-    /// By the kit's rasteriser, 32-bit depth.
+    /// By the kit's rasteriser, with the shipped defaults: 16-bit depth, 128² maps.
     Raster(MapKind),
     /// From outside the rasteriser, as imperfect shadow maps will: a float (R32Float) paraboloid
     /// atlas whose every texel is a CPU ray cast, uploaded with a texture write.
     CpuFloat,
 }
 
-const MAP: u32 = 512;
+/// The shipped default map size (`vpl-map-size`).
+const MAP: u32 = 128;
 const SLOT: u32 = 2;
 
 /// Per pixel: (GPU irradiance from `vpl` with visibility, CPU unoccluded irradiance, CPU
@@ -65,7 +67,7 @@ fn one_vpl(backend: &str, fill: Fill, vpl: Vpl) -> Vec<Option<(f32, f32, bool)>>
     )
     .unwrap();
     let (kind, format) = match fill {
-        Fill::Raster(kind) => (kind, AtlasFormat::Depth32),
+        Fill::Raster(kind) => (kind, AtlasFormat::Depth16),
         Fill::CpuFloat => (MapKind::Paraboloid, AtlasFormat::Float32),
     };
     let atlas = ShadowAtlas::new(
@@ -179,14 +181,42 @@ fn test_vpls() -> [Vpl; 2] {
     ]
 }
 
+/// Pixels of a 96x72 result whose 3x3 neighbourhood is all geometry with the same CPU
+/// visibility: away from shadow boundaries, where a map texel's footprint cannot decide.
+fn interior(px: &[Option<(f32, f32, bool)>]) -> Vec<bool> {
+    let (w, h) = (96i64, 72i64);
+    (0..px.len() as i64)
+        .map(|i| {
+            let (x, y) = (i % w, i / w);
+            let Some((_, _, v)) = px[i as usize] else {
+                return false;
+            };
+            (-1..=1).all(|dy| {
+                (-1..=1).all(|dx| {
+                    let (xx, yy) = (x + dx, y + dy);
+                    xx >= 0
+                        && yy >= 0
+                        && xx < w
+                        && yy < h
+                        && px[(yy * w + xx) as usize].is_some_and(|(_, _, u)| u == v)
+                })
+            })
+        })
+        .collect()
+}
+
 fn check(fill: Fill) {
     for backend in ["vulkan", "gl"] {
         for vpl in test_vpls() {
             let px = one_vpl(backend, fill, vpl);
+            let inside = interior(&px);
             let (mut n, mut agree, mut shadowed, mut lit) = (0, 0, 0, 0);
-            for (gpu_e, unoccluded, visible) in px.iter().flatten() {
-                // Receivers facing the VPL clearly.
-                if *unoccluded < 1e-6 {
+            for (p, inside) in px.iter().zip(&inside) {
+                let Some((gpu_e, unoccluded, visible)) = p else {
+                    continue;
+                };
+                // Receivers facing the VPL clearly, away from shadow boundaries.
+                if *unoccluded < 1e-6 || !inside {
                     continue;
                 }
                 n += 1;
@@ -208,10 +238,12 @@ fn check(fill: Fill) {
                 n > 1000 && shadowed > 50 && lit > 500,
                 "{backend} {fill:?}: too few pixels ({n}, {shadowed} shadowed, {lit} lit)"
             );
-            // Texel-sized disagreements at shadow boundaries only.
+            // Away from shadow boundaries the maps decide like ray casts, but for receivers
+            // within the lookup's normal offset (four map texels: about 15 mm at 128² and
+            // 0.5 m) of a contact edge, which see past it (about 1 % here).
             assert!(
-                agree * 100 >= n * 97,
-                "{backend} {fill:?} at {:?}: visibility agrees on {agree} of {n} pixels",
+                agree * 100 >= n * 98,
+                "{backend} {fill:?} at {:?}: visibility agrees on {agree} of {n} interior pixels",
                 vpl.position
             );
         }
@@ -243,7 +275,7 @@ fn cube_maps_agree_with_ray_casts() {
 /// A float atlas filled from outside the rasteriser (as imperfect shadow maps will fill theirs)
 /// gathers through the same store, accumulation and interleaving: against ray casts as above,
 /// and against the rasterised paraboloid atlas on the same VPLs: visibility agrees on at least
-/// 97 % of the receivers and the summed irradiance within 2 %.
+/// 97 % of all receivers (shadow boundaries included) and the summed irradiance within 2 %.
 #[test]
 fn float_atlas_from_outside_the_rasteriser_matches_the_rasterised_one() {
     check(Fill::CpuFloat);
