@@ -155,3 +155,22 @@ fn bad_timing_mode_and_backend() {
     fails(&["--timing", "sometimes"], "timing");
     fails(&["--backend", "glide"], "unknown backend 'glide'");
 }
+
+/// Timing whole frames with fewer warm-up frames than the frames in flight plus one would let
+/// the first (fill) frame's work land in a measured interval; `laine`'s recalc-min above its
+/// recalc-max would drain its VPL count. Both are refused before anything runs.
+#[test]
+fn short_warmup_and_draining_laine_parameters() {
+    fails(&["--warmup", "1"], "warmup");
+    fails(
+        &[
+            "--technique",
+            "laine",
+            "--param",
+            "recalc-min=9",
+            "--warmup",
+            "3",
+        ],
+        "laine.recalc-min",
+    );
+}

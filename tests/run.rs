@@ -21,7 +21,7 @@ fn run_ok(args: &[&str], out: &std::path::Path) -> String {
 #[test]
 fn cornell_run_writes_results_images_and_tables() {
     let tmp = tempfile::tempdir().unwrap();
-    let stdout = run_ok(&["--frames", "4", "--warmup", "1"], tmp.path());
+    let stdout = run_ok(&["--frames", "4", "--warmup", "3"], tmp.path());
     for col in [
         "gbuffer",
         "direct-shadow-map",
@@ -35,7 +35,7 @@ fn cornell_run_writes_results_images_and_tables() {
     assert_eq!(r.scene, "cornell");
     assert_eq!(r.technique, "direct");
     assert_eq!(r.frames.measured, 4);
-    assert_eq!(r.frames.warmup, 1);
+    assert_eq!(r.frames.warmup, 3);
     for s in &r.stages {
         let wall = s.wall_ms.expect("flushed wall time");
         assert_eq!(wall.count, 4, "stage {}", s.name);
@@ -118,7 +118,7 @@ fn quality_columns_and_results() {
             "--frames",
             "3",
             "--warmup",
-            "1",
+            "3",
             "--quality",
             "--quality-pairs",
             "1",
@@ -134,10 +134,10 @@ fn quality_columns_and_results() {
     }
     let r = RunResult::read(&tmp.path().join("cornell-direct.json")).unwrap();
     let q = r.quality.expect("quality in the results");
-    // Frames 2 and 3 (a consecutive pair ending at the last measured frame).
+    // Frames 4 and 5 (a consecutive pair ending at the last measured frame).
     assert_eq!(
         q.frames.iter().map(|f| f.frame).collect::<Vec<_>>(),
-        vec![2, 3]
+        vec![4, 5]
     );
     assert!(q.frames[1].temporal.is_some());
     // `direct` has no indirect light: its relative MSE against one bounce is close to 1.

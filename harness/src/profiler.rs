@@ -287,15 +287,6 @@ impl Profiler {
         Ok(())
     }
 
-    /// Waits for every submitted frame (between the warm-up and the measured frames, so that
-    /// no warm-up frame's GPU work is waited for inside a measured interval).
-    pub fn drain(&mut self, gpu: &GpuContext) -> Result<()> {
-        gpu.flush()?;
-        self.in_flight.clear();
-        self.frame_start = None;
-        Ok(())
-    }
-
     pub fn stage_results(&self) -> Vec<StageResult> {
         self.series
             .iter()

@@ -120,12 +120,19 @@ impl RunConfig {
                 "at least one measured frame is needed (got 0)",
             ));
         }
-        if self.timing != TimingMode::Stages && self.warmup == 0 {
+        let min_warmup = crate::profiler::FRAMES_IN_FLIGHT as u32 + 1;
+        if self.timing != TimingMode::Stages && self.warmup < min_warmup {
             return Err(Error::param(
                 "warmup",
-                "timing whole frames needs at least one warm-up frame (the first frame fills \
-                 every map and is recorded on its own as the fill frame); use --warmup 1 or more, \
-                 or --timing stages",
+                format!(
+                    "timing whole frames needs at least {min_warmup} warm-up frames (got {}): with \
+                     {} frames in flight, frame i waits for frame i - {}, so the first (fill) frame's \
+                     work would land in a measured interval; it is recorded on its own as the fill \
+                     frame. Use --warmup {min_warmup} or more, or --timing stages",
+                    self.warmup,
+                    crate::profiler::FRAMES_IN_FLIGHT,
+                    crate::profiler::FRAMES_IN_FLIGHT
+                ),
             ));
         }
         if !(16..=MAX_RESOLUTION).contains(&self.shadow_size) {
@@ -334,10 +341,6 @@ impl<'a> Harness<'a> {
             let mut profiler = Profiler::new(self.gpu, mode);
             let total = config.warmup + config.frames;
             for i in 0..total {
-                if i == config.warmup && i > 0 {
-                    // Measured frames start with an idle queue.
-                    profiler.drain(self.gpu)?;
-                }
                 let frame = self.clock.frame(config.first_frame + i);
                 self.render_frame(
                     technique.as_mut(),

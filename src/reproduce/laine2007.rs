@@ -79,7 +79,7 @@ fn sizes(quick: bool) -> Sizes {
         Sizes {
             resolutions: vec![[256, 192], [400, 300]],
             frames: 12,
-            warmup: 2,
+            warmup: 3,
         }
     } else {
         Sizes {
@@ -110,7 +110,6 @@ fn run_pairs(args: &ReproduceArgs) -> Result<Vec<Pair>> {
     let mut s = sizes(args.quick);
     if let Some(f) = args.frames {
         s.frames = f;
-        s.warmup = s.warmup.min(f);
     }
     let scenes = if args.scenes.is_empty() {
         ["cornell", "maze", "sibenik"].map(String::from).to_vec()
