@@ -16,7 +16,7 @@ if [ -n "$(git status --porcelain --untracked-files=no)" ]; then
   exit 1
 fi
 cargo build --release --quiet
-g=target/release/gibench
+g="${CARGO_TARGET_DIR:-target}/release/gibench"
 run() { # run OUTPUT_DIR command... (a dedicated OUTPUT_DIR is emptied first: no stale files)
   local out="$1"; shift
   case "$out" in "results/$only"*) ;; *) [ -z "$only" ] || return 0 ;; esac
