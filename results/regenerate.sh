@@ -11,8 +11,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 only="${1:-}"
-if [ -n "$(git status --porcelain --untracked-files=no)" ]; then
-  echo "regenerate.sh: the checkout has uncommitted changes; results would record a -dirty commit" >&2
+if [ -n "$(git status --porcelain --untracked-files=no -- . ':(exclude)results')" ]; then
+  echo "regenerate.sh: the checkout has uncommitted changes outside results/; results would record a -dirty commit" >&2
   exit 1
 fi
 cargo build --release --quiet

@@ -397,6 +397,25 @@ pub(crate) fn plan(args: &RunArgs, extra_params: &[String]) -> Result<Plan> {
         .iter()
         .map(|n| TechniqueInfo::find(registry, n.trim()))
         .collect::<Result<_>>()?;
+    for (i, t) in techniques.iter().enumerate() {
+        if techniques[..i].iter().any(|o| o.name == t.name) {
+            return Err(Error::param(
+                "technique",
+                format!(
+                    "'{}' is listed twice; its second run would overwrite the first's files",
+                    t.name
+                ),
+            ));
+        }
+    }
+    if let Some(dir) = &args.assets {
+        if !dir.is_dir() {
+            return Err(Error::param(
+                "assets",
+                format!("{} is not a folder", dir.display()),
+            ));
+        }
+    }
     let mut raw = args.params.clone();
     raw.extend_from_slice(extra_params);
     let params = assign_params(&techniques, &raw)?;
@@ -553,6 +572,18 @@ fn sweep(args: &SweepArgs) -> Result<()> {
                 format!("expected name=v1,v2,... (got '{}')", args.sweep),
             )
         })?;
+    if let Some(v) = values
+        .iter()
+        .enumerate()
+        .find_map(|(i, v)| values[..i].contains(v).then_some(v))
+    {
+        return Err(Error::param(
+            "sweep",
+            format!(
+                "the value '{v}' is listed twice; its second run would overwrite the first's files"
+            ),
+        ));
+    }
     if args.run.technique.len() != 1 {
         return Err(Error::param(
             "technique",

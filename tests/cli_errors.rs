@@ -174,3 +174,46 @@ fn short_warmup_and_draining_laine_parameters() {
         "laine.recalc-min",
     );
 }
+
+/// Overflowing frame counts, a descriptor name that would climb out of the output folder, a
+/// technique or sweep value listed twice, `--assets` that is not a folder: clear errors, nothing
+/// written.
+#[test]
+fn overflow_names_duplicates_and_assets() {
+    fails(&["--frames", "4294967295"], "frames");
+    fails(&["--first-frame", "4294967295"], "first-frame");
+    let tmp = tempfile::tempdir().unwrap();
+    for bad in ["../../x", "", ".hidden", "a/b"] {
+        let d = descriptor(tmp.path(), "named.json", |v| {
+            v["name"] = serde_json::json!(bad)
+        });
+        fails(&["--scene", d.to_str().unwrap()], "name");
+    }
+    fails(&["--technique", "direct,direct"], "listed twice");
+    fails(&["--assets", "/no/such/folder"], "assets");
+    let o = Command::new(env!("CARGO_BIN_EXE_gibench"))
+        .args([
+            "sweep",
+            "--technique",
+            "keller-full",
+            "--sweep",
+            "vpls=8,8",
+            "--frames",
+            "2",
+        ])
+        .arg("--out")
+        .arg(tmp.path().join("sweep"))
+        .output()
+        .unwrap();
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("listed twice"));
+    let o = Command::new(env!("CARGO_BIN_EXE_gibench"))
+        .args(["reproduce", "laine-dispersion", "--frames", "0"])
+        .arg("--out")
+        .arg(tmp.path().join("repro"))
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success() && stderr.contains("frames") && !stderr.contains("panicked"));
+    assert!(!tmp.path().join("repro").exists());
+}

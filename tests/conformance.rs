@@ -144,7 +144,7 @@ fn conform_on(gpu: &GpuContext, scene_name: &str, failures: &mut Vec<String>) {
             c.mean_ratio,
             component.name()
         );
-        if !(rel_l1 <= c.max_relative_l1) {
+        if rel_l1.is_nan() || rel_l1 > c.max_relative_l1 {
             failures.push(format!(
                 "{name}: relative L1 error {rel_l1:.4} above its bound {}",
                 c.max_relative_l1

@@ -98,7 +98,7 @@ fn sibenik_loads_through_the_asset_search_path() {
     let triangles = |r: &RunResult, key: &str| r.settings[key].as_u64().unwrap();
     assert!(triangles(&laine, "scene_triangles") > 70_000);
     assert!(triangles(&laine, "shadow_mesh_triangles") > triangles(&laine, "scene_triangles"));
-    let counter = |r: &RunResult, name: &str| r.counters[name].clone();
+    let counter = |r: &RunResult, name: &str| r.counters[name];
     assert_eq!(counter(&keller, "vpls").min, 16.0);
     assert!(counter(&laine, "vpls").max <= 16.0 && counter(&laine, "vpls").min >= 8.0);
     assert_eq!(counter(&keller, "shadow-maps").mean, 16.0);

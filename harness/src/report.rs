@@ -455,14 +455,27 @@ fn timing_notes(results: &[&RunResult]) -> Vec<String> {
     notes
 }
 
-/// One row per run: scene, technique, resolution "WxH", one column per stage (median ms:
-/// flushed wall time, else GPU timestamps), "Σ stages", "frame (median ms)", "FPS".
-/// Notes say how the times were taken and on which device(s).
+/// "mean / min" of the VPLs lighting each measured frame (the `vpls` counter), if counted.
+pub fn vpl_count_cell(r: &RunResult) -> Cell {
+    match r.counters.get("vpls") {
+        Some(c) => Cell::text(format!("{:.1} / {}", c.mean, c.min)),
+        None => Cell::text("–"),
+    }
+}
+
+/// One row per run: scene, technique, resolution "WxH", "VPLs (mean / min)" when any run
+/// counts VPLs, one column per stage (median ms: flushed wall time, else GPU timestamps),
+/// "Σ stages", "frame (median ms)", "FPS". Notes say how the times were taken and on which
+/// device(s).
 pub fn stage_table(results: &[RunResult]) -> Table {
     let stages = stage_names(results);
+    let vpls = results.iter().any(|r| r.counters.contains_key("vpls"));
     let mut columns: Vec<String> = ["scene", "technique", "resolution"]
         .map(String::from)
         .into();
+    if vpls {
+        columns.push("VPLs (mean / min)".into());
+    }
     columns.extend(stages.iter().cloned());
     columns.extend(["Σ stages", "frame (median ms)", "FPS"].map(String::from));
     let quality = results.iter().any(|r| r.quality.is_some());
@@ -478,6 +491,9 @@ pub fn stage_table(results: &[RunResult]) -> Table {
                 Cell::text(&r.technique),
                 Cell::text(format!("{}x{}", r.resolution[0], r.resolution[1])),
             ];
+            if vpls {
+                row.push(vpl_count_cell(r));
+            }
             row.extend(
                 stages
                     .iter()

@@ -120,6 +120,21 @@ impl RunConfig {
                 "at least one measured frame is needed (got 0)",
             ));
         }
+        // Frame numbers must stay representable: the last animation frame rendered is
+        // first_frame + warmup + frames - 1.
+        const MAX_FRAMES: u32 = 10_000_000;
+        for (name, v) in [
+            ("frames", self.frames),
+            ("warmup", self.warmup),
+            ("first-frame", self.first_frame),
+        ] {
+            if v > MAX_FRAMES {
+                return Err(Error::param(
+                    name,
+                    format!("{v} exceeds the limit of {MAX_FRAMES}"),
+                ));
+            }
+        }
         let min_warmup = crate::profiler::FRAMES_IN_FLIGHT as u32 + 1;
         if self.timing != TimingMode::Stages && self.warmup < min_warmup {
             return Err(Error::param(
@@ -479,19 +494,38 @@ impl<'a> Harness<'a> {
     }
 }
 
-/// `git describe --always --dirty` of the source checkout gibench was built from, or "unknown".
+/// `git describe --always` of the source checkout gibench was built from, with `-dirty` when
+/// tracked files outside `results/` differ from that commit (rewriting committed results, as
+/// `results/regenerate.sh` does, changes no code); "unknown" without git.
 pub fn git_commit() -> String {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .parent()
         .unwrap_or(std::path::Path::new("."));
-    std::process::Command::new("git")
-        .arg("-C")
-        .arg(dir)
-        .args(["describe", "--always", "--dirty"])
-        .output()
-        .ok()
-        .filter(|o| o.status.success())
-        .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
-        .filter(|s| !s.is_empty())
-        .unwrap_or_else(|| "unknown".into())
+    let git = |args: &[&str]| {
+        std::process::Command::new("git")
+            .arg("-C")
+            .arg(dir)
+            .args(args)
+            .output()
+            .ok()
+            .filter(|o| o.status.success())
+            .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
+    };
+    let Some(commit) = git(&["describe", "--always"]).filter(|s| !s.is_empty()) else {
+        return "unknown".into();
+    };
+    let code_changed = git(&[
+        "status",
+        "--porcelain",
+        "--untracked-files=no",
+        "--",
+        ".",
+        ":(exclude)results",
+    ])
+    .is_some_and(|s| !s.is_empty());
+    if code_changed {
+        format!("{commit}-dirty")
+    } else {
+        commit
+    }
 }

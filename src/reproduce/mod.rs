@@ -102,6 +102,13 @@ pub fn paper_cells(values: &serde_json::Value) -> Vec<Cell> {
 /// Runs `args.target` and writes its tables (Markdown, CSV, LaTeX) into `args.out`.
 pub fn reproduce(args: &ReproduceArgs) -> Result<()> {
     let target = args.target.as_str();
+    if args.frames == Some(0) {
+        // Statistics of no samples are not a table.
+        return Err(Error::param(
+            "frames",
+            "at least one frame is needed (got 0)",
+        ));
+    }
     let tables = if laine2007::TARGETS.contains(&target) {
         laine2007::reproduce(target, args)?
     } else {

@@ -172,10 +172,22 @@ impl VplGather {
         Ok(())
     }
 
-    /// Uploads `vpls` (slot, VPL) into the store and records the gathering stages.
+    /// Uploads `vpls` (slot, VPL) into the store and records the gathering stages. Counts
+    /// `vpls`, and the fewest and most VPLs any interleaving tile gets (`tile-vpls-min`,
+    /// `tile-vpls-max`: slot k lights tile k mod T).
     pub fn gather(&self, ctx: &mut FrameContext, vpls: &[(u32, Vpl)]) -> Result<()> {
         self.store.write(&ctx.gpu.queue, vpls);
         ctx.profiler.count("vpls", vpls.len() as f64);
+        let tiles = (self.interleave.tiles[0] * self.interleave.tiles[1]) as usize;
+        let mut per_tile = vec![0u32; tiles];
+        for (slot, _) in vpls {
+            per_tile[*slot as usize % tiles] += 1;
+        }
+        let (lo, hi) = per_tile
+            .iter()
+            .fold((u32::MAX, 0), |(lo, hi), &n| (lo.min(n), hi.max(n)));
+        ctx.profiler.count("tile-vpls-min", lo as f64);
+        ctx.profiler.count("tile-vpls-max", hi as f64);
         self.gather_store(ctx)
     }
 

@@ -66,7 +66,9 @@ impl VplStore {
         }
         let size = HEADER + capacity as u64 * std::mem::size_of::<GpuVpl>() as u64;
         let limits = gpu.device.limits();
-        let max = (limits.max_storage_buffer_binding_size as u64).min(limits.max_buffer_size);
+        let max = limits
+            .max_storage_buffer_binding_size
+            .min(limits.max_buffer_size);
         if size > max {
             return Err(Error::param(
                 "vpls",

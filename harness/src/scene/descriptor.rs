@@ -266,6 +266,22 @@ impl SceneDescriptor {
     /// `light.size: area lights need a [width, height] size`.
     pub fn validate(&self, path_for_errors: &Path) -> Result<()> {
         let p = path_for_errors;
+        // The name becomes part of output and cache file names: a plain file stem only.
+        let plain = |c: char| c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.');
+        if self.name.is_empty()
+            || self.name.len() > 64
+            || self.name.starts_with('.')
+            || !self.name.chars().all(plain)
+        {
+            return Err(invalid(
+                p,
+                "name",
+                format!(
+                    "must be 1 to 64 letters, digits, '-', '_' or '.' not starting with '.' (it names output files), got {:?}",
+                    self.name
+                ),
+            ));
+        }
         validate_mesh_source(p, "mesh", &self.mesh)?;
         if let Some(shadow) = &self.shadow_mesh {
             validate_mesh_source(p, "shadow_mesh", shadow)?;

@@ -202,6 +202,9 @@ pub struct Step {
     pub new_slots: Vec<u32>,
     /// New sampling points (hits and misses).
     pub created: u32,
+    /// Of those, how many the largest-empty-circle search put on the disc's rim (the paper's
+    /// rule): their rays graze the light's plane, so any motion of the light invalidates them.
+    pub on_rim: u32,
     /// VPLs deleted (invalid or redundant).
     pub deleted: u32,
 }
@@ -284,6 +287,7 @@ impl Manager {
         self.started = true;
         let mut new_slots = Vec::new();
         let mut created = 0;
+        let mut on_rim = 0;
         while created < budget
             && (self.vpls.len() as u32) < self.max_lights
             && self.misses.len() < self.max_lights as usize
@@ -297,6 +301,9 @@ impl Manager {
                 break;
             }
             created += 1;
+            if kind == DomainKind::Disc && centre.truncate().length() >= 1.0 - 1e-9 {
+                on_rim += 1;
+            }
             let sample = centre.as_vec3();
             if let Some(v) = vpl::vpl_from_sample(scene, bvh, &light, sample, Vec3::ZERO, id) {
                 let slot = self.free_slots.pop().expect("fewer VPLs than slots");
@@ -319,6 +326,7 @@ impl Manager {
         Step {
             new_slots,
             created,
+            on_rim,
             deleted,
         }
     }
@@ -335,6 +343,8 @@ impl Technique for Laine {
         ctx.profiler
             .count("new-sampling-points", step.created as f64);
         ctx.profiler.count("deleted-vpls", step.deleted as f64);
+        ctx.profiler
+            .count("rim-sampling-points", step.on_rim as f64);
         ctx.profiler.count("dispersion", self.manager.dispersion());
         let new: Vec<(u32, Vpl)> = list
             .iter()
