@@ -13,11 +13,7 @@ use gibench_harness::scene::Scene;
 #[test]
 fn keller_full_matches_the_reference_one_bounce() {
     let scene = Scene::load_named("cornell", &AssetPaths::standard(None)).unwrap();
-    let gpu = GpuContext::new(&GpuOptions {
-        backend: Some("vulkan".into()),
-        adapter: None,
-    })
-    .expect("a GPU adapter");
+    let gpu = GpuContext::new(&GpuOptions::default()).expect("a GPU adapter (Vulkan or GL)");
     let size = [128u32, 96];
     let config = RunConfig {
         resolution: size,

@@ -68,6 +68,28 @@ const NO_ADAPTER_HELP: &str = "no GPU adapter found. gibench needs a Vulkan driv
 on a machine without a GPU install Mesa's CPU drivers (Debian/Ubuntu: \
 `apt-get install mesa-vulkan-drivers` for lavapipe; llvmpipe GL comes with libgl1-mesa-dri)";
 
+/// The portable backends (`vulkan`, `gl`) that offer an adapter on this machine, in that order:
+/// tests that compare backends run on the ones present and say which are absent.
+pub fn available_backends() -> Vec<&'static str> {
+    ["vulkan", "gl"]
+        .into_iter()
+        .filter(|b| {
+            GpuContext::new(&GpuOptions {
+                backend: Some(b.to_string()),
+                adapter: None,
+            })
+            .is_ok()
+        })
+        .collect()
+}
+
+/// Writes `message` to the process's standard error directly, past the test harness's output
+/// capture: for a test that must say plainly what it could not check on this machine.
+pub fn say_uncaptured(message: &str) {
+    use std::io::Write;
+    let _ = writeln!(std::io::stderr(), "note: {message}");
+}
+
 impl GpuContext {
     /// Picks an adapter and creates the device.
     pub fn new(opts: &GpuOptions) -> Result<GpuContext> {

@@ -89,12 +89,18 @@ fn check_backend(backend: Option<&str>) {
     );
 }
 
+/// On each portable backend present (Vulkan, GL); an absent one is named, not failed.
 #[test]
-fn gbuffer_matches_ray_casts_vulkan() {
-    check_backend(Some("vulkan"));
-}
-
-#[test]
-fn gbuffer_matches_ray_casts_gl() {
-    check_backend(Some("gl"));
+fn gbuffer_matches_ray_casts_on_every_backend() {
+    let present = gibench_harness::gpu::available_backends();
+    assert!(!present.is_empty(), "no Vulkan or GL adapter");
+    for backend in ["vulkan", "gl"] {
+        if present.contains(&backend) {
+            check_backend(Some(backend));
+        } else {
+            gibench_harness::gpu::say_uncaptured(&format!(
+                "gbuffer_matches_ray_casts: {backend} is absent on this machine; not checked"
+            ));
+        }
+    }
 }

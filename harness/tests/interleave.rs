@@ -13,8 +13,16 @@ use gibench_harness::scene::Scene;
 use gibench_harness::wgpu;
 use gibench_harness::Error;
 
-fn backends() -> [&'static str; 2] {
-    ["vulkan", "gl"]
+/// The portable backends present (an absent one is named once, not failed).
+fn backends() -> Vec<&'static str> {
+    let present = gibench_harness::gpu::available_backends();
+    assert!(!present.is_empty(), "no Vulkan or GL adapter");
+    if present.len() < 2 {
+        gibench_harness::gpu::say_uncaptured(&format!(
+            "interleave: only {present:?} present on this machine"
+        ));
+    }
+    present
 }
 
 const CORNELL: FilterSettings = FilterSettings {
