@@ -667,8 +667,11 @@ fn list() -> Result<()> {
     for t in registry::all() {
         println!("  {:<16} {}", t.name, t.description);
         println!(
-            "      compared with the {} reference by default",
-            t.reference.name()
+            "      compared with the {} reference by default; conformance: relative L1 error <= {}, mean ratio {}-{}",
+            t.reference.name(),
+            t.conformance.max_relative_l1,
+            t.conformance.mean_ratio.0,
+            t.conformance.mean_ratio.1
         );
         if t.param_specs().next().is_none() {
             println!("      (no parameters)");
