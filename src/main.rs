@@ -421,6 +421,11 @@ pub(crate) fn plan(args: &RunArgs, extra_params: &[String]) -> Result<Plan> {
     let params = assign_params(&techniques, &raw)?;
     let desc = SceneDescriptor::resolve(&args.scene)?;
     let scene = Scene::load(&desc, &AssetPaths::standard(args.assets.as_deref()))?;
+    // Where files will go must be usable before any GPU work.
+    writable_dir("out", &args.out)?;
+    if args.quality && !args.reference.no_cache {
+        writable_dir("cache", &args.reference.cache)?;
+    }
     Ok(Plan {
         config,
         quality,
@@ -469,6 +474,19 @@ pub(crate) fn execute_with_bar(
     });
     bar.finish_and_clear();
     results
+}
+
+/// Creates `dir` if needed and checks a file can be written there; the error names `option`.
+pub(crate) fn writable_dir(option: &str, dir: &Path) -> Result<()> {
+    let fail = |e: std::io::Error| {
+        Error::param(
+            option,
+            format!("{} is not a writable folder: {e}", dir.display()),
+        )
+    };
+    std::fs::create_dir_all(dir).map_err(fail)?;
+    tempfile::NamedTempFile::new_in(dir).map_err(fail)?;
+    Ok(())
 }
 
 pub(crate) fn progress_bar(quiet: bool, total: u64) -> indicatif::ProgressBar {

@@ -217,3 +217,26 @@ fn overflow_names_duplicates_and_assets() {
     assert!(!o.status.success() && stderr.contains("frames") && !stderr.contains("panicked"));
     assert!(!tmp.path().join("repro").exists());
 }
+
+/// An output folder that cannot be written is found before any GPU work, naming `--out`.
+#[test]
+fn unwritable_output_folder() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = tmp.path().join("a-file");
+    std::fs::write(&file, b"not a folder").unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_gibench"))
+        .args(["run", "--frames", "2", "--quiet", "--out"])
+        .arg(file.join("sub"))
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("out") && stderr.contains("not a writable folder"),
+        "{stderr}"
+    );
+    assert!(
+        !stderr.contains("gibench: scene"),
+        "failed only after opening the GPU: {stderr}"
+    );
+}
