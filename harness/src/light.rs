@@ -75,8 +75,8 @@ impl LightPose {
         self.direction.normalize_or(Vec3::NEG_Y)
     }
 
-    /// Whether the light sits at one point (spot, omni, and area lights as seen by the GPU
-    /// passes and Laine's management), as opposed to the sun's parallel rays.
+    /// Whether the light is the sun (parallel rays, no position), as opposed to a light at a
+    /// point (spot, omni, and area lights as the GPU passes and Laine's management see them).
     pub fn is_directional(&self) -> bool {
         self.kind == LightKind::Sun
     }

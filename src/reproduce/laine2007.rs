@@ -366,10 +366,19 @@ fn cpu_scene(
     Ok((name, scene, bvh))
 }
 
+/// The animation of `scene` with its light turned into a light of `kind` (same path).
+fn clock_with_light(
+    scene: &gibench_harness::scene::Scene,
+    kind: gibench_harness::scene::descriptor::LightKind,
+) -> gibench_harness::anim::FrameClock {
+    let mut d = scene.descriptor.clone();
+    d.light.kind = kind;
+    gibench_harness::anim::FrameClock::new(&d)
+}
+
 /// VPL management cost per frame on the CPU (spot and omni, 256 and 1024 VPLs) on Sibenik's
 /// animation: a CPU-only run of the `laine` manager.
 fn management(args: &ReproduceArgs) -> Result<Table> {
-    use gibench_harness::anim::FrameClock;
     use gibench_harness::scene::descriptor::LightKind;
     use gibench_harness::stats::Stats;
     let frames = args.frames.unwrap_or(if args.quick { 100 } else { 1000 });
@@ -378,9 +387,7 @@ fn management(args: &ReproduceArgs) -> Result<Table> {
     let mut rows = Vec::new();
     let mut records = serde_json::Map::new();
     for kind in [LightKind::Spot, LightKind::Omni] {
-        let mut d = scene.descriptor.clone();
-        d.light.kind = kind;
-        let clock = FrameClock::new(&d);
+        let clock = clock_with_light(&scene, kind);
         for vpls in [256u32, 1024] {
             let mut m = gibench_laine::Manager::new(vpls, 4, 8);
             m.step(&scene, &bvh, clock.frame(0).light);
@@ -441,7 +448,6 @@ fn management(args: &ReproduceArgs) -> Result<Table> {
 /// largest empty circle), spot and omni, with the light moving along the scene's path and with
 /// it still at frame 0's pose: a table of statistics, a JSON of every frame and an SVG plot.
 fn dispersion(args: &ReproduceArgs) -> Result<Table> {
-    use gibench_harness::anim::FrameClock;
     use gibench_harness::scene::descriptor::LightKind;
     use gibench_harness::stats::Stats;
     let frames = args.frames.unwrap_or(if args.quick { 120 } else { 600 });
@@ -450,9 +456,7 @@ fn dispersion(args: &ReproduceArgs) -> Result<Table> {
     let mut rows = Vec::new();
     let mut records = serde_json::Map::new();
     for kind in [LightKind::Spot, LightKind::Omni] {
-        let mut d = scene.descriptor.clone();
-        d.light.kind = kind;
-        let clock = FrameClock::new(&d);
+        let clock = clock_with_light(&scene, kind);
         for moving in [true, false] {
             let mut m = gibench_laine::Manager::new(256, 4, 8);
             let series: Vec<(f64, f64)> = (0..frames)
