@@ -21,7 +21,7 @@ use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec2, Vec3};
 
 use crate::gpu::GpuContext;
-use crate::passes::{cube_face_matrix, texture_entry, uniform_entry};
+use crate::passes::{cube_face_matrix, params_entry, texture_entry, PARAMS_USAGE};
 use crate::scene::SceneExtent;
 use crate::{Error, Result};
 
@@ -198,14 +198,14 @@ impl ShadowAtlas {
         let params = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("vpl atlas params"),
             size: std::mem::size_of::<ParamsData>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            usage: PARAMS_USAGE,
             mapped_at_creation: false,
         });
         let stages = wgpu::ShaderStages::COMPUTE | wgpu::ShaderStages::FRAGMENT;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("vpl atlas"),
             entries: &[
-                uniform_entry(0, stages, false),
+                params_entry(0, stages),
                 texture_entry(
                     1,
                     stages,
@@ -328,7 +328,7 @@ impl ShadowAtlas {
             .find("// Top-left texel")
             .expect("atlas_lookup.wgsl declares AtlasParams first");
         format!(
-            "{}\n@group({group}) @binding(0) var<uniform> atlas_params: AtlasParams;\n@group({group}) @binding(1) var vpl_atlas: texture_2d<f32>;\n{}",
+            "{}\n@group({group}) @binding(0) var<storage, read> atlas_params: AtlasParams;\n@group({group}) @binding(1) var vpl_atlas: texture_2d<f32>;\n{}",
             &lookup[..split],
             &lookup[split..]
         )

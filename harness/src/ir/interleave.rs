@@ -42,7 +42,7 @@ use bytemuck::{Pod, Zeroable};
 use crate::gpu::GpuContext;
 use crate::{Error, Result};
 
-use crate::passes::{shader_module, uniform_entry, GBuffer, HDR_FORMAT};
+use crate::passes::{params_entry, shader_module, GBuffer, HDR_FORMAT, PARAMS_USAGE};
 
 /// WGSL declarations a technique prepends to its accumulate shader (after `common.wgsl`, which
 /// [`crate::passes::shader_module`] adds): `struct InterleaveParams { full, tiles, tile_size, split:
@@ -223,7 +223,7 @@ impl Interleave {
         let params = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("interleave params"),
             size: std::mem::size_of::<Params>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            usage: PARAMS_USAGE,
             mapped_at_creation: false,
         });
 
@@ -231,7 +231,7 @@ impl Interleave {
         let split_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("interleave split (accumulate)"),
             entries: &[
-                uniform_entry(0, compute, false),
+                params_entry(0, compute),
                 storage_entry(1, true),
                 storage_entry(2, true),
                 storage_entry(3, false),
@@ -250,7 +250,7 @@ impl Interleave {
         let pass_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("interleave passes"),
             entries: &[
-                uniform_entry(0, compute, false),
+                params_entry(0, compute),
                 storage_entry(1, false),
                 storage_entry(2, false),
                 storage_entry(3, true),

@@ -9,8 +9,7 @@ use wgpu::util::DeviceExt;
 use crate::gpu::GpuContext;
 
 use super::{
-    draw_fullscreen, fullscreen_pipeline, render_target, shader_module, texture_entry,
-    uniform_entry,
+    draw_fullscreen, fullscreen_pipeline, params_entry, render_target, shader_module, texture_entry,
 };
 use super::{GBuffer, HDR_FORMAT};
 
@@ -43,13 +42,13 @@ impl Compose {
             entries: &[
                 texture_entry(0, fs, unfilterable, d2),
                 texture_entry(1, fs, unfilterable, d2),
-                uniform_entry(2, fs, false),
+                params_entry(2, fs),
             ],
         });
         let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("compose params"),
             contents: bytemuck::cast_slice(&[exposure, 0.0, 0.0, 0.0]),
-            usage: wgpu::BufferUsages::UNIFORM,
+            usage: wgpu::BufferUsages::STORAGE,
         });
         let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("compose"),

@@ -18,8 +18,7 @@ use crate::scene::descriptor::LightKind;
 
 use super::gbuffer::{scene_pipeline, DEPTH_FORMAT};
 use super::{
-    draw_fullscreen, fullscreen_pipeline, render_target, shader_module, texture_entry,
-    uniform_entry,
+    draw_fullscreen, fullscreen_pipeline, params_entry, render_target, shader_module, texture_entry,
 };
 use super::{FrameUniforms, GBuffer, GpuScene, HDR_FORMAT};
 
@@ -109,7 +108,7 @@ impl DirectLight {
         let light_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("light"),
             entries: &[
-                uniform_entry(0, fs, false),
+                params_entry(0, fs),
                 texture_entry(
                     1,
                     fs,
@@ -165,7 +164,7 @@ impl DirectLight {
     /// (`direct_shadow(p, n)`, `direct_irradiance(p, n)`). Prepend it after `common.wgsl`.
     pub fn wgsl(group: u32) -> String {
         format!(
-            "@group({group}) @binding(0) var<uniform> light: Light;\n\
+            "@group({group}) @binding(0) var<storage, read> light: Light;\n\
              @group({group}) @binding(1) var direct_shadow_map: texture_2d<f32>;\n\
              {DIRECT_LIGHT_WGSL}"
         )

@@ -39,6 +39,29 @@ pub fn shader_module(device: &wgpu::Device, label: &str, source: &str) -> wgpu::
 /// Format of every irradiance and radiance buffer (renderable on Vulkan and GL).
 pub const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 
+/// A read-only storage-buffer layout entry for a pass's parameter block.
+///
+/// Parameters a shader branches or loops on are bound as read-only storage buffers, not
+/// uniforms: lavapipe (Mesa 22.3) inlines uniform values that control flow depends on and
+/// compiles a fresh shader variant for every draw or dispatch that reads them, never freeing it
+/// (about 0.7 MB per frame for the direct-light pass alone: memory grew without bound).
+pub fn params_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only: true },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+/// Buffer usages of a parameter block bound with [`params_entry`] and written by the queue.
+pub const PARAMS_USAGE: wgpu::BufferUsages =
+    wgpu::BufferUsages::STORAGE.union(wgpu::BufferUsages::COPY_DST);
+
 /// A uniform-buffer layout entry.
 pub fn uniform_entry(
     binding: u32,

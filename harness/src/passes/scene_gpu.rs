@@ -528,7 +528,7 @@ impl FrameUniforms {
         let light_buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("light"),
             size: std::mem::size_of::<LightData>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            usage: super::PARAMS_USAGE,
             mapped_at_creation: false,
         });
         FrameUniforms {

@@ -3,7 +3,7 @@
 // combined) and the geometry-aware box filter of Laine et al. 2007, Figure 5 (combined → output).
 // Prepended: common.wgsl and interleave.wgsl.
 
-@group(0) @binding(0) var<uniform> interleave: InterleaveParams;
+@group(0) @binding(0) var<storage, read> interleave: InterleaveParams;
 @group(0) @binding(1) var<storage, read_write> split_position: array<vec4<f32>>;
 @group(0) @binding(2) var<storage, read_write> split_normal: array<vec4<f32>>;
 @group(0) @binding(3) var<storage, read> split_irradiance: array<vec4<f32>>;

@@ -12,7 +12,7 @@ struct ComposeParams {
 
 @group(1) @binding(0) var direct_irradiance: texture_2d<f32>;
 @group(1) @binding(1) var indirect_irradiance: texture_2d<f32>;
-@group(1) @binding(2) var<uniform> compose: ComposeParams;
+@group(1) @binding(2) var<storage, read> compose: ComposeParams;
 
 @vertex
 fn vs_main(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
