@@ -309,6 +309,7 @@ impl Profiler {
             fps: 1000.0 / frame_ms.mean,
             frame_ms,
             frames_in_flight: FRAMES_IN_FLIGHT as u32,
+            samples_ms: self.frame_times.clone(),
         })
     }
 

@@ -463,8 +463,20 @@ pub fn vpl_count_cell(r: &RunResult) -> Cell {
     }
 }
 
-/// One row per run: scene, technique, resolution "WxH", "VPLs (mean / min)" when any run
-/// counts VPLs, one column per stage (median ms: flushed wall time, else GPU timestamps),
+/// "fewest / most" VPLs any interleaving tile got in any measured frame (the `tile-vpls-min`
+/// and `tile-vpls-max` counters), if counted.
+pub fn tile_balance_cell(r: &RunResult) -> Cell {
+    match (
+        r.counters.get("tile-vpls-min"),
+        r.counters.get("tile-vpls-max"),
+    ) {
+        (Some(lo), Some(hi)) => Cell::text(format!("{} / {}", lo.min, hi.max)),
+        _ => Cell::text("–"),
+    }
+}
+
+/// One row per run: scene, technique, resolution "WxH", "VPLs (mean / min)" and "tile VPLs
+/// (fewest / most)" when any run counts them, one column per stage (median ms: flushed wall time, else GPU timestamps),
 /// "Σ stages", "frame (median ms)", "FPS". Notes say how the times were taken and on which
 /// device(s).
 pub fn stage_table(results: &[RunResult]) -> Table {
@@ -475,6 +487,12 @@ pub fn stage_table(results: &[RunResult]) -> Table {
         .into();
     if vpls {
         columns.push("VPLs (mean / min)".into());
+    }
+    let tiles = results
+        .iter()
+        .any(|r| r.counters.contains_key("tile-vpls-min"));
+    if tiles {
+        columns.push("tile VPLs (fewest / most)".into());
     }
     columns.extend(stages.iter().cloned());
     columns.extend(["Σ stages", "frame (median ms)", "FPS"].map(String::from));
@@ -493,6 +511,9 @@ pub fn stage_table(results: &[RunResult]) -> Table {
             ];
             if vpls {
                 row.push(vpl_count_cell(r));
+            }
+            if tiles {
+                row.push(tile_balance_cell(r));
             }
             row.extend(
                 stages
@@ -1118,6 +1139,7 @@ mod tests {
                 frame_ms: stats(frame_median),
                 fps: 1000.0 / (frame_median * 1.01),
                 frames_in_flight: 2,
+                samples_ms: vec![frame_median],
             }),
             counters: BTreeMap::from([("shadow maps".to_string(), stats(1.0))]),
             prepare_ms: None,

@@ -45,6 +45,9 @@ pub struct FrameResult {
     /// 1000 / mean frame time.
     pub fps: f64,
     pub frames_in_flight: u32,
+    /// Every measured frame's time, in order (for spotting spikes and their frames).
+    #[serde(default)]
+    pub samples_ms: Vec<f64>,
 }
 
 /// What the run was run on.

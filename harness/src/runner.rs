@@ -407,6 +407,10 @@ impl<'a> Harness<'a> {
                     Value::from(self.scene.mesh.triangle_count()),
                 );
                 s.insert(
+                    "scene_surface_area".into(),
+                    Value::from(self.scene.extent.surface_area as f64),
+                );
+                s.insert(
                     "shadow_mesh_triangles".into(),
                     Value::from(self.scene.shadow_caster_mesh().triangle_count()),
                 );

@@ -1,12 +1,13 @@
 //! VPL depth maps, paraboloid and cube, at the shipped defaults (16-bit depth, 128² maps):
 //! rendering a VPL's map and looking receivers up in it is a round trip through the projection;
 //! away from shadow boundaries its visibility must agree with CPU ray casts on 98 % of the
-//! receivers. Runs on Vulkan and GL.
+//! receivers; the accumulation's irradiance clamp bounds each VPL's irradiance at k / A times
+//! the store's summed flux. Runs on Vulkan and GL.
 
 use gibench_harness::assets::AssetPaths;
 use gibench_harness::glam::Vec3;
 use gibench_harness::gpu::{GpuContext, GpuOptions};
-use gibench_harness::ir::accumulate::Accumulation;
+use gibench_harness::ir::accumulate::{Accumulation, IrradianceClamp};
 use gibench_harness::ir::atlas::{AtlasFormat, AtlasSettings, MapKind, ShadowAtlas};
 use gibench_harness::ir::interleave::{FilterSettings, Interleave};
 use gibench_harness::ir::raster::{AtlasClear, AtlasRasteriser};
@@ -34,6 +35,18 @@ const SLOT: u32 = 2;
 /// Per pixel: (GPU irradiance from `vpl` with visibility, CPU unoccluded irradiance, CPU
 /// visible), gathered through the kit's store, atlas and accumulation with 1x1 tiles.
 fn one_vpl(backend: &str, fill: Fill, vpl: Vpl) -> Vec<Option<(f32, f32, bool)>> {
+    one_vpl_clamped(backend, fill, vpl, &[], IrradianceClamp::OFF)
+}
+
+/// [`one_vpl`] with `others` also in the store (in the slots after `vpl`'s, without maps: they
+/// must light nothing visible) and `clamp` on the accumulation.
+fn one_vpl_clamped(
+    backend: &str,
+    fill: Fill,
+    vpl: Vpl,
+    others: &[Vpl],
+    clamp: IrradianceClamp,
+) -> Vec<Option<(f32, f32, bool)>> {
     let scene = Scene::load_named("cornell", &AssetPaths::standard(None)).unwrap();
     let gpu = GpuContext::new(&GpuOptions {
         backend: Some(backend.into()),
@@ -83,8 +96,13 @@ fn one_vpl(backend: &str, fill: Fill, vpl: Vpl) -> Vec<Option<(f32, f32, bool)>>
     )
     .unwrap();
     let store = VplStore::new(&gpu, 4).unwrap();
-    let accumulation = Accumulation::new(&gpu, &interleave, &store, &atlas, 0.0).unwrap();
-    store.write(&gpu.queue, &[(SLOT, vpl)]);
+    let accumulation = Accumulation::new(&gpu, &interleave, &store, &atlas, clamp).unwrap();
+    let stored: Vec<(u32, Vpl)> = std::iter::once(vpl)
+        .chain(others.iter().copied())
+        .enumerate()
+        .map(|(i, v)| (SLOT + i as u32, v))
+        .collect();
+    store.write(&gpu.queue, &stored);
     let mut enc = gpu.device.create_command_encoder(&Default::default());
     harness
         .gbuffer
@@ -320,5 +338,71 @@ fn float_atlas_from_outside_the_rasteriser_matches_the_rasterised_one() {
                 "{backend}: summed irradiance differs by {rel:.4}"
             );
         }
+    }
+}
+
+/// The clamp (Laine et al. 2007 §5.2) bounds one VPL's irradiance at E_max = k / A · ΣΦ, ΣΦ
+/// being the summed flux of every VPL in the store, per channel, and a clamped contribution
+/// keeps its colour: a second VPL that lights nothing visible (above the ceiling, facing up)
+/// but carries (3, 1, 3) times the white VPL's flux makes the bound (4, 2, 4) times the white
+/// VPL's own, so green's is the tightest. With k chosen so that green's bound is the median
+/// unclamped irradiance, visible receivers get red = min(E, E_max,green) within 1 % (a bound
+/// from the VPL's own flux or from the mean, channels clamped separately, or a clamp left out,
+/// fails this).
+#[test]
+fn the_clamp_bounds_each_vpls_irradiance_relative_to_the_summed_flux() {
+    let scene = Scene::load_named("cornell", &AssetPaths::standard(None)).unwrap();
+    let area = scene.extent.surface_area;
+    let vpl = test_vpls()[0];
+    let dark = Vpl {
+        position: Vec3::new(278.0, 600.0, 280.0),
+        normal: Vec3::Y,
+        flux: Vec3::new(3.0, 1.0, 3.0) * vpl.flux,
+        ..vpl
+    };
+    for backend in backends() {
+        let free = one_vpl(backend, Fill::Raster(MapKind::Paraboloid), vpl);
+        let mut lit: Vec<f32> = free
+            .iter()
+            .flatten()
+            .filter(|(e, u, v)| *v && *u > 1e-6 && *e > 0.5 * u)
+            .map(|(e, _, _)| *e)
+            .collect();
+        lit.sort_by(f32::total_cmp);
+        let e_max = lit[lit.len() / 2];
+        // The white VPL's red channel is bounded by the tightest channel's bound, green's.
+        let summed = vpl.flux + dark.flux;
+        let clamp = IrradianceClamp {
+            factor: e_max * area / summed.y,
+            surface_area: area,
+        };
+        assert!((clamp.max_irradiance(summed).unwrap().y - e_max).abs() <= 1e-3 * e_max);
+        let clamped = one_vpl_clamped(
+            backend,
+            Fill::Raster(MapKind::Paraboloid),
+            vpl,
+            &[dark],
+            clamp,
+        );
+        let (mut n, mut bounded) = (0, 0);
+        for (a, b) in free.iter().zip(&clamped) {
+            let (Some((e, u, v)), Some((c, _, _))) = (a, b) else {
+                continue;
+            };
+            if !*v || *u < 1e-6 || *e <= 0.5 * u {
+                continue;
+            }
+            n += 1;
+            bounded += (*e > e_max) as usize;
+            let want = e.min(e_max);
+            assert!(
+                (c - want).abs() <= 0.01 * want + 1e-9,
+                "{backend}: clamped {c} where min({e}, {e_max}) = {want}"
+            );
+        }
+        assert!(
+            n > 500 && bounded * 3 > n,
+            "{backend}: {bounded} of {n} clamped"
+        );
     }
 }

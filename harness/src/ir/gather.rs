@@ -9,7 +9,7 @@
 //! Stages: [`STAGE_VPL_SHADOW_MAPS`], [`STAGE_SPLIT`], [`STAGE_ACCUMULATE`],
 //! [`STAGE_COMBINE`], [`STAGE_FILTER`]; counters `shadow-maps` and `vpls`.
 
-use super::accumulate::Accumulation;
+use super::accumulate::{Accumulation, IrradianceClamp};
 use super::atlas::{AtlasFormat, AtlasSettings, MapKind, ShadowAtlas};
 use super::interleave::{FilterSettings, Interleave};
 use super::raster::{AtlasClear, AtlasRasteriser};
@@ -60,9 +60,9 @@ pub const GATHER_PARAMS: &[ParamSpec] = &[
     },
     ParamSpec {
         name: "clamp",
-        kind: ParamKind::Float { min: 0.0, max: 1.0 },
-        default: "0.02",
-        doc: "minimum VPL-receiver distance in 1/r^2, as a fraction of the scene's bounding-box diagonal",
+        kind: ParamKind::Float { min: 0.0, max: 1e9 },
+        default: "10",
+        doc: "largest irradiance one VPL may give a receiver, in units of the mean irradiance of all VPLs (their flux spread over the scene's surface area); 0 = no clamp",
     },
 ];
 
@@ -73,7 +73,7 @@ pub struct GatherParams {
     pub map: MapKind,
     pub map_size: u32,
     pub format: AtlasFormat,
-    /// Fraction of the scene diagonal.
+    /// The irradiance clamp's factor k ([`super::accumulate`]; 0: no clamp).
     pub clamp: f32,
 }
 
@@ -141,7 +141,10 @@ impl VplGather {
             &interleave,
             &store,
             &atlas,
-            settings.clamp * ctx.scene.extent.diagonal,
+            IrradianceClamp {
+                factor: settings.clamp,
+                surface_area: ctx.scene.extent.surface_area,
+            },
         )?;
         let view = output.create_view(&Default::default());
         Ok(VplGather {

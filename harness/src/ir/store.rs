@@ -4,8 +4,11 @@
 //! writes the buffer itself (bind [`VplStore::buffer`] read-write and declare it with
 //! [`VplStore::wgsl`]`(group, binding, true)`).
 //! Writes: one storage buffer `VplStoreData { header: vec4<u32>, items: array<GpuVpl> }` of
-//! `capacity` items: `header.x` = number of slots in use (the highest used slot + 1); item k
-//! is the VPL in slot k (a zero flux marks an empty slot, which every lookup skips).
+//! `capacity` items: `header.x` = number of slots in use (the highest used slot + 1),
+//! `header.yzw` = the bits of three `f32`s, the VPLs' summed flux per channel (what the
+//! accumulation's irradiance clamp is relative to; a GPU pass that fills the store writes it
+//! too); item k is the VPL in slot k (a zero flux marks an empty slot, which every lookup
+//! skips).
 //!
 //! A VPL's slot is also its shadow-map slot in a [`super::atlas::ShadowAtlas`] and decides its
 //! interleaving tile (`slot mod T`), so incremental techniques that keep a VPL in its slot keep
@@ -97,7 +100,8 @@ impl VplStore {
     }
 
     /// Uploads `vpls` (slot, VPL): slots without a VPL up to the highest used one get a
-    /// zero-flux item; slots at or beyond the capacity are dropped. Returns the slots in use.
+    /// zero-flux item; slots at or beyond the capacity are dropped. The header gets the slots
+    /// in use and the summed flux of the VPLs kept. Returns the slots in use.
     pub fn write(&self, queue: &wgpu::Queue, vpls: &[(u32, Vpl)]) -> u32 {
         let n = vpls
             .iter()
@@ -106,10 +110,14 @@ impl VplStore {
             .unwrap_or(0)
             .min(self.capacity as usize);
         let mut data = vec![GpuVpl::zeroed(); n];
+        let mut flux = glam::DVec3::ZERO;
         for (slot, v) in vpls.iter().filter(|(slot, _)| (*slot as usize) < n) {
             data[*slot as usize] = GpuVpl::new(*slot, v);
+            flux += v.flux.as_dvec3();
         }
-        queue.write_buffer(&self.buffer, 0, bytemuck::bytes_of(&[n as u32, 0, 0, 0]));
+        let f = flux.as_vec3();
+        let header = [n as u32, f.x.to_bits(), f.y.to_bits(), f.z.to_bits()];
+        queue.write_buffer(&self.buffer, 0, bytemuck::bytes_of(&header));
         if !data.is_empty() {
             queue.write_buffer(&self.buffer, HEADER, bytemuck::cast_slice(&data));
         }

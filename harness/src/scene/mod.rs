@@ -206,15 +206,28 @@ pub struct SceneExtent {
     pub radius: f32,
     /// 10⁻⁴ × the diagonal, or 10⁻⁶ for an empty or degenerate mesh.
     pub ray_epsilon: f32,
+    /// Total area of the mesh's triangles (at least 10⁻¹²): what the VPL irradiance clamp
+    /// spreads the VPLs' flux over ([`crate::ir::accumulate`]).
+    pub surface_area: f32,
 }
 
 impl SceneExtent {
-    /// The extent of `mesh` (one pass over its vertices).
+    /// The extent of `mesh` (one pass over its vertices and one over its triangles).
     pub fn of(mesh: &Mesh) -> SceneExtent {
         let (lo, hi) = mesh.bounds();
-        SceneExtent::from_bounds(lo, hi)
+        let area: f64 = (0..mesh.triangle_count())
+            .map(|t| {
+                let [a, b, c] = mesh.triangle(t);
+                0.5 * (b - a).cross(c - a).length() as f64
+            })
+            .filter(|a| a.is_finite())
+            .sum();
+        SceneExtent {
+            surface_area: (area as f32).max(1e-12),
+            ..SceneExtent::from_bounds(lo, hi)
+        }
     }
-    /// The extent of the box `[min, max]`.
+    /// The extent of the box `[min, max]`, whose surface is the box's own.
     pub fn from_bounds(min: Vec3, max: Vec3) -> SceneExtent {
         let d = (max - min).length();
         let ok = d.is_finite() && d > 0.0;
@@ -225,6 +238,15 @@ impl SceneExtent {
             centre: 0.5 * (min + max),
             radius: if ok { 0.5 * d } else { 5e-7 },
             ray_epsilon: if ok { 1e-4 * d } else { 1e-6 },
+            surface_area: {
+                let e = (max - min).max(Vec3::ZERO);
+                let a = 2.0 * (e.x * e.y + e.y * e.z + e.z * e.x);
+                if a.is_finite() {
+                    a.max(1e-12)
+                } else {
+                    1e-12
+                }
+            },
         }
     }
 }

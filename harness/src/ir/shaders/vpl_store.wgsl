@@ -13,7 +13,8 @@ struct GpuVpl {
 };
 
 struct VplStoreData {
-    // x: slots in use (highest used slot + 1)
+    // x: slots in use (highest used slot + 1);
+    // yzw: bits of three f32s, the VPLs' summed flux (r, g, b)
     header: vec4<u32>,
     items: array<GpuVpl>,
 };
