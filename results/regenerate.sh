@@ -3,7 +3,7 @@
 # result (the README lists the same commands beside each result). Run from the repository root
 # on a clean checkout so that every results file records a clean git commit:
 #
-#   bash results/regenerate.sh            # everything (about an hour on a 2-core CPU)
+#   bash results/regenerate.sh            # everything (about 25 minutes on a 2-core CPU)
 #   bash results/regenerate.sh laine      # only the commands whose output is under results/laine
 #
 # Paper-size runs (`gibench reproduce laine-tables` without --quick) are for a GPU and are not
