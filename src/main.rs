@@ -10,6 +10,7 @@ use std::process::ExitCode;
 use clap::{Args, Parser, Subcommand};
 use gibench_harness::assets::AssetPaths;
 use gibench_harness::gpu::{GpuContext, GpuOptions};
+use gibench_harness::output::OutputSet;
 use gibench_harness::quality::{IndirectComponent, QualityConfig, ReferenceCache};
 use gibench_harness::reference::ReferenceSettings;
 use gibench_harness::report;
@@ -532,6 +533,7 @@ fn run(args: &RunArgs) -> Result<()> {
     let plan = plan(args, &[])?;
     let spec = plan.spec(args);
     spec.validate()?;
+    let set = OutputSet::begin("out", &args.out)?;
     let gpu = open_gpu(args)?;
     announce(&plan, &gpu);
     let results = execute_with_bar(args.quiet, &gpu, &spec)?;
@@ -561,6 +563,7 @@ fn run(args: &RunArgs) -> Result<()> {
             written.push(file_name(&svg));
         }
     }
+    set.publish()?;
     eprintln!(
         "wrote {} results, images and {} to {}",
         results.len(),
@@ -626,6 +629,7 @@ fn sweep(args: &SweepArgs) -> Result<()> {
         })
         .collect();
     spec.validate()?;
+    let set = OutputSet::begin("out", &args.run.out)?;
     let gpu = open_gpu(&args.run)?;
     announce(first, &gpu);
     let runs = execute_with_bar(args.run.quiet, &gpu, &spec)?;
@@ -652,6 +656,7 @@ fn sweep(args: &SweepArgs) -> Result<()> {
         ),
         &name,
     )?;
+    set.publish()?;
     eprintln!(
         "wrote {} points and {stem}.md/.csv/.tex/.svg to {}",
         points.len(),
@@ -742,6 +747,7 @@ fn plot_quality(args: &PlotQualityArgs) -> Result<()> {
 
 fn report_cmd(args: &ReportArgs) -> Result<()> {
     let results = read_results(&args.inputs)?;
+    let set = OutputSet::begin("out", &args.out)?;
     let table = report::stage_table(&results);
     println!("{}", table.to_terminal());
     if args.detailed {
@@ -755,7 +761,7 @@ fn report_cmd(args: &ReportArgs) -> Result<()> {
         &args.out.join(format!("{}.svg", args.stem)),
         "Per-stage times",
     )?;
-    Ok(())
+    set.publish()
 }
 
 fn reference_cmd(args: &ReferenceArgs) -> Result<()> {
@@ -775,6 +781,7 @@ fn reference_cmd(args: &ReferenceArgs) -> Result<()> {
     let scene = Scene::load(&desc, &AssetPaths::standard(args.assets.as_deref()))?;
     let frame = gibench_harness::anim::FrameClock::new(&desc).frame(args.frame);
     let cache = args.reference.cache();
+    let set = OutputSet::begin("out", &args.out)?;
     eprintln!(
         "gibench: reference for '{}' frame {} at {}x{}: {} spp, {} bounces, seed {}",
         desc.name,
@@ -844,6 +851,7 @@ fn reference_cmd(args: &ReferenceArgs) -> Result<()> {
     });
     let json = serde_json::to_vec_pretty(&info).map_err(|e| Error::Invalid(e.to_string()))?;
     gibench_harness::error::write_atomic(&out(".json"), &json)?;
+    set.publish()?;
     eprintln!("wrote {stem}.png, .json and -direct/-one-bounce/-multi-bounce/-radiance.exr to {} ({seconds:.1} s)", args.out.display());
     Ok(())
 }

@@ -240,3 +240,97 @@ fn unwritable_output_folder() {
         "failed only after opening the GPU: {stderr}"
     );
 }
+
+/// A one-triangle `.gltf` in `dir` whose buffer is the file `uri` names (written by the caller,
+/// or not at all); the descriptor that loads it is returned.
+fn one_triangle_gltf(dir: &Path, uri: &str) -> PathBuf {
+    let gltf = serde_json::json!({
+        "asset": {"version": "2.0"},
+        "buffers": [{"uri": uri, "byteLength": 36}],
+        "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36}],
+        "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                       "min": [0.0, 0.0, 0.0], "max": [3.0e38, 1.0, 0.0]}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+        "nodes": [{"mesh": 0}],
+        "scenes": [{"nodes": [0]}],
+        "scene": 0
+    });
+    let file = dir.join("tri.gltf");
+    std::fs::write(&file, serde_json::to_string(&gltf).unwrap()).unwrap();
+    descriptor(dir, "tri.json", |v| {
+        v["mesh"] = serde_json::json!({"file": file.to_str().unwrap()});
+        v.as_object_mut().unwrap().remove("shadow_mesh");
+    })
+}
+
+/// Triangle corners as the little-endian f32 bytes of a glTF buffer.
+fn corners(p: [[f32; 3]; 3]) -> Vec<u8> {
+    p.iter().flatten().flat_map(|c| c.to_le_bytes()).collect()
+}
+
+/// Geometry too large for f32 bounds (a vertex at 3e38, a static scaled by 1e30 or placed at
+/// 3e38) is refused with the field or mesh named, instead of panicking in the BVH build.
+#[test]
+fn huge_coordinates() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = one_triangle_gltf(tmp.path(), "tri.bin");
+    std::fs::write(
+        tmp.path().join("tri.bin"),
+        corners([[0.0, 0.0, 0.0], [3.0e38, 0.0, 0.0], [0.0, 1.0, 0.0]]),
+    )
+    .unwrap();
+    fails(
+        &["--scene", d.to_str().unwrap()],
+        "the static mesh (with its statics): a vertex at",
+    );
+    let statue = |scale: f64, at: f64| {
+        move |v: &mut serde_json::Value| {
+            v["statics"] = serde_json::json!([{
+                "mesh": {"generated": "cornell-box"},
+                "scale": scale,
+                "position": [at, 0.0, 0.0]
+            }]);
+        }
+    };
+    let d = descriptor(tmp.path(), "scaled.json", statue(1e30, 0.0));
+    fails(&["--scene", d.to_str().unwrap()], "after its transforms");
+    let d = descriptor(tmp.path(), "placed.json", statue(1.0, 3e38));
+    fails(&["--scene", d.to_str().unwrap()], "statics[0]");
+}
+
+/// A buffer URI must stay inside the glTF's folder and name a regular file; a missing one is
+/// named; a device (`/dev/zero`) is never read, as a URI or as `--scene`.
+#[test]
+fn buffer_uris_outside_the_folder_devices_and_missing_files() {
+    let tmp = tempfile::tempdir().unwrap();
+    for (uri, expect) in [
+        ("../../../../etc/passwd", "leaves the glTF's folder"),
+        ("/dev/zero", "leaves the glTF's folder"),
+        ("file:///dev/zero", "has a scheme"),
+        ("missing.bin", "missing.bin"),
+    ] {
+        let d = one_triangle_gltf(tmp.path(), uri);
+        fails(&["--scene", d.to_str().unwrap()], expect);
+    }
+    #[cfg(unix)]
+    {
+        std::os::unix::fs::symlink("/dev/zero", tmp.path().join("zero.bin")).unwrap();
+        let d = one_triangle_gltf(tmp.path(), "zero.bin");
+        fails(
+            &["--scene", d.to_str().unwrap()],
+            "does not name a regular file",
+        );
+        fails(&["--scene", "/dev/zero"], "not a regular file");
+    }
+}
+
+/// A `tessellate` edge that would make more than 2²³ triangles is refused before any memory is
+/// asked for, naming the field.
+#[test]
+fn tessellation_past_the_cap() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = descriptor(tmp.path(), "fine.json", |v| {
+        v["shadow_mesh"]["tessellate"] = serde_json::json!(0.001)
+    });
+    fails(&["--scene", d.to_str().unwrap()], "shadow_mesh.tessellate");
+}

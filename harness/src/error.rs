@@ -59,15 +59,34 @@ impl Error {
 }
 
 /// Writes `bytes` to `path` atomically: a temporary file in the same directory, then a rename,
-/// so a reader never sees a half-written file and a failed run leaves nothing behind.
+/// so a reader never sees a half-written file and a failed run leaves nothing behind. While an
+/// [`crate::output::OutputSet`] is open on a folder holding `path`, the file is staged there and
+/// appears at `path` when the set is published.
 pub fn write_atomic(path: &std::path::Path, bytes: &[u8]) -> Result<()> {
+    match crate::output::staged_path(path) {
+        Some(staged) => write_atomic_direct(&staged, bytes),
+        None => write_atomic_direct(path, bytes),
+    }
+}
+
+/// [`write_atomic`] straight to `path`, never staged (the reference cache). The temporary file is
+/// named `.gibench-tmp-PID-…`, so one a killed process leaves can be found and removed
+/// ([`crate::output::remove_stale_temporaries`]).
+pub fn write_atomic_direct(path: &std::path::Path, bytes: &[u8]) -> Result<()> {
     use std::io::Write;
     let dir = path
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
         .unwrap_or(std::path::Path::new("."));
     std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
-    let mut tmp = tempfile::NamedTempFile::new_in(dir).map_err(|e| Error::io(dir, e))?;
+    let mut tmp = tempfile::Builder::new()
+        .prefix(&format!(
+            "{}{}-",
+            crate::output::TEMP_PREFIX,
+            std::process::id()
+        ))
+        .tempfile_in(dir)
+        .map_err(|e| Error::io(dir, e))?;
     tmp.write_all(bytes).map_err(|e| Error::io(path, e))?;
     tmp.as_file().sync_all().map_err(|e| Error::io(path, e))?;
     // Temporary files are created private; results are meant to be read by anyone.
@@ -80,4 +99,40 @@ pub fn write_atomic(path: &std::path::Path, bytes: &[u8]) -> Result<()> {
     }
     tmp.persist(path).map_err(|e| Error::io(path, e.error))?;
     Ok(())
+}
+
+/// Reads the regular file `path` whole, refusing anything else (a device such as `/dev/zero`, a
+/// pipe, a folder) and files over `max` bytes, so no input can make a read run without bound.
+pub fn read_bounded(path: &std::path::Path, max: u64) -> Result<Vec<u8>> {
+    use std::io::Read;
+    let meta = std::fs::metadata(path).map_err(|e| Error::io(path, e))?;
+    if !meta.is_file() {
+        return Err(Error::bad_file(path, "not a regular file"));
+    }
+    if meta.len() > max {
+        return Err(Error::bad_file(
+            path,
+            format!(
+                "{} bytes, more than the {max} this input may have",
+                meta.len()
+            ),
+        ));
+    }
+    let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
+    let mut bytes = Vec::with_capacity(meta.len() as usize);
+    file.take(max + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| Error::io(path, e))?;
+    if bytes.len() as u64 > max {
+        return Err(Error::bad_file(
+            path,
+            format!("grew past the {max} bytes this input may have while being read"),
+        ));
+    }
+    Ok(bytes)
+}
+
+/// [`read_bounded`] as UTF-8 text.
+pub fn read_bounded_text(path: &std::path::Path, max: u64) -> Result<String> {
+    String::from_utf8(read_bounded(path, max)?).map_err(|_| Error::bad_file(path, "not UTF-8 text"))
 }

@@ -35,6 +35,7 @@ pub mod image_io;
 pub mod ir;
 pub mod light;
 pub mod metrics;
+pub mod output;
 pub mod passes;
 pub mod profiler;
 pub mod quality;

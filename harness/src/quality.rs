@@ -133,12 +133,52 @@ impl QualityConfig {
 }
 
 /// On-disk cache of reference images (`None` directory: no caching).
+///
+/// An entry's name hashes everything the reference depends on: the descriptor, the *loaded*
+/// scene's content (every vertex, index and material of the static mesh and the movers, every
+/// texel — so an edited glTF or another copy of an asset never reuses a stale entry), the frame,
+/// resolution, spp, bounces, seed and the reference code's version. An entry is checked on
+/// load (its size, its header and every value finite) and rendered again if bad. The cache
+/// keeps at most [`MAX_CACHE_BYTES`], dropping the least recently used entries; temporary
+/// files a killed run left are removed when the cache is used.
 #[derive(Clone, Debug, Default)]
 pub struct ReferenceCache {
     pub dir: Option<PathBuf>,
 }
 
 const MAGIC: &[u8; 8] = b"GIBREF1\n";
+
+/// Most bytes of entries the reference cache keeps (4 GiB).
+pub const MAX_CACHE_BYTES: u64 = 4 << 30;
+
+/// A hash of the loaded scene's content the reference depends on (see [`ReferenceCache`]).
+pub fn scene_content_hash(scene: &Scene) -> u64 {
+    let mut h = 0xcbf29ce484222325;
+    let mesh = |m: &crate::scene::Mesh, h: &mut u64| {
+        *h = fnv1a(bytemuck::cast_slice(&m.positions), *h);
+        *h = fnv1a(bytemuck::cast_slice(&m.normals), *h);
+        *h = fnv1a(bytemuck::cast_slice(&m.uvs), *h);
+        *h = fnv1a(bytemuck::cast_slice(&m.materials), *h);
+        *h = fnv1a(bytemuck::cast_slice(&m.indices), *h);
+    };
+    mesh(&scene.mesh, &mut h);
+    for m in &scene.movers {
+        h = fnv1a(m.name.as_bytes(), h);
+        mesh(&m.mesh, &mut h);
+    }
+    for m in &scene.materials {
+        h = fnv1a(m.name.as_bytes(), h);
+        h = fnv1a(bytemuck::bytes_of(&m.base_color), h);
+        h = fnv1a(bytemuck::bytes_of(&m.average_color), h);
+        h = fnv1a(&m.texture.map_or(u64::MAX, |t| t as u64).to_le_bytes(), h);
+    }
+    for t in &scene.textures {
+        h = fnv1a(&t.width.to_le_bytes(), h);
+        h = fnv1a(&t.height.to_le_bytes(), h);
+        h = fnv1a(&t.rgba8, h);
+    }
+    h
+}
 
 fn fnv1a(bytes: &[u8], mut h: u64) -> u64 {
     for b in bytes {
@@ -158,6 +198,7 @@ impl ReferenceCache {
     ) -> String {
         let desc = serde_json::to_vec(&scene.descriptor).unwrap_or_default();
         let mut h = fnv1a(&desc, 0xcbf29ce484222325);
+        h = fnv1a(&scene_content_hash(scene).to_le_bytes(), h);
         let key = format!(
             "{frame}|{}x{}|{}|{}|{}|{}|{}|{}",
             resolution[0],
@@ -188,14 +229,22 @@ impl ReferenceCache {
             .dir
             .as_ref()
             .map(|d| d.join(Self::file_name(scene, frame.index, resolution, settings)));
+        if let Some(dir) = &self.dir {
+            crate::output::remove_stale_temporaries(dir);
+        }
         if let Some(p) = &path {
             if let Some(r) = read_cached(p, resolution, settings) {
+                // Recently used: kept longest when the cache is trimmed.
+                if let Ok(f) = std::fs::File::options().append(true).open(p) {
+                    let _ = f.set_modified(std::time::SystemTime::now());
+                }
                 return Ok(r);
             }
         }
         let r = reference::render_reference(scene, frame, resolution, settings);
-        if let Some(p) = &path {
-            crate::error::write_atomic(p, &encode(&r))?;
+        if let (Some(p), Some(dir)) = (&path, &self.dir) {
+            crate::error::write_atomic_direct(p, &encode(&r))?;
+            trim(dir, MAX_CACHE_BYTES, p);
         }
         Ok(r)
     }
@@ -224,11 +273,42 @@ fn encode(r: &ReferenceImages) -> Vec<u8> {
     out
 }
 
-/// A cached reference, or `None` if absent or not matching (it is then rendered again).
+/// Removes the least recently used entries (`*.bin`, by modification time) of the cache in
+/// `dir` until they total at most `max` bytes, never `keep` (the entry just written).
+fn trim(dir: &Path, max: u64, keep: &Path) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    let mut files: Vec<(std::time::SystemTime, u64, PathBuf)> = entries
+        .flatten()
+        .filter(|e| e.path().extension().is_some_and(|x| x == "bin"))
+        .filter_map(|e| {
+            let m = e.metadata().ok()?;
+            Some((m.modified().ok()?, m.len(), e.path()))
+        })
+        .collect();
+    let mut total: u64 = files.iter().map(|f| f.1).sum();
+    files.sort();
+    for (_, len, p) in files {
+        if total <= max {
+            break;
+        }
+        if p != keep && std::fs::remove_file(&p).is_ok() {
+            total -= len;
+        }
+    }
+}
+
+/// A cached reference, or `None` if absent, not matching or damaged (a wrong size or header,
+/// a non-finite value): it is then rendered again.
 fn read_cached(path: &Path, size: [u32; 2], s: &ReferenceSettings) -> Option<ReferenceImages> {
-    let bytes = std::fs::read(path).ok()?;
     let n = (size[0] * size[1]) as usize;
-    if bytes.len() != 8 + 24 + n + 5 * n * 12 || &bytes[..8] != MAGIC {
+    let expected = 8 + 24 + n + 5 * n * 12;
+    if std::fs::metadata(path).ok()?.len() != expected as u64 {
+        return None;
+    }
+    let bytes = crate::error::read_bounded(path, expected as u64).ok()?;
+    if bytes.len() != expected || &bytes[..8] != MAGIC {
         return None;
     }
     let u32_at = |o: usize| u32::from_le_bytes(bytes[o..o + 4].try_into().unwrap());
@@ -257,6 +337,12 @@ fn read_cached(path: &Path, size: [u32; 2], s: &ReferenceSettings) -> Option<Ref
         v
     };
     let (albedo, direct, one_bounce, multi_bounce, radiance) = (img(), img(), img(), img(), img());
+    if [&albedo, &direct, &one_bounce, &multi_bounce, &radiance]
+        .iter()
+        .any(|img| img.iter().any(|v| !v.is_finite()))
+    {
+        return None;
+    }
     Some(ReferenceImages {
         size,
         spp: s.spp,
@@ -340,4 +426,91 @@ pub fn compare(
     let images = images
         .ok_or_else(|| Error::Invalid("no frames were compared with the reference".into()))?;
     Ok((metrics::summarize(config.label(), frames), images))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::assets::AssetPaths;
+
+    fn tiny(value: f32) -> ReferenceImages {
+        let n = 4;
+        let img = vec![Vec3::splat(value); n];
+        ReferenceImages {
+            size: [2, 2],
+            spp: 1,
+            bounces: 1,
+            seed: 0,
+            hit: vec![true; n],
+            albedo: img.clone(),
+            direct: img.clone(),
+            one_bounce: img.clone(),
+            multi_bounce: img.clone(),
+            radiance: img,
+        }
+    }
+
+    /// The key follows the loaded content: a changed material colour or a moved vertex gives
+    /// another entry; the same scene loaded twice the same one.
+    #[test]
+    fn the_cache_key_follows_the_scenes_content() {
+        let scene = Scene::load_named("cornell", &AssetPaths::standard(None)).unwrap();
+        let frame = crate::anim::FrameClock::new(&scene.descriptor).frame(0);
+        let s = ReferenceSettings {
+            spp: 4,
+            bounces: 1,
+            seed: 0,
+        };
+        let key = |sc: &Scene| ReferenceCache::file_name(sc, frame.index, [8, 8], &s);
+        let again = Scene::load_named("cornell", &AssetPaths::standard(None)).unwrap();
+        assert_eq!(key(&scene), key(&again));
+        let mut recoloured = scene.clone();
+        recoloured.materials[0].base_color *= 0.5;
+        assert_ne!(key(&scene), key(&recoloured));
+        let mut moved = scene.clone();
+        moved.mesh.positions[0].x += 1.0;
+        assert_ne!(key(&scene), key(&moved));
+    }
+
+    /// A damaged entry (a NaN, a truncated file) is not used; a good one is.
+    #[test]
+    fn damaged_entries_are_rendered_again() {
+        let dir = tempfile::tempdir().unwrap();
+        let s = ReferenceSettings {
+            spp: 1,
+            bounces: 1,
+            seed: 0,
+        };
+        let good = dir.path().join("good.bin");
+        std::fs::write(&good, encode(&tiny(1.0))).unwrap();
+        assert!(read_cached(&good, [2, 2], &s).is_some());
+        let nan = dir.path().join("nan.bin");
+        std::fs::write(&nan, encode(&tiny(f32::NAN))).unwrap();
+        assert!(read_cached(&nan, [2, 2], &s).is_none());
+        let bytes = encode(&tiny(1.0));
+        let cut = dir.path().join("cut.bin");
+        std::fs::write(&cut, &bytes[..bytes.len() - 1]).unwrap();
+        assert!(read_cached(&cut, [2, 2], &s).is_none());
+    }
+
+    /// Trimming drops the least recently used entries until the rest fit, never the new one.
+    #[test]
+    fn the_cache_is_trimmed_oldest_first() {
+        let dir = tempfile::tempdir().unwrap();
+        let t0 = std::time::SystemTime::now() - std::time::Duration::from_secs(100);
+        for (i, name) in ["a.bin", "b.bin", "c.bin"].iter().enumerate() {
+            let p = dir.path().join(name);
+            std::fs::write(&p, vec![0u8; 100]).unwrap();
+            let f = std::fs::File::options().append(true).open(&p).unwrap();
+            f.set_modified(t0 + std::time::Duration::from_secs(10 * i as u64))
+                .unwrap();
+        }
+        let newest = dir.path().join("a.bin");
+        trim(dir.path(), 200, &newest);
+        let left: Vec<bool> = ["a.bin", "b.bin", "c.bin"]
+            .iter()
+            .map(|n| dir.path().join(n).exists())
+            .collect();
+        assert_eq!(left, [true, false, true]);
+    }
 }

@@ -127,7 +127,7 @@ impl RunResult {
 
     /// Reads and checks a results file.
     pub fn read(path: &Path) -> Result<RunResult> {
-        let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+        let bytes = crate::error::read_bounded(path, 1 << 30)?;
         let r: RunResult = serde_json::from_slice(&bytes)
             .map_err(|e| Error::bad_file(path, format!("not a gibench results file: {e}")))?;
         if r.schema_version != SCHEMA_VERSION {

@@ -109,9 +109,7 @@ pub fn reproduce(args: &ReproduceArgs) -> Result<()> {
             "at least one frame is needed (got 0)",
         ));
     }
-    let tables = if laine2007::TARGETS.contains(&target) {
-        laine2007::reproduce(target, args)?
-    } else {
+    if !laine2007::TARGETS.contains(&target) {
         return Err(Error::param(
             "target",
             format!(
@@ -119,7 +117,10 @@ pub fn reproduce(args: &ReproduceArgs) -> Result<()> {
                 laine2007::TARGETS.join(", ")
             ),
         ));
-    };
+    }
+    crate::writable_dir("out", &args.out)?;
+    let set = gibench_harness::output::OutputSet::begin("out", &args.out)?;
+    let tables = laine2007::reproduce(target, args)?;
     for (table, stem) in tables {
         println!("{}", table.to_terminal());
         let written = report::write_tables(&table, &args.out, stem)?;
@@ -132,5 +133,5 @@ pub fn reproduce(args: &ReproduceArgs) -> Result<()> {
                 .join(", ")
         );
     }
-    Ok(())
+    set.publish()
 }

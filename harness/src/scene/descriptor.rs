@@ -241,13 +241,18 @@ fn invalid(path: &Path, field: &str, message: impl std::fmt::Display) -> Error {
 }
 
 fn check_finite3(path: &Path, field: &str, v: &[f32; 3]) -> Result<()> {
-    if v.iter().all(|c| c.is_finite()) {
+    if v.iter()
+        .all(|c| c.is_finite() && c.abs() <= super::MAX_COORDINATE)
+    {
         Ok(())
     } else {
         Err(invalid(
             path,
             field,
-            format!("every component must be a finite number, got {v:?}"),
+            format!(
+                "every component must be a finite number within ±{:e}, got {v:?}",
+                super::MAX_COORDINATE
+            ),
         ))
     }
 }
@@ -296,7 +301,12 @@ impl SceneDescriptor {
                     format!("must be positive, got {}", st.scale),
                 ));
             }
-            if !st.position.iter().all(|c| c.is_finite()) || !st.rotation_y_deg.is_finite() {
+            if !st
+                .position
+                .iter()
+                .all(|c| c.is_finite() && c.abs() <= super::MAX_COORDINATE)
+                || !st.rotation_y_deg.is_finite()
+            {
                 return Err(invalid(
                     p,
                     &field,
@@ -463,7 +473,8 @@ impl SceneDescriptor {
                 builtin_names().join(", ")
             )));
         }
-        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        // A descriptor is a few kilobytes; 16 MiB bounds the read (`--scene /dev/zero`).
+        let text = crate::error::read_bounded_text(path, 16 << 20)?;
         let desc = Self::from_json(path, &text)?;
         desc.validate(path)?;
         Ok(desc)

@@ -64,14 +64,7 @@ pub fn load_gltf_with_offsets(
     material_offset: u32,
     texture_offset: u32,
 ) -> Result<LoadedGltf> {
-    let (doc, buffers, images) = gltf::import(path).map_err(|e| match e {
-        gltf::Error::Io(source)
-            if source.kind() == std::io::ErrorKind::NotFound && !path.exists() =>
-        {
-            Error::io(path, source)
-        }
-        other => Error::bad_file(path, format!("not a valid glTF binary: {other}")),
-    })?;
+    let (doc, buffers, images) = import_checked(path)?;
     let bad = |message: String| Error::bad_file(path, message);
 
     // Materials and the images they use as base colour.
@@ -386,6 +379,123 @@ pub fn load_gltf_with_offsets(
 }
 
 /// Unit normal of triangle `tri` (counter-clockwise front), `+Y` if it has no area.
+/// Largest glTF file, and largest file one of its URIs may name, that gibench reads (2 GiB).
+pub const MAX_GLTF_FILE_BYTES: u64 = 2 << 30;
+
+/// `gltf::import` with every read bounded and every external file checked first: the glTF
+/// itself and each file a buffer or image URI names must be a regular file of at most
+/// [`MAX_GLTF_FILE_BYTES`]; a URI must be a `data:` URI or a relative path that stays inside the
+/// glTF's folder (no absolute path, no `..`, no other scheme); a missing file is named.
+fn import_checked(
+    path: &Path,
+) -> Result<(
+    gltf::Document,
+    Vec<gltf::buffer::Data>,
+    Vec<gltf::image::Data>,
+)> {
+    let bytes = crate::error::read_bounded(path, MAX_GLTF_FILE_BYTES)?;
+    let invalid = |e: gltf::Error| Error::bad_file(path, format!("not a valid glTF binary: {e}"));
+    let gltf::Gltf { document, blob } = gltf::Gltf::from_slice(&bytes).map_err(invalid)?;
+    drop(bytes);
+    let base = path.parent().unwrap_or(Path::new("."));
+    for b in document.buffers() {
+        if let gltf::buffer::Source::Uri(uri) = b.source() {
+            let what = format!("buffer {}", b.index());
+            if let Some(file) = external_file(path, base, &what, uri)? {
+                let len = std::fs::metadata(&file).map(|m| m.len()).unwrap_or(0);
+                if len < b.length() as u64 {
+                    return Err(Error::bad_file(
+                        path,
+                        format!(
+                            "{what}: '{}' has {len} bytes, the buffer declares {}",
+                            file.display(),
+                            b.length()
+                        ),
+                    ));
+                }
+            }
+        }
+    }
+    for img in document.images() {
+        if let gltf::image::Source::Uri { uri, .. } = img.source() {
+            external_file(path, base, &format!("image {}", img.index()), uri)?;
+        }
+    }
+    let buffers = gltf::import_buffers(&document, Some(base), blob).map_err(invalid)?;
+    let images = gltf::import_images(&document, Some(base), &buffers).map_err(invalid)?;
+    Ok((document, buffers, images))
+}
+
+/// The file a glTF URI names, checked (see [`import_checked`]); `None` for a `data:` URI.
+fn external_file(
+    gltf: &Path,
+    base: &Path,
+    what: &str,
+    uri: &str,
+) -> Result<Option<std::path::PathBuf>> {
+    let refuse = |why: &str| {
+        Error::bad_file(
+            gltf,
+            format!("{what}: URI '{uri}' {why}; only data: URIs and relative paths inside the glTF's folder are read"),
+        )
+    };
+    if uri.starts_with("data:") {
+        return Ok(None);
+    }
+    if uri.contains(':') {
+        return Err(refuse("has a scheme"));
+    }
+    let decoded =
+        percent_decode(uri).ok_or_else(|| refuse("is not valid percent-encoded UTF-8"))?;
+    let rel = Path::new(&decoded);
+    if !rel.components().all(|c| {
+        matches!(
+            c,
+            std::path::Component::Normal(_) | std::path::Component::CurDir
+        )
+    }) {
+        return Err(refuse("leaves the glTF's folder"));
+    }
+    let file = base.join(rel);
+    let meta = std::fs::metadata(&file).map_err(|e| {
+        Error::bad_file(
+            gltf,
+            format!(
+                "{what}: cannot read '{}' (URI '{uri}'): {e}",
+                file.display()
+            ),
+        )
+    })?;
+    if !meta.is_file() {
+        return Err(refuse("does not name a regular file"));
+    }
+    if meta.len() > MAX_GLTF_FILE_BYTES {
+        return Err(refuse(&format!(
+            "names a file of {} bytes, more than {MAX_GLTF_FILE_BYTES}",
+            meta.len()
+        )));
+    }
+    Ok(Some(file))
+}
+
+/// Decodes `%XX` escapes of a URI path (`None` for a bad escape or invalid UTF-8).
+fn percent_decode(s: &str) -> Option<String> {
+    let bytes = s.as_bytes();
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        if bytes[i] == b'%' {
+            let hex = std::str::from_utf8(bytes.get(i + 1..i + 3)?).ok()?;
+            out.push(u8::from_str_radix(hex, 16).ok()?);
+            i += 3;
+        } else {
+            out.push(bytes[i]);
+            i += 1;
+        }
+    }
+    String::from_utf8(out).ok()
+}
+
 fn face_normal(positions: &[Vec3], tri: &[u32]) -> Vec3 {
     let [a, b, c] = [0, 1, 2].map(|k| positions[tri[k] as usize]);
     (b - a).cross(c - a).normalize_or(Vec3::Y)

@@ -89,6 +89,24 @@ impl Mesh {
             |(lo, hi), p| (lo.min(*p), hi.max(*p)),
         )
     }
+    /// How many triangles [`Mesh::tessellated`] would make, computed without making them.
+    pub fn tessellated_triangle_count(&self, max_edge: f32) -> u64 {
+        if !(max_edge.is_finite() && max_edge > 0.0) {
+            return self.triangle_count() as u64;
+        }
+        (0..self.triangle_count())
+            .map(|t| {
+                let p = self.triangle(t);
+                let longest = (p[1] - p[0])
+                    .length()
+                    .max((p[2] - p[1]).length())
+                    .max((p[0] - p[2]).length());
+                let n = tessellation_factor(longest, max_edge) as u64;
+                n * n
+            })
+            .sum()
+    }
+
     /// A copy in which every triangle whose longest edge exceeds `max_edge` is split into an
     /// n×n grid of sub-triangles (n = ceil(longest edge / max_edge)) with attributes
     /// interpolated linearly; smaller triangles are kept. Neighbours split differently meet at
@@ -109,7 +127,7 @@ impl Mesh {
                 .length()
                 .max((p[2] - p[1]).length())
                 .max((p[0] - p[2]).length());
-            let n = ((longest / max_edge).ceil() as usize).clamp(1, 256);
+            let n = tessellation_factor(longest, max_edge);
             let base = out.positions.len() as u32;
             // Vertices of the barycentric grid: row i (0..=n) has n - i + 1 vertices.
             let mut row_start = Vec::with_capacity(n + 1);
@@ -251,6 +269,41 @@ impl SceneExtent {
     }
 }
 
+/// Most triangles a tessellated mesh may have (2²³): a `tessellate` edge that would make more is
+/// refused before any memory is asked for.
+pub const MAX_TESSELLATED_TRIANGLES: u64 = 1 << 23;
+
+/// Rows of the barycentric grid a triangle with longest edge `longest` is split into.
+fn tessellation_factor(longest: f32, max_edge: f32) -> usize {
+    let n = (longest / max_edge).ceil();
+    if n.is_finite() {
+        (n as usize).clamp(1, 256)
+    } else {
+        1
+    }
+}
+
+/// Largest magnitude of any world-space coordinate (scene units): positions in a descriptor,
+/// and every vertex after its transforms. Beyond it f32 bounds and BVH arithmetic overflow.
+pub const MAX_COORDINATE: f32 = 1e9;
+
+/// Checks every vertex of `mesh` against [`MAX_COORDINATE`]; `what` names the mesh.
+fn check_coordinates(scene: &str, what: &str, mesh: &Mesh) -> Result<()> {
+    match mesh
+        .positions
+        .iter()
+        .find(|p| !p.is_finite() || p.abs().max_element() > MAX_COORDINATE)
+    {
+        None => Ok(()),
+        Some(p) => Err(crate::Error::bad_file(
+            format!("scene '{scene}'"),
+            format!(
+                "{what}: a vertex at {p} after its transforms; every coordinate must be finite and within ±{MAX_COORDINATE:e} scene units"
+            ),
+        )),
+    }
+}
+
 /// The whole scene.
 #[derive(Clone, Debug)]
 pub struct Scene {
@@ -279,13 +332,26 @@ struct BuiltMesh {
     lights: Vec<PunctualLight>,
 }
 
-fn build_mesh(src: &MeshSource, assets: &AssetPaths) -> Result<BuiltMesh> {
+/// Builds `src`; `field` names it in errors (`mesh`, `shadow_mesh`, `statics[0].mesh`, ...).
+fn build_mesh(src: &MeshSource, assets: &AssetPaths, field: &str) -> Result<BuiltMesh> {
     match (&src.file, &src.generated) {
         (Some(file), _) => {
             let path = assets.find(file)?;
             let g = gltf_load::load_gltf(&path, 0)?;
             let mesh = match src.tessellate {
-                Some(edge) => g.mesh.tessellated(edge),
+                Some(edge) => {
+                    let n = g.mesh.tessellated_triangle_count(edge);
+                    if n > MAX_TESSELLATED_TRIANGLES {
+                        return Err(crate::Error::bad_file(
+                            &path,
+                            format!(
+                                "{field}.tessellate = {edge} would split its {} triangles into {n}; at most {MAX_TESSELLATED_TRIANGLES} are allowed (use a longer edge)",
+                                g.mesh.triangle_count()
+                            ),
+                        ));
+                    }
+                    g.mesh.tessellated(edge)
+                }
                 None => g.mesh,
             };
             Ok(BuiltMesh {
@@ -357,7 +423,7 @@ impl Scene {
     pub fn load(desc: &SceneDescriptor, assets: &AssetPaths) -> Result<Scene> {
         desc.validate(Path::new(&format!("scene '{}'", desc.name)))?;
 
-        let main = build_mesh(&desc.mesh, assets)?;
+        let main = build_mesh(&desc.mesh, assets, "mesh")?;
         let mut textures = Vec::new();
         let mut materials = append_textures(&mut textures, main.textures, main.materials);
         let mesh = main.mesh;
@@ -365,7 +431,7 @@ impl Scene {
         let shadow_mesh = match &desc.shadow_mesh {
             None => None,
             Some(src) => {
-                let shadow = build_mesh(src, assets)?;
+                let shadow = build_mesh(src, assets, "shadow_mesh")?;
                 let texture_offset = textures.len();
                 let mut needs_textures = false;
                 let mut remap = Vec::with_capacity(shadow.materials.len());
@@ -396,8 +462,8 @@ impl Scene {
         // Static instances (e.g. the MAZE's statue) join the static mesh and its shadow copy.
         let mut mesh = mesh;
         let mut shadow_mesh = shadow_mesh;
-        for st in &desc.statics {
-            let built = build_mesh(&st.mesh, assets)?;
+        for (i, st) in desc.statics.iter().enumerate() {
+            let built = build_mesh(&st.mesh, assets, &format!("statics[{i}].mesh"))?;
             let offset = materials.len() as u32;
             materials.extend(append_textures(
                 &mut textures,
@@ -419,8 +485,8 @@ impl Scene {
         }
 
         let mut movers = Vec::with_capacity(desc.movers.len());
-        for mover in &desc.movers {
-            let built = build_mesh(&mover.mesh, assets)?;
+        for (i, mover) in desc.movers.iter().enumerate() {
+            let built = build_mesh(&mover.mesh, assets, &format!("movers[{i}].mesh"))?;
             let offset = materials.len() as u32;
             materials.extend(append_textures(
                 &mut textures,
@@ -438,6 +504,14 @@ impl Scene {
             });
         }
 
+        let name = &desc.name;
+        check_coordinates(name, "the static mesh (with its statics)", &mesh)?;
+        if let Some(s) = &shadow_mesh {
+            check_coordinates(name, "the shadow mesh (with its statics)", s)?;
+        }
+        for m in &movers {
+            check_coordinates(name, &format!("mover '{}' (scaled)", m.name), &m.mesh)?;
+        }
         Ok(Scene {
             descriptor: desc.clone(),
             extent: SceneExtent::of(&mesh),

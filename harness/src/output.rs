@@ -1,0 +1,269 @@
+//! **Output sets**: a command's files appear in its output folder complete or not at all.
+//!
+//! A command that writes into a folder opens an [`OutputSet`] on it before any expensive work:
+//!
+//! * it takes the folder's lock (`.gibench.lock`, holding the process id): a second command
+//!   into a folder in use is refused, naming `--out`; a lock whose process is gone (a killed
+//!   run) is taken over, after finishing or undoing what that run left (below);
+//! * while the set is open, every file written with [`crate::error::write_atomic`] under the
+//!   folder goes to a hidden staging folder (`.gibench-staging/`) instead;
+//! * [`OutputSet::publish`] lists the staged files in a journal (`.gibench-publish`), moves them
+//!   into place, then removes the journal, the staging folder and the lock. A run killed while
+//!   moving is finished by the next command that opens the folder (the journal says what to
+//!   move; every staged file is complete); a run that fails or is killed before publishing
+//!   leaves only the staging folder, which the next command removes. Dropping an unpublished
+//!   set (an error) removes the staging folder and the lock at once.
+//!
+//! Files written with [`crate::error::write_atomic_direct`] (the reference cache, whose entries
+//! are shared across runs and read back within one) bypass the set.
+//!
+//! One set per process at a time.
+
+use std::path::{Component, Path, PathBuf};
+use std::sync::Mutex;
+
+use crate::{Error, Result};
+
+const LOCK: &str = ".gibench.lock";
+const STAGING: &str = ".gibench-staging";
+const JOURNAL: &str = ".gibench-publish";
+
+/// The open set's folder (absolute, lexically normalised) and its staged files (relative).
+struct Active {
+    dir: PathBuf,
+    canonical: PathBuf,
+    staged: Vec<PathBuf>,
+}
+
+static ACTIVE: Mutex<Option<Active>> = Mutex::new(None);
+
+/// An open output set (see the module docs). Publish it on success; dropping it unpublished
+/// discards what was staged.
+pub struct OutputSet {
+    dir: PathBuf,
+    option: String,
+    published: bool,
+}
+
+/// `path` made absolute against the working directory and with `.` and `..` resolved lexically.
+fn absolute(path: &Path) -> PathBuf {
+    let joined = if path.is_absolute() {
+        path.to_path_buf()
+    } else {
+        std::env::current_dir()
+            .unwrap_or_else(|_| PathBuf::from("/"))
+            .join(path)
+    };
+    let mut out = PathBuf::new();
+    for c in joined.components() {
+        match c {
+            Component::CurDir => {}
+            Component::ParentDir => {
+                out.pop();
+            }
+            other => out.push(other),
+        }
+    }
+    out
+}
+
+/// Whether process `pid` is alive (Linux: `/proc/PID`; elsewhere every lock is taken as live).
+fn alive(pid: u32) -> bool {
+    if cfg!(target_os = "linux") {
+        pid == std::process::id() || Path::new(&format!("/proc/{pid}")).exists()
+    } else {
+        true
+    }
+}
+
+impl OutputSet {
+    /// Opens the set on `dir` (created if needed); `option` names the command-line option in
+    /// errors (`out`).
+    pub fn begin(option: &str, dir: &Path) -> Result<OutputSet> {
+        let fail = |what: String| Error::param(option, what);
+        if ACTIVE.lock().map(|a| a.is_some()).unwrap_or(true) {
+            return Err(fail("another output set is open in this process".into()));
+        }
+        std::fs::create_dir_all(dir)
+            .map_err(|e| fail(format!("{} is not a writable folder: {e}", dir.display())))?;
+        let lock = dir.join(LOCK);
+        loop {
+            match std::fs::OpenOptions::new()
+                .write(true)
+                .create_new(true)
+                .open(&lock)
+            {
+                Ok(mut f) => {
+                    use std::io::Write;
+                    f.write_all(std::process::id().to_string().as_bytes())
+                        .map_err(|e| fail(format!("cannot write {}: {e}", lock.display())))?;
+                    break;
+                }
+                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
+                    let owner = std::fs::read_to_string(&lock)
+                        .ok()
+                        .and_then(|s| s.trim().parse::<u32>().ok());
+                    match owner {
+                        Some(pid) if alive(pid) => {
+                            return Err(fail(format!(
+                                "{} is in use by another gibench command (process {pid}); wait for it or choose another folder",
+                                dir.display()
+                            )))
+                        }
+                        _ => {
+                            // Left by a killed run: finish or undo it, then take the lock.
+                            recover(dir)?;
+                            std::fs::remove_file(&lock).map_err(|e| Error::io(&lock, e))?;
+                        }
+                    }
+                }
+                Err(e) => {
+                    return Err(fail(format!(
+                        "{} is not a writable folder: {e}",
+                        dir.display()
+                    )))
+                }
+            }
+        }
+        let set = OutputSet {
+            dir: dir.to_path_buf(),
+            option: option.to_string(),
+            published: false,
+        };
+        recover(dir)?;
+        let staging = dir.join(STAGING);
+        std::fs::create_dir_all(&staging).map_err(|e| Error::io(&staging, e))?;
+        let mut active = ACTIVE
+            .lock()
+            .map_err(|_| fail("output state poisoned".into()))?;
+        *active = Some(Active {
+            dir: absolute(dir),
+            canonical: dir.canonicalize().unwrap_or_else(|_| absolute(dir)),
+            staged: Vec::new(),
+        });
+        Ok(set)
+    }
+
+    /// Moves every staged file into place (see the module docs) and closes the set.
+    pub fn publish(mut self) -> Result<()> {
+        let staged = {
+            let mut active = ACTIVE
+                .lock()
+                .map_err(|_| Error::param(&self.option, "output state poisoned"))?;
+            active.take().map(|a| a.staged).unwrap_or_default()
+        };
+        let journal = self.dir.join(JOURNAL);
+        let list: Vec<String> = staged
+            .iter()
+            .map(|p| p.to_string_lossy().into_owned())
+            .collect();
+        crate::error::write_atomic_direct(&journal, list.join("\n").as_bytes())?;
+        move_staged(&self.dir)?;
+        self.published = true;
+        self.close();
+        Ok(())
+    }
+
+    /// Removes the staging folder, the journal and the lock.
+    fn close(&self) {
+        let _ = std::fs::remove_dir_all(self.dir.join(STAGING));
+        let _ = std::fs::remove_file(self.dir.join(JOURNAL));
+        let _ = std::fs::remove_file(self.dir.join(LOCK));
+    }
+}
+
+impl Drop for OutputSet {
+    fn drop(&mut self) {
+        if !self.published {
+            if let Ok(mut active) = ACTIVE.lock() {
+                *active = None;
+            }
+            self.close();
+        }
+    }
+}
+
+/// Moves the files the journal in `dir` lists from the staging folder into place (skipping
+/// any already moved).
+fn move_staged(dir: &Path) -> Result<()> {
+    let journal = dir.join(JOURNAL);
+    let text = std::fs::read_to_string(&journal).map_err(|e| Error::io(&journal, e))?;
+    for rel in text.lines().filter(|l| !l.is_empty()) {
+        let rel = Path::new(rel);
+        if !rel.components().all(|c| matches!(c, Component::Normal(_))) {
+            return Err(Error::bad_file(
+                &journal,
+                format!("bad entry '{}'", rel.display()),
+            ));
+        }
+        let from = dir.join(STAGING).join(rel);
+        let to = dir.join(rel);
+        if !from.exists() {
+            continue;
+        }
+        if let Some(parent) = to.parent() {
+            std::fs::create_dir_all(parent).map_err(|e| Error::io(parent, e))?;
+        }
+        std::fs::rename(&from, &to).map_err(|e| Error::io(&to, e))?;
+    }
+    Ok(())
+}
+
+/// Finishes a publication a killed run left half done, then removes its staging folder and
+/// journal.
+fn recover(dir: &Path) -> Result<()> {
+    if dir.join(JOURNAL).exists() {
+        move_staged(dir)?;
+    }
+    let staging = dir.join(STAGING);
+    if staging.exists() {
+        std::fs::remove_dir_all(&staging).map_err(|e| Error::io(&staging, e))?;
+    }
+    let journal = dir.join(JOURNAL);
+    if journal.exists() {
+        std::fs::remove_file(&journal).map_err(|e| Error::io(&journal, e))?;
+    }
+    Ok(())
+}
+
+/// Where a write to `path` must go while a set is open: its staged path, recorded for
+/// publication; `None` when `path` is outside the open set's folder (or none is open).
+pub(crate) fn staged_path(path: &Path) -> Option<PathBuf> {
+    let mut active = ACTIVE.lock().ok()?;
+    let a = active.as_mut()?;
+    let abs = absolute(path);
+    let rel = abs
+        .strip_prefix(&a.dir)
+        .or_else(|_| abs.strip_prefix(&a.canonical))
+        .ok()?
+        .to_path_buf();
+    if rel.as_os_str().is_empty() || rel.starts_with(STAGING) {
+        return None;
+    }
+    let staged = a.dir.join(STAGING).join(&rel);
+    if !a.staged.contains(&rel) {
+        a.staged.push(rel);
+    }
+    Some(staged)
+}
+
+/// Removes temporary files (`.gibench-tmp-PID-*`) in `dir` whose process is gone: what a killed
+/// atomic write leaves behind.
+pub fn remove_stale_temporaries(dir: &Path) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for e in entries.flatten() {
+        let name = e.file_name();
+        let Some(rest) = name.to_str().and_then(|n| n.strip_prefix(TEMP_PREFIX)) else {
+            continue;
+        };
+        let pid = rest.split('-').next().and_then(|p| p.parse::<u32>().ok());
+        if pid.is_some_and(|p| !alive(p)) {
+            let _ = std::fs::remove_file(e.path());
+        }
+    }
+}
+
+/// Prefix of every temporary file gibench writes (then `PID-`).
+pub(crate) const TEMP_PREFIX: &str = ".gibench-tmp-";

@@ -1,0 +1,175 @@
+//! A command's files appear in `--out` complete or not at all (`gibench_harness::output`): runs
+//! killed at several points leave the folder as it was, a later command clears what they left
+//! (staging folder, lock, temporary cache files), and a second command into a folder in use is
+//! refused.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+fn gibench() -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_gibench"));
+    c.stdout(Stdio::null()).stderr(Stdio::piped());
+    c
+}
+
+const SMALL: [&str; 8] = [
+    "--resolution",
+    "64x48",
+    "--frames",
+    "4",
+    "--warmup",
+    "3",
+    "--shadow-size",
+    "64",
+];
+
+/// Every file under `dir` (relative path → bytes), hidden ones too.
+fn files(dir: &Path) -> BTreeMap<String, Vec<u8>> {
+    let mut out = BTreeMap::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).into_iter().flatten().flatten() {
+            let p = e.path();
+            if p.is_dir() {
+                stack.push(p);
+            } else {
+                let rel = p.strip_prefix(dir).unwrap().to_string_lossy().into_owned();
+                out.insert(rel, std::fs::read(&p).unwrap_or_default());
+            }
+        }
+    }
+    out
+}
+
+/// Every results JSON in `dir` names images that exist: complete sets only.
+fn complete_sets(dir: &Path) {
+    for (name, bytes) in files(dir) {
+        if name.ends_with(".json") && !name.starts_with('.') {
+            let v: serde_json::Value = serde_json::from_slice(&bytes).unwrap();
+            for img in v["images"].as_array().into_iter().flatten() {
+                let img = img.as_str().unwrap();
+                assert!(
+                    dir.join(img).exists(),
+                    "{name} names {img}, which is missing"
+                );
+            }
+        }
+    }
+}
+
+fn spawn_long(out: &Path, cache: &Path) -> Child {
+    gibench()
+        .args([
+            "run",
+            "--technique",
+            "direct,keller-full,laine",
+            "--quality",
+        ])
+        .args(["--spp", "4", "--quiet", "--timing", "stages"])
+        .args(SMALL)
+        .arg("--out")
+        .arg(out)
+        .arg("--cache")
+        .arg(cache)
+        .spawn()
+        .unwrap()
+}
+
+#[test]
+fn killed_runs_leave_only_complete_sets() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (out, cache) = (tmp.path().join("out"), tmp.path().join("cache"));
+    // A complete earlier run: a killed one must leave it exactly as it was.
+    let o = gibench()
+        .args(["run", "--technique", "direct", "--quiet"])
+        .args(SMALL)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let before = files(&out);
+    assert!(before.keys().any(|k| k.ends_with("cornell-direct.json")));
+    assert!(!before.keys().any(|k| k.starts_with('.')), "{before:?}");
+    for delay_ms in [150, 600, 1500, 3000] {
+        let mut child = spawn_long(&out, &cache);
+        std::thread::sleep(Duration::from_millis(delay_ms));
+        let finished = child.try_wait().unwrap().is_some_and(|s| s.success());
+        let _ = child.kill();
+        let _ = child.wait();
+        let visible: BTreeMap<_, _> = files(&out)
+            .into_iter()
+            .filter(|(k, _)| !k.starts_with('.'))
+            .collect();
+        if !finished {
+            assert_eq!(
+                visible.keys().collect::<Vec<_>>(),
+                before.keys().collect::<Vec<_>>(),
+                "killed after {delay_ms} ms: the folder changed"
+            );
+            assert!(
+                visible == before,
+                "killed after {delay_ms} ms: a file changed"
+            );
+        }
+        complete_sets(&out);
+    }
+    // The next command takes over the dead run's lock and clears what it left.
+    let o = gibench()
+        .args([
+            "run",
+            "--technique",
+            "direct",
+            "--quality",
+            "--spp",
+            "4",
+            "--quiet",
+        ])
+        .args(SMALL)
+        .arg("--out")
+        .arg(&out)
+        .arg("--cache")
+        .arg(&cache)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let hidden: Vec<String> = files(&out)
+        .into_keys()
+        .filter(|k| k.starts_with('.'))
+        .collect();
+    assert!(hidden.is_empty(), "left in --out: {hidden:?}");
+    let temporaries: Vec<String> = files(&cache)
+        .into_keys()
+        .filter(|k| k.starts_with(".gibench-tmp"))
+        .collect();
+    assert!(temporaries.is_empty(), "left in the cache: {temporaries:?}");
+    complete_sets(&out);
+}
+
+#[test]
+fn a_second_command_into_a_folder_in_use_is_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (out, cache) = (tmp.path().join("out"), tmp.path().join("cache"));
+    let mut first = spawn_long(&out, &cache);
+    let start = Instant::now();
+    while !out.join(".gibench.lock").exists() && start.elapsed() < Duration::from_secs(20) {
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let o = gibench()
+        .args(["run", "--technique", "direct", "--quiet"])
+        .args(SMALL)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    let _ = first.kill();
+    let _ = first.wait();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("'out'") && stderr.contains("in use"),
+        "{stderr}"
+    );
+}
