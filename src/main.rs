@@ -474,6 +474,11 @@ pub(crate) fn execute_with_bar(
         Progress::Frame => bar.inc(1),
     });
     bar.finish_and_clear();
+    for r in results.iter().flatten() {
+        for w in &r.warnings {
+            eprintln!("warning: {} on {}: {w}", r.technique, r.scene);
+        }
+    }
     results
 }
 

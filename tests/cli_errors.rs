@@ -334,3 +334,135 @@ fn tessellation_past_the_cap() {
     });
     fails(&["--scene", d.to_str().unwrap()], "shadow_mesh.tessellate");
 }
+
+/// Irradiance past the half-float limit of the irradiance buffers is reported, in the results
+/// file and on standard error, instead of being clamped silently.
+#[test]
+fn half_float_saturation_is_reported() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = descriptor(tmp.path(), "bright.json", |v| {
+        v["light"]["power"] = serde_json::json!([1e12, 1e12, 1e12])
+    });
+    let out = tmp.path().join("out");
+    let o = Command::new(env!("CARGO_BIN_EXE_gibench"))
+        .args([
+            "run",
+            "--technique",
+            "direct",
+            "--frames",
+            "1",
+            "--warmup",
+            "0",
+        ])
+        .args([
+            "--timing",
+            "stages",
+            "--resolution",
+            "64x48",
+            "--quiet",
+            "--scene",
+        ])
+        .arg(&d)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{stderr}");
+    assert!(stderr.contains("half-float limit"), "{stderr}");
+    let name = std::fs::read_dir(&out)
+        .unwrap()
+        .flatten()
+        .map(|e| e.path())
+        .find(|p| {
+            p.extension().is_some_and(|x| x == "json") && !p.to_string_lossy().contains("summary")
+        })
+        .unwrap();
+    let v: serde_json::Value = serde_json::from_slice(&std::fs::read(name).unwrap()).unwrap();
+    assert!(v["warnings"][0]
+        .as_str()
+        .unwrap()
+        .contains("direct irradiance"));
+    // The ordinary scene gets no such warning.
+    let o = Command::new(env!("CARGO_BIN_EXE_gibench"))
+        .args([
+            "run",
+            "--technique",
+            "direct",
+            "--frames",
+            "1",
+            "--warmup",
+            "0",
+        ])
+        .args([
+            "--timing",
+            "stages",
+            "--resolution",
+            "64x48",
+            "--quiet",
+            "--out",
+        ])
+        .arg(tmp.path().join("plain"))
+        .output()
+        .unwrap();
+    assert!(!String::from_utf8_lossy(&o.stderr).contains("half-float"));
+}
+
+#[test]
+fn dispersion_needs_two_frames() {
+    let tmp = tempfile::tempdir().unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_gibench"))
+        .args(["reproduce", "laine-dispersion", "--frames", "1", "--out"])
+        .arg(tmp.path().join("d"))
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && stderr.contains("at least 2 frames"),
+        "{stderr}"
+    );
+    let left: Vec<_> = std::fs::read_dir(tmp.path().join("d"))
+        .map(|d| d.flatten().map(|e| e.path()).collect())
+        .unwrap_or_default();
+    assert!(left.is_empty(), "{left:?}");
+}
+
+/// What does not fit the device is found before the first technique's first frame: a VPL atlas
+/// too large for the adapter fails at once even after a long `direct` run in the same command
+/// (3000 frames, tens of seconds), and a cube-map atlas past the texture limit names
+/// `--shadow-size`.
+#[test]
+fn device_limits_are_checked_before_any_frame() {
+    let tmp = tempfile::tempdir().unwrap();
+    let start = std::time::Instant::now();
+    let o = Command::new(env!("CARGO_BIN_EXE_gibench"))
+        .args([
+            "run",
+            "--technique",
+            "direct,laine",
+            "--frames",
+            "3000",
+            "--quiet",
+        ])
+        .args([
+            "--param",
+            "vpl-map-size=4096",
+            "--param",
+            "vpls=1024",
+            "--out",
+        ])
+        .arg(tmp.path().join("out"))
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && stderr.contains("do not fit"),
+        "{stderr}"
+    );
+    assert!(
+        start.elapsed() < std::time::Duration::from_secs(15),
+        "found only after {:?}",
+        start.elapsed()
+    );
+    fails(&["--shadow-size", "8000"], "parameter 'shadow-size'");
+}

@@ -127,8 +127,11 @@ pub fn write_exr(path: &Path, size: [u32; 2], rgb: &[[f32; 3]]) -> Result<()> {
     });
     let image = Image::from_channels((w, h), channels);
     let mut bytes = std::io::Cursor::new(Vec::new());
+    // One thread: with parallel compression the chunks land in completion order, so the same
+    // pixels gave different files.
     image
         .write()
+        .non_parallel()
         .to_buffered(&mut bytes)
         .map_err(|e| Error::bad_file(path, format!("EXR encoding failed: {e}")))?;
     crate::error::write_atomic(path, bytes.get_ref())
@@ -137,6 +140,24 @@ pub fn write_exr(path: &Path, size: [u32; 2], rgb: &[[f32; 3]]) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The same pixels give the same bytes, every time.
+    #[test]
+    fn exr_files_of_identical_pixels_are_identical() {
+        let dir = tempfile::tempdir().unwrap();
+        let (w, h) = (256usize, 192usize);
+        let rgb: Vec<[f32; 3]> = (0..w * h)
+            .map(|i| [i as f32 * 0.37 % 7.0, (i % 13) as f32, 0.5])
+            .collect();
+        let first = dir.path().join("a.exr");
+        write_exr(&first, [w as u32, h as u32], &rgb).unwrap();
+        let a = std::fs::read(&first).unwrap();
+        for k in 0..8 {
+            let p = dir.path().join(format!("b{k}.exr"));
+            write_exr(&p, [w as u32, h as u32], &rgb).unwrap();
+            assert!(std::fs::read(&p).unwrap() == a, "write {k} differs");
+        }
+    }
 
     #[test]
     fn half_conversion() {

@@ -393,15 +393,19 @@ pub struct FrameQuality {
     /// Frame index.
     pub frame: u32,
     /// [`rmse`] of the technique's image.
+    #[serde(with = "crate::stats::nullable")]
     pub rmse: f64,
     /// [`relative_mse`].
+    #[serde(with = "crate::stats::nullable")]
     pub rel_mse: f64,
     /// [`mae`].
+    #[serde(with = "crate::stats::nullable")]
     pub mae: f64,
     /// Mean LDR-ꟻLIP error ([`FlipResult::mean`]) of the tone-mapped images.
+    #[serde(with = "crate::stats::nullable")]
     pub flip_mean: f64,
     /// [`relative_bias`]: signed relative error of the mean (negative = too dark).
-    #[serde(default)]
+    #[serde(default, with = "crate::stats::nullable")]
     pub bias: f64,
     /// [`temporal_instability`] (or its relative form, as the caller documents) against the
     /// previous frame; absent for the first frame or when not measured.

@@ -1146,6 +1146,7 @@ mod tests {
             first_frame_ms: None,
             quality: None,
             images: vec!["frame.png".into()],
+            warnings: Vec::new(),
         }
     }
 

@@ -115,6 +115,10 @@ pub struct RunResult {
     /// Images written next to the results file (relative paths).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub images: Vec<String>,
+    /// What the run found wrong with its own output (e.g. irradiance past the half-float
+    /// limit), also printed after the run.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
 }
 
 impl RunResult {

@@ -184,6 +184,30 @@ pub struct FrameImages {
     pub direct: Vec<[f32; 3]>,
 }
 
+/// Largest finite half float: the irradiance buffers (Rgba16Float) clamp above it.
+pub const HALF_MAX: f32 = 65504.0;
+
+impl FrameImages {
+    /// A warning for each irradiance image (indirect, direct) with pixels at or past
+    /// [`HALF_MAX`], where the stored value is clamped.
+    pub fn saturation_warnings(&self) -> Vec<String> {
+        [("indirect", &self.indirect), ("direct", &self.direct)]
+            .into_iter()
+            .filter_map(|(what, img)| {
+                let n = img
+                    .iter()
+                    .filter(|p| p.iter().any(|c| c.abs() >= HALF_MAX))
+                    .count();
+                (n > 0).then(|| {
+                    format!(
+                        "{what} irradiance reached the half-float limit ({HALF_MAX}) in {n} pixels of the last frame, where it is clamped: lower the light's power or use larger scene units"
+                    )
+                })
+            })
+            .collect()
+    }
+}
+
 /// Everything that is shared by all techniques on one scene.
 pub struct Harness<'a> {
     pub gpu: &'a GpuContext,
@@ -208,12 +232,27 @@ impl<'a> Harness<'a> {
                 format!("{w}x{h} exceeds the adapter's limit of {max} per side"),
             ));
         }
-        if config.shadow_size > max {
+        // The direct light's cube map is a 3x2 atlas of faces.
+        if config.shadow_size as u64 * 3 > max as u64 {
             return Err(Error::param(
                 "shadow-size",
                 format!(
-                    "{} exceeds the adapter's limit of {max}",
-                    config.shadow_size
+                    "{} needs a {}-texel-wide cube-map atlas (3 faces); the adapter's limit is {max}, so at most {}",
+                    config.shadow_size,
+                    config.shadow_size as u64 * 3,
+                    max / 3
+                ),
+            ));
+        }
+        // Images are read back through one buffer (rows padded to 256 bytes, at most 16 bytes a
+        // texel).
+        let readback = (w as u64 * 16).next_multiple_of(256) * h as u64;
+        let max_buffer = gpu.device.limits().max_buffer_size;
+        if readback > max_buffer {
+            return Err(Error::param(
+                "resolution",
+                format!(
+                    "{w}x{h} needs a {readback}-byte readback buffer; the adapter allows {max_buffer}"
                 ),
             ));
         }
@@ -432,8 +471,12 @@ impl<'a> Harness<'a> {
             first_frame_ms,
             quality: None,
             images: Vec::new(),
+            warnings: Vec::new(),
         };
-        Ok((result, images.expect("at least one timing pass")))
+        let images = images.expect("at least one timing pass");
+        let mut result = result;
+        result.warnings = images.saturation_warnings();
+        Ok((result, images))
     }
 
     /// Runs the technique once more over the frames, untimed, capturing its images at the

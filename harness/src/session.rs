@@ -15,7 +15,7 @@ use crate::gpu::GpuContext;
 use crate::image_io::{write_exr, write_png};
 use crate::quality::{QualityConfig, ReferenceCache};
 use crate::results::RunResult;
-use crate::runner::{Harness, RunConfig, TimingMode};
+use crate::runner::{Harness, PreparedTechnique, RunConfig, TimingMode};
 use crate::scene::Scene;
 use crate::technique::{Params, TechniqueInfo};
 use crate::{Error, Result};
@@ -109,9 +109,17 @@ pub fn execute(
 ) -> Result<Vec<RunResult>> {
     spec.validate()?;
     let harness = Harness::new(gpu, spec.scene, &spec.config)?;
-    let mut results = Vec::with_capacity(spec.runs.len());
+    // Every technique is prepared and built once before any frame runs, so that what does not
+    // fit the device (a VPL atlas, a buffer) is reported before the first technique's work.
+    let mut prepared = Vec::with_capacity(spec.runs.len());
     for run in &spec.runs {
-        results.push(execute_one(&harness, spec, run, progress)?);
+        let p = harness.prepare(run.info, &run.params, &spec.config)?;
+        drop(harness.build(run.info, &run.params, &spec.config, &p)?);
+        prepared.push(p);
+    }
+    let mut results = Vec::with_capacity(spec.runs.len());
+    for (run, p) in spec.runs.iter().zip(&prepared) {
+        results.push(execute_one(&harness, spec, run, p, progress)?);
     }
     Ok(results)
 }
@@ -120,28 +128,23 @@ fn execute_one(
     harness: &Harness,
     spec: &RunSpec,
     run: &TechniqueRun,
+    prepared: &PreparedTechnique,
     progress: &mut dyn FnMut(Progress),
 ) -> Result<RunResult> {
     let (info, params, config) = (run.info, &run.params, &spec.config);
     let out = |suffix: &str| spec.out.join(format!("{}{suffix}", run.stem));
     progress(Progress::Technique(info.name));
-    let prepared = harness.prepare(info, params, config)?;
-    let (mut result, images) = harness.run(info, params, config, &prepared, &mut || {
+    let (mut result, images) = harness.run(info, params, config, prepared, &mut || {
         progress(Progress::Frame)
     })?;
     let mut extra_images = Vec::new();
     if let Some(q) = &spec.quality {
         let label = format!("{} (quality)", info.name);
         progress(Progress::Technique(&label));
-        let (summary, qimages) = harness.measure_quality(
-            info,
-            params,
-            config,
-            &prepared,
-            q,
-            &spec.cache,
-            &mut || progress(Progress::Frame),
-        )?;
+        let (summary, qimages) =
+            harness.measure_quality(info, params, config, prepared, q, &spec.cache, &mut || {
+                progress(Progress::Frame)
+            })?;
         result.quality = Some(summary);
         if spec.images {
             let reference_png = out("-reference.png");

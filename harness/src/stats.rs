@@ -2,19 +2,45 @@
 
 use serde::{Deserialize, Serialize};
 
-/// Statistics of one series of samples (milliseconds for timings).
+/// Statistics of one series of samples (milliseconds for timings). A non-finite value (a
+/// technique whose output has NaNs gives NaN metrics) is written as JSON `null` and read back
+/// as NaN ([`nullable`]), so such a results file still loads and shows it.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Stats {
     pub count: usize,
+    #[serde(with = "nullable")]
     pub mean: f64,
+    #[serde(with = "nullable")]
     pub median: f64,
+    #[serde(with = "nullable")]
     pub p5: f64,
+    #[serde(with = "nullable")]
     pub p95: f64,
     /// 99th percentile (stutters: Laine et al. 2007 report them for VPL management).
-    #[serde(default)]
+    #[serde(default, with = "nullable")]
     pub p99: f64,
+    #[serde(with = "nullable")]
     pub min: f64,
+    #[serde(with = "nullable")]
     pub max: f64,
+}
+
+/// Serde for an `f64` that may be non-finite: NaN and ±∞ are written as `null` (JSON has no
+/// such numbers) and `null` is read as NaN.
+pub mod nullable {
+    use serde::{Deserialize, Deserializer, Serializer};
+
+    pub fn serialize<S: Serializer>(x: &f64, s: S) -> Result<S::Ok, S::Error> {
+        if x.is_finite() {
+            s.serialize_f64(*x)
+        } else {
+            s.serialize_none()
+        }
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+        Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
+    }
 }
 
 impl Stats {
@@ -49,6 +75,19 @@ impl Stats {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// NaN statistics survive a JSON round trip (as null, read back as NaN) instead of making
+    /// the file unreadable.
+    #[test]
+    fn non_finite_statistics_round_trip_through_json() {
+        let s = Stats::of(&[1.0, f64::NAN, f64::INFINITY]);
+        let json = serde_json::to_string(&s).unwrap();
+        assert!(json.contains("null"), "{json}");
+        let back: Stats = serde_json::from_str(&json).unwrap();
+        assert_eq!(back.count, 3);
+        assert_eq!(back.min, 1.0);
+        assert!(back.max.is_nan() && back.mean.is_nan());
+    }
 
     #[test]
     fn percentiles_interpolate() {

@@ -451,6 +451,13 @@ fn dispersion(args: &ReproduceArgs) -> Result<Table> {
     use gibench_harness::scene::descriptor::LightKind;
     use gibench_harness::stats::Stats;
     let frames = args.frames.unwrap_or(if args.quick { 120 } else { 600 });
+    if frames < 2 {
+        // The median and maximum are over the frames after the fill frame.
+        return Err(Error::param(
+            "frames",
+            format!("the dispersion table needs at least 2 frames: frame 0 and one after it (got {frames})"),
+        ));
+    }
     let (name, scene, bvh) = cpu_scene(args, "cornell")?;
     let mut lines = Vec::new();
     let mut rows = Vec::new();
