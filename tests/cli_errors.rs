@@ -191,6 +191,9 @@ fn overflow_names_duplicates_and_assets() {
     }
     fails(&["--technique", "direct,direct"], "listed twice");
     fails(&["--assets", "/no/such/folder"], "assets");
+    let file = tmp.path().join("not-a-folder");
+    std::fs::write(&file, b"x").unwrap();
+    fails(&["--assets", file.to_str().unwrap()], "not a folder");
     let o = Command::new(env!("CARGO_BIN_EXE_gibench"))
         .args([
             "sweep",
