@@ -1,8 +1,12 @@
-//! Criterion benches: CPU kernels the techniques lean on (BVH ray casts, Laine's VPL
-//! management for spot and omni lights at 256 and 1024 VPLs) and one whole frame of each
-//! registered technique on the Cornell box (GPU, flushed per frame).
+//! Criterion benches: CPU kernels the techniques lean on — BVH closest-hit and shadow rays on
+//! Cornell and Sibenik; Laine's sampling domains (disc and sphere, 256 and 1024 points): one
+//! delete + insert, the largest empty circle, the Voronoi areas; Laine's whole VPL management
+//! per frame, spot and omni; VPL generation (Keller's light paths); the reference path tracer
+//! (one path per pixel) — and one whole frame of each registered technique on the Cornell box
+//! (GPU, flushed per frame).
 //!
-//! `cargo bench` runs them; `cargo bench -- rays` runs a subset.
+//! `cargo bench` runs them; `cargo bench -- rays` runs a subset; `cargo test --benches` (CI)
+//! runs each once as a test.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use gibench_harness::assets::AssetPaths;
@@ -48,7 +52,113 @@ fn rays(c: &mut Criterion) {
                     .count()
             })
         });
+        // Shadow rays from the light to where the closest-hit rays land.
+        let targets: Vec<Vec3> = dirs
+            .iter()
+            .filter_map(|d| bvh.closest_hit(origin, *d, 0.0, f32::INFINITY))
+            .map(|h| h.position + h.geometric_normal * scene.extent.ray_epsilon)
+            .collect();
+        c.bench_function(&format!("rays/shadow-1024/{name}"), |b| {
+            b.iter(|| {
+                targets
+                    .iter()
+                    .filter(|t| bvh.occluded(origin, **t, 1e-4))
+                    .count()
+            })
+        });
     }
+}
+
+/// Laine's sampling domains with n points: one delete + insert (the steady state of a frame's
+/// changes), the largest empty circle and the Voronoi areas.
+fn domains(c: &mut Criterion) {
+    use gibench_laine::domain::{DomainKind, SamplingDomain};
+    for kind in [DomainKind::Disc, DomainKind::Sphere] {
+        for n in [256u64, 1024] {
+            let mut d = SamplingDomain::new(kind);
+            let point = |i: u64| {
+                // Quasi-random points on the domain (Fibonacci spiral).
+                let t = (i as f64 + 0.5) / n as f64;
+                let phi = i as f64 * std::f64::consts::PI * (3.0 - 5f64.sqrt());
+                match kind {
+                    DomainKind::Disc => {
+                        let r = t.sqrt() * 0.999;
+                        gibench_harness::glam::DVec3::new(r * phi.cos(), r * phi.sin(), 0.0)
+                    }
+                    DomainKind::Sphere => {
+                        let z = 1.0 - 2.0 * t;
+                        let r = (1.0 - z * z).sqrt();
+                        gibench_harness::glam::DVec3::new(r * phi.cos(), r * phi.sin(), z)
+                    }
+                }
+            };
+            for i in 0..n {
+                d.insert(i, point(i)).expect("distinct points");
+            }
+            let tag = format!("{}-{n}", format!("{kind:?}").to_lowercase());
+            let mut next = n;
+            c.bench_function(&format!("domain/delete-insert/{tag}"), |b| {
+                b.iter(|| {
+                    let victim = next - n;
+                    let p = d.remove(victim).expect("present");
+                    d.insert(next, p).expect("reinserted");
+                    next += 1;
+                })
+            });
+            c.bench_function(&format!("domain/largest-empty-circle/{tag}"), |b| {
+                b.iter(|| d.largest_empty_circle())
+            });
+            c.bench_function(&format!("domain/voronoi-areas/{tag}"), |b| {
+                b.iter(|| d.voronoi_areas())
+            });
+        }
+    }
+}
+
+/// Keller's light paths: 256 VPLs (one bounce) and 256 paths of up to four bounces on Cornell
+/// and Sibenik.
+fn vpl_generation(c: &mut Criterion) {
+    let assets = AssetPaths::standard(None);
+    for name in ["cornell", "sibenik"] {
+        let Ok(scene) = Scene::load_named(name, &assets) else {
+            eprintln!("skipping vpl-generation/{name}: scene not found");
+            continue;
+        };
+        let bvh = gibench_harness::bvh::SceneBvh::new(&scene.mesh);
+        let light = gibench_harness::anim::FrameClock::new(&scene.descriptor)
+            .frame(0)
+            .light;
+        let rho = scene.average_reflectance().max_element();
+        for bounces in [1u32, 4] {
+            c.bench_function(
+                &format!("vpl-generation/256-bounces-{bounces}/{name}"),
+                |b| {
+                    b.iter(|| {
+                        gibench_harness::vpl::generate_at_least(
+                            &scene, &bvh, &light, 256, bounces, rho,
+                        )
+                        .1
+                        .len()
+                    })
+                },
+            );
+        }
+    }
+}
+
+/// The reference path tracer: one path per pixel (8 bounces) over a 64x48 image of Cornell.
+fn reference_paths(c: &mut Criterion) {
+    let scene =
+        Scene::load_named("cornell", &AssetPaths::standard(None)).expect("cornell is generated");
+    let frame = gibench_harness::anim::FrameClock::new(&scene.descriptor).frame(0);
+    let settings = gibench_harness::reference::ReferenceSettings {
+        spp: 1,
+        bounces: 8,
+        seed: 0,
+    };
+    c.bench_function("reference/1-path-per-pixel-64x48/cornell", |b| {
+        b.iter(|| gibench_harness::reference::render_reference(&scene, &frame, [64, 48], &settings))
+    });
 }
 
 /// Laine's VPL management per frame (validity, deletion, creation, Voronoi intensities), spot
@@ -124,6 +234,6 @@ fn frames(c: &mut Criterion) {
 criterion_group! {
     name = benches;
     config = Criterion::default().sample_size(20);
-    targets = rays, laine_management, frames
+    targets = rays, domains, laine_management, vpl_generation, reference_paths, frames
 }
 criterion_main!(benches);
