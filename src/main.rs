@@ -50,6 +50,27 @@ enum Command {
     /// Plot per-frame error against the reference from results files made with
     /// `run --quality --quality-all` (e.g. the lag of keller-incremental).
     PlotQuality(PlotQualityArgs),
+    /// Compare CURRENT runs with BASE runs stage by stage: ratios, a noise band from at least
+    /// three repeats on each side, and a verdict (faster / slower / unchanged).
+    Compare(CompareArgs),
+}
+
+#[derive(Args)]
+struct CompareArgs {
+    /// Folder of the BASE runs (searched recursively for results files; one subfolder per repeat).
+    base: PathBuf,
+    /// Folder of the CURRENT runs, likewise.
+    current: PathBuf,
+    /// Relative change a verdict needs beyond the band: slower when every pairing is above
+    /// 1 + tolerance (0.25 keeps a shared CPU's run-to-run noise from deciding).
+    #[arg(long, default_value_t = 0.25)]
+    tolerance: f64,
+    /// Output directory for the comparison (Markdown, CSV, LaTeX, JSON).
+    #[arg(long, default_value = "results/local")]
+    out: PathBuf,
+    /// File name stem of the outputs.
+    #[arg(long, default_value = "compare")]
+    stem: String,
 }
 
 #[derive(Args)]
@@ -246,6 +267,7 @@ fn main() -> ExitCode {
         Some(Command::Reference(args)) => reference_cmd(&args),
         Some(Command::Sweep(args)) => sweep(&args),
         Some(Command::PlotQuality(args)) => plot_quality(&args),
+        Some(Command::Compare(args)) => compare_cmd(&args),
         Some(Command::Reproduce(args)) => reproduce::reproduce(&args),
     };
     match outcome {
@@ -750,6 +772,67 @@ fn plot_quality(args: &PlotQualityArgs) -> Result<()> {
     Ok(())
 }
 
+/// Every results file under `dir`, recursively (files that are not results are skipped).
+fn results_under(option: &str, dir: &Path) -> Result<Vec<RunResult>> {
+    if !dir.is_dir() {
+        return Err(Error::param(
+            option,
+            format!("{} is not a folder of results", dir.display()),
+        ));
+    }
+    let mut found = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        let mut entries: Vec<PathBuf> = std::fs::read_dir(&d)
+            .map_err(|e| Error::io(&d, e))?
+            .flatten()
+            .map(|e| e.path())
+            .collect();
+        entries.sort();
+        for p in entries {
+            let hidden = p
+                .file_name()
+                .is_some_and(|n| n.to_string_lossy().starts_with('.'));
+            if hidden {
+                continue;
+            }
+            if p.is_dir() {
+                stack.push(p);
+            } else if p.extension().is_some_and(|x| x == "json") {
+                if let Ok(r) = RunResult::read(&p) {
+                    found.push(r);
+                }
+            }
+        }
+    }
+    if found.is_empty() {
+        return Err(Error::param(
+            option,
+            format!("no gibench results files under {}", dir.display()),
+        ));
+    }
+    Ok(found)
+}
+
+fn compare_cmd(args: &CompareArgs) -> Result<()> {
+    let base = results_under("base", &args.base)?;
+    let current = results_under("current", &args.current)?;
+    let rows = gibench_harness::compare::compare(&base, &current, args.tolerance)?;
+    let table = gibench_harness::compare::compare_table(&rows, args.tolerance);
+    println!("{}", table.to_terminal());
+    let set = OutputSet::begin("out", &args.out)?;
+    report::write_tables(&table, &args.out, &args.stem)?;
+    let json = serde_json::to_vec_pretty(&rows).map_err(|e| Error::Invalid(e.to_string()))?;
+    gibench_harness::error::write_atomic(&args.out.join(format!("{}.json", args.stem)), &json)?;
+    set.publish()?;
+    eprintln!(
+        "wrote {stem}.md, .csv, .tex and .json to {}",
+        args.out.display(),
+        stem = args.stem
+    );
+    Ok(())
+}
+
 fn report_cmd(args: &ReportArgs) -> Result<()> {
     let results = read_results(&args.inputs)?;
     let set = OutputSet::begin("out", &args.out)?;
@@ -785,6 +868,9 @@ fn reference_cmd(args: &ReferenceArgs) -> Result<()> {
     let desc = SceneDescriptor::resolve(&args.scene)?;
     let scene = Scene::load(&desc, &AssetPaths::standard(args.assets.as_deref()))?;
     let frame = gibench_harness::anim::FrameClock::new(&desc).frame(args.frame);
+    if !args.reference.no_cache {
+        writable_dir("cache", &args.reference.cache)?;
+    }
     let cache = args.reference.cache();
     let set = OutputSet::begin("out", &args.out)?;
     eprintln!(

@@ -319,6 +319,9 @@ fn buffer_uris_outside_the_folder_devices_and_missing_files() {
     {
         std::os::unix::fs::symlink("/dev/zero", tmp.path().join("zero.bin")).unwrap();
         let d = one_triangle_gltf(tmp.path(), "zero.bin");
+        fails(&["--scene", d.to_str().unwrap()], "through a symbolic link");
+        std::fs::create_dir(tmp.path().join("folder.bin")).unwrap();
+        let d = one_triangle_gltf(tmp.path(), "folder.bin");
         fails(
             &["--scene", d.to_str().unwrap()],
             "does not name a regular file",
@@ -468,4 +471,89 @@ fn device_limits_are_checked_before_any_frame() {
         start.elapsed()
     );
     fails(&["--shadow-size", "8000"], "parameter 'shadow-size'");
+}
+
+/// What a hostile review found: a buffer URI that leaves the folder through a symbolic link,
+/// a `tessellate` edge so short it would be clamped, a mover whose scale and path together
+/// pass the coordinate bound, a `--cache` that is a file for `reference`, a stale lock held by
+/// a pid of another program, a staging leftover that is a file — each refused or recovered.
+#[test]
+fn hostile_review_cases() {
+    let tmp = tempfile::tempdir().unwrap();
+    #[cfg(unix)]
+    {
+        let outside = tmp.path().join("outside");
+        std::fs::create_dir(&outside).unwrap();
+        std::fs::write(
+            outside.join("tri.bin"),
+            corners([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]),
+        )
+        .unwrap();
+        let inside = tmp.path().join("inside");
+        std::fs::create_dir(&inside).unwrap();
+        std::os::unix::fs::symlink(outside.join("tri.bin"), inside.join("link.bin")).unwrap();
+        let d = one_triangle_gltf(&inside, "link.bin");
+        fails(&["--scene", d.to_str().unwrap()], "through a symbolic link");
+    }
+    let d = descriptor(tmp.path(), "tiny-edge.json", |v| {
+        v["shadow_mesh"]["tessellate"] = serde_json::json!(1e-30)
+    });
+    fails(&["--scene", d.to_str().unwrap()], "shadow_mesh.tessellate");
+    let d = descriptor(tmp.path(), "far-mover.json", |v| {
+        v["movers"] = serde_json::json!([{
+            "name": "big", "mesh": {"generated": "cornell-box"}, "scale": 1e6,
+            "path": {"keys": [{"time": 0.0, "position": [9e8, 0.0, 9e8]}]}
+        }]);
+    });
+    fails(&["--scene", d.to_str().unwrap()], "mover 'big'");
+    let file = tmp.path().join("cache-file");
+    std::fs::write(&file, b"x").unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_gibench"))
+        .args([
+            "reference",
+            "--resolution",
+            "16x12",
+            "--spp",
+            "1",
+            "--cache",
+        ])
+        .arg(&file)
+        .arg("--out")
+        .arg(tmp.path().join("ref"))
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && stderr.contains("parameter 'cache'"),
+        "{stderr}"
+    );
+    // A lock naming pid 1 (another program) and a staging leftover that is a file: taken over.
+    let out = tmp.path().join("locked");
+    std::fs::create_dir(&out).unwrap();
+    std::fs::write(out.join(".gibench.lock"), b"1").unwrap();
+    std::fs::write(out.join(".gibench-staging"), b"junk").unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_gibench"))
+        .args([
+            "run",
+            "--technique",
+            "direct",
+            "--frames",
+            "1",
+            "--warmup",
+            "0",
+        ])
+        .args([
+            "--timing",
+            "stages",
+            "--resolution",
+            "32x24",
+            "--quiet",
+            "--out",
+        ])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(out.join("cornell-direct.json").exists());
+    assert!(!out.join(".gibench.lock").exists() && !out.join(".gibench-staging").exists());
 }

@@ -17,7 +17,7 @@ use gibench_harness::profiler::{ProfileMode, Profiler};
 use gibench_harness::runner::{Harness, RunConfig, TimingMode};
 use gibench_harness::scene::Scene;
 
-const MAX_GROWTH_MB: f64 = 12.0;
+const MAX_GROWTH_MB: f64 = 24.0;
 const SETTLE: u32 = 20;
 const MEASURED: u32 = 80;
 

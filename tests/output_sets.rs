@@ -173,3 +173,48 @@ fn a_second_command_into_a_folder_in_use_is_refused() {
         "{stderr}"
     );
 }
+
+/// `--out` through a symbolic link and `..` publishes where the OS resolves it; a folder in the
+/// place of a file the command writes fails the command before anything is moved, leaving the
+/// earlier set whole.
+#[cfg(unix)]
+#[test]
+fn symlinked_out_and_a_folder_in_the_way() {
+    let tmp = tempfile::tempdir().unwrap();
+    std::fs::create_dir_all(tmp.path().join("real/sub")).unwrap();
+    std::os::unix::fs::symlink(tmp.path().join("real/sub"), tmp.path().join("link")).unwrap();
+    let o = gibench()
+        .current_dir(tmp.path())
+        .args(["run", "--technique", "direct", "--quiet"])
+        .args(SMALL)
+        .args(["--out", "link/.."])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(tmp.path().join("real/cornell-direct.json").exists());
+    assert!(!tmp.path().join(".gibench-staging").exists());
+
+    let out = tmp.path().join("real");
+    let before = files(&out);
+    std::fs::remove_file(out.join("cornell-summary.md")).unwrap();
+    std::fs::create_dir(out.join("cornell-summary.md")).unwrap();
+    let o = gibench()
+        .args(["run", "--technique", "direct", "--quiet"])
+        .args(SMALL)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && stderr.contains("is a folder"),
+        "{stderr}"
+    );
+    let after = files(&out);
+    for (name, bytes) in &before {
+        if name != "cornell-summary.md" {
+            assert!(after.get(name) == Some(bytes), "{name} changed");
+        }
+    }
+    assert!(!after.keys().any(|k| k.starts_with('.')), "{after:?}");
+}

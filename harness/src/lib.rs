@@ -29,6 +29,8 @@
 pub mod anim;
 pub mod assets;
 pub mod bvh;
+pub mod calibrate;
+pub mod compare;
 pub mod error;
 pub mod gpu;
 pub mod image_io;

@@ -31,7 +31,6 @@ const JOURNAL: &str = ".gibench-publish";
 /// The open set's folder (absolute, lexically normalised) and its staged files (relative).
 struct Active {
     dir: PathBuf,
-    canonical: PathBuf,
     staged: Vec<PathBuf>,
 }
 
@@ -40,9 +39,12 @@ static ACTIVE: Mutex<Option<Active>> = Mutex::new(None);
 /// An open output set (see the module docs). Publish it on success; dropping it unpublished
 /// discards what was staged.
 pub struct OutputSet {
+    /// The folder, canonical (symlinks resolved): staging, lock and publication all use it.
     dir: PathBuf,
     option: String,
     published: bool,
+    /// Whether `begin` created the folder (an unpublished set then removes it if empty).
+    created: bool,
 }
 
 /// `path` made absolute against the working directory and with `.` and `..` resolved lexically.
@@ -67,12 +69,45 @@ fn absolute(path: &Path) -> PathBuf {
     out
 }
 
-/// Whether process `pid` is alive (Linux: `/proc/PID`; elsewhere every lock is taken as live).
+/// Whether process `pid` is alive and runs the same program as this one (Linux: `/proc/PID`
+/// and its `comm`, so a pid reused by another program does not hold a folder; elsewhere every
+/// lock is taken as live).
 fn alive(pid: u32) -> bool {
     if cfg!(target_os = "linux") {
-        pid == std::process::id() || Path::new(&format!("/proc/{pid}")).exists()
+        if pid == std::process::id() {
+            return true;
+        }
+        let comm = |p: &str| std::fs::read_to_string(format!("/proc/{p}/comm")).ok();
+        match (comm(&pid.to_string()), comm("self")) {
+            (Some(theirs), Some(ours)) => theirs == ours,
+            _ => false,
+        }
     } else {
         true
+    }
+}
+
+/// `path` with its longest existing ancestor canonicalised (symlinks and `..` resolved the way
+/// the OS will resolve them) and the rest appended.
+fn resolve(path: &Path) -> PathBuf {
+    let abs = absolute(path);
+    let mut existing = abs.as_path();
+    let mut rest = Vec::new();
+    loop {
+        if let Ok(c) = existing.canonicalize() {
+            let mut out = c;
+            for part in rest.iter().rev() {
+                out.push(part);
+            }
+            return out;
+        }
+        match (existing.parent(), existing.file_name()) {
+            (Some(parent), Some(name)) => {
+                rest.push(name.to_os_string());
+                existing = parent;
+            }
+            _ => return abs,
+        }
     }
 }
 
@@ -84,9 +119,20 @@ impl OutputSet {
         if ACTIVE.lock().map(|a| a.is_some()).unwrap_or(true) {
             return Err(fail("another output set is open in this process".into()));
         }
+        let created = !dir.exists();
         std::fs::create_dir_all(dir)
             .map_err(|e| fail(format!("{} is not a writable folder: {e}", dir.display())))?;
+        let shown = dir.display().to_string();
+        let dir = &dir
+            .canonicalize()
+            .map_err(|e| fail(format!("{shown} is not a writable folder: {e}")))?;
         let lock = dir.join(LOCK);
+        if lock.is_dir() {
+            return Err(fail(format!(
+                "{} is a folder, not gibench's lock file; remove it",
+                lock.display()
+            )));
+        }
         loop {
             match std::fs::OpenOptions::new()
                 .write(true)
@@ -106,8 +152,7 @@ impl OutputSet {
                     match owner {
                         Some(pid) if alive(pid) => {
                             return Err(fail(format!(
-                                "{} is in use by another gibench command (process {pid}); wait for it or choose another folder",
-                                dir.display()
+                                "{shown} is in use by another gibench command (process {pid}); wait for it or choose another folder"
                             )))
                         }
                         _ => {
@@ -117,18 +162,14 @@ impl OutputSet {
                         }
                     }
                 }
-                Err(e) => {
-                    return Err(fail(format!(
-                        "{} is not a writable folder: {e}",
-                        dir.display()
-                    )))
-                }
+                Err(e) => return Err(fail(format!("{shown} is not a writable folder: {e}"))),
             }
         }
         let set = OutputSet {
             dir: dir.to_path_buf(),
             option: option.to_string(),
             published: false,
+            created,
         };
         recover(dir)?;
         let staging = dir.join(STAGING);
@@ -137,8 +178,7 @@ impl OutputSet {
             .lock()
             .map_err(|_| fail("output state poisoned".into()))?;
         *active = Some(Active {
-            dir: absolute(dir),
-            canonical: dir.canonicalize().unwrap_or_else(|_| absolute(dir)),
+            dir: dir.to_path_buf(),
             staged: Vec::new(),
         });
         Ok(set)
@@ -152,6 +192,20 @@ impl OutputSet {
                 .map_err(|_| Error::param(&self.option, "output state poisoned"))?;
             active.take().map(|a| a.staged).unwrap_or_default()
         };
+        // Every destination must be free to take a file before any is moved, so a failure
+        // cannot leave some files new and others old.
+        for rel in &staged {
+            let to = self.dir.join(rel);
+            if to.is_dir() {
+                return Err(Error::param(
+                    &self.option,
+                    format!(
+                        "{} is a folder where this command writes a file; nothing was changed",
+                        to.display()
+                    ),
+                ));
+            }
+        }
         let journal = self.dir.join(JOURNAL);
         let list: Vec<String> = staged
             .iter()
@@ -164,11 +218,15 @@ impl OutputSet {
         Ok(())
     }
 
-    /// Removes the staging folder, the journal and the lock.
+    /// Removes the staging folder, the journal and the lock (and, unpublished, the folder
+    /// itself if this set created it and it is empty).
     fn close(&self) {
         let _ = std::fs::remove_dir_all(self.dir.join(STAGING));
         let _ = std::fs::remove_file(self.dir.join(JOURNAL));
         let _ = std::fs::remove_file(self.dir.join(LOCK));
+        if self.created && !self.published {
+            let _ = std::fs::remove_dir(&self.dir);
+        }
     }
 }
 
@@ -191,10 +249,8 @@ fn move_staged(dir: &Path) -> Result<()> {
     for rel in text.lines().filter(|l| !l.is_empty()) {
         let rel = Path::new(rel);
         if !rel.components().all(|c| matches!(c, Component::Normal(_))) {
-            return Err(Error::bad_file(
-                &journal,
-                format!("bad entry '{}'", rel.display()),
-            ));
+            // Not written by gibench: ignored.
+            continue;
         }
         let from = dir.join(STAGING).join(rel);
         let to = dir.join(rel);
@@ -216,8 +272,10 @@ fn recover(dir: &Path) -> Result<()> {
         move_staged(dir)?;
     }
     let staging = dir.join(STAGING);
-    if staging.exists() {
+    if staging.is_dir() {
         std::fs::remove_dir_all(&staging).map_err(|e| Error::io(&staging, e))?;
+    } else if staging.exists() {
+        std::fs::remove_file(&staging).map_err(|e| Error::io(&staging, e))?;
     }
     let journal = dir.join(JOURNAL);
     if journal.exists() {
@@ -231,12 +289,7 @@ fn recover(dir: &Path) -> Result<()> {
 pub(crate) fn staged_path(path: &Path) -> Option<PathBuf> {
     let mut active = ACTIVE.lock().ok()?;
     let a = active.as_mut()?;
-    let abs = absolute(path);
-    let rel = abs
-        .strip_prefix(&a.dir)
-        .or_else(|_| abs.strip_prefix(&a.canonical))
-        .ok()?
-        .to_path_buf();
+    let rel = resolve(path).strip_prefix(&a.dir).ok()?.to_path_buf();
     if rel.as_os_str().is_empty() || rel.starts_with(STAGING) {
         return None;
     }

@@ -41,6 +41,24 @@ struct StageSeries {
     kind: StageKind,
     wall: Vec<f64>,
     gpu: Vec<f64>,
+    /// Thread CPU time (CPU stages).
+    cpu: Vec<f64>,
+}
+
+/// A deliberate slowdown for testing `gibench compare`: `GIBENCH_TEST_SLOW_STAGE=NAME:MS` makes
+/// the stage NAME busy-wait MS milliseconds on the CPU inside its timed span. Read once per
+/// profiler; never set in benchmark runs.
+fn slow_stage_hook() -> Option<(String, f64)> {
+    let v = std::env::var("GIBENCH_TEST_SLOW_STAGE").ok()?;
+    let (name, ms) = v.split_once(':')?;
+    Some((name.to_string(), ms.parse().ok()?))
+}
+
+fn busy_wait(ms: f64) {
+    let t0 = Instant::now();
+    while t0.elapsed().as_secs_f64() * 1e3 < ms {
+        std::hint::spin_loop();
+    }
 }
 
 struct Timestamps {
@@ -57,6 +75,8 @@ pub struct Profiler {
     series: Vec<StageSeries>,
     counters: BTreeMap<String, Vec<f64>>,
     timestamps: Option<Timestamps>,
+    /// [`slow_stage_hook`].
+    slow: Option<(String, f64)>,
     /// (series index, query index) of stages timed this frame.
     frame_queries: Vec<(usize, u32)>,
     frame_commands: Vec<wgpu::CommandBuffer>,
@@ -103,6 +123,7 @@ impl Profiler {
             series: Vec::new(),
             counters: BTreeMap::new(),
             timestamps,
+            slow: slow_stage_hook(),
             frame_queries: Vec::new(),
             frame_commands: Vec::new(),
             in_flight: VecDeque::new(),
@@ -127,6 +148,7 @@ impl Profiler {
             kind,
             wall: Vec::new(),
             gpu: Vec::new(),
+            cpu: Vec::new(),
         });
         self.series.len() - 1
     }
@@ -163,6 +185,7 @@ impl Profiler {
         match self.mode {
             ProfileMode::Frame => {
                 let r = record(&mut enc);
+                self.slow_down(name);
                 self.frame_commands.push(enc.finish());
                 Ok(r)
             }
@@ -181,6 +204,7 @@ impl Profiler {
                 }
                 gpu.queue.submit([enc.finish()]);
                 gpu.flush()?;
+                self.slow_down(name);
                 let ms = t0.elapsed().as_secs_f64() * 1e3;
                 self.record_wall(idx, ms);
                 Ok(r)
@@ -191,11 +215,26 @@ impl Profiler {
     /// Runs a CPU stage and times it by wall clock.
     pub fn cpu_stage<R>(&mut self, name: &str, work: impl FnOnce() -> R) -> R {
         let idx = self.series_index(name, StageKind::Cpu);
+        let c0 = crate::calibrate::thread_cpu_ms();
         let t0 = Instant::now();
         let r = work();
+        self.slow_down(name);
         let ms = t0.elapsed().as_secs_f64() * 1e3;
+        if let (Some(c0), Some(c1), true) = (c0, crate::calibrate::thread_cpu_ms(), self.recording)
+        {
+            self.series[idx].cpu.push(c1 - c0);
+        }
         self.record_wall(idx, ms);
         r
+    }
+
+    /// The [`slow_stage_hook`], if it names this stage.
+    fn slow_down(&self, name: &str) {
+        if let Some((stage, ms)) = &self.slow {
+            if stage == name {
+                busy_wait(*ms);
+            }
+        }
     }
 
     fn record_wall(&mut self, series: usize, ms: f64) {
@@ -295,6 +334,7 @@ impl Profiler {
                 kind: s.kind,
                 gpu_ms: (!s.gpu.is_empty()).then(|| Stats::of(&s.gpu)),
                 wall_ms: (!s.wall.is_empty()).then(|| Stats::of(&s.wall)),
+                cpu_ms: (!s.cpu.is_empty()).then(|| Stats::of(&s.cpu)),
             })
             .collect()
     }

@@ -273,15 +273,26 @@ fn encode(r: &ReferenceImages) -> Vec<u8> {
     out
 }
 
-/// Removes the least recently used entries (`*.bin`, by modification time) of the cache in
-/// `dir` until they total at most `max` bytes, never `keep` (the entry just written).
+/// Whether `path` starts with a cache entry's header (only entries are ever trimmed).
+fn is_entry(path: &Path) -> bool {
+    use std::io::Read;
+    let mut head = [0u8; 8];
+    std::fs::File::open(path)
+        .and_then(|mut f| f.read_exact(&mut head))
+        .is_ok()
+        && &head == MAGIC
+}
+
+/// Removes the least recently used entries (`*.bin` files that start with an entry's header, by
+/// modification time) of the cache in `dir` until they total at most `max` bytes, never `keep`
+/// (the entry just written). Other files in the folder are never touched.
 fn trim(dir: &Path, max: u64, keep: &Path) {
     let Ok(entries) = std::fs::read_dir(dir) else {
         return;
     };
     let mut files: Vec<(std::time::SystemTime, u64, PathBuf)> = entries
         .flatten()
-        .filter(|e| e.path().extension().is_some_and(|x| x == "bin"))
+        .filter(|e| e.path().extension().is_some_and(|x| x == "bin") && is_entry(&e.path()))
         .filter_map(|e| {
             let m = e.metadata().ok()?;
             Some((m.modified().ok()?, m.len(), e.path()))
@@ -498,9 +509,20 @@ mod tests {
     fn the_cache_is_trimmed_oldest_first() {
         let dir = tempfile::tempdir().unwrap();
         let t0 = std::time::SystemTime::now() - std::time::Duration::from_secs(100);
+        let mut entry = MAGIC.to_vec();
+        entry.resize(100, 0);
+        // Not an entry, and the oldest file: never trimmed.
+        let foreign = dir.path().join("mine.bin");
+        std::fs::write(&foreign, vec![1u8; 1000]).unwrap();
+        std::fs::File::options()
+            .append(true)
+            .open(&foreign)
+            .unwrap()
+            .set_modified(std::time::SystemTime::UNIX_EPOCH)
+            .unwrap();
         for (i, name) in ["a.bin", "b.bin", "c.bin"].iter().enumerate() {
             let p = dir.path().join(name);
-            std::fs::write(&p, vec![0u8; 100]).unwrap();
+            std::fs::write(&p, &entry).unwrap();
             let f = std::fs::File::options().append(true).open(&p).unwrap();
             f.set_modified(t0 + std::time::Duration::from_secs(10 * i as u64))
                 .unwrap();
@@ -512,5 +534,6 @@ mod tests {
             .map(|n| dir.path().join(n).exists())
             .collect();
         assert_eq!(left, [true, false, true]);
+        assert!(foreign.exists());
     }
 }

@@ -345,7 +345,7 @@ fn stage_names<'a>(results: impl IntoIterator<Item = &'a RunResult>) -> Vec<Stri
 }
 
 /// A stage's plotted/tabulated time, treating non-finite values as missing.
-fn stage_ms(s: &StageResult) -> Option<f64> {
+pub fn stage_ms(s: &StageResult) -> Option<f64> {
     finite(s.best_ms())
 }
 
@@ -1104,6 +1104,7 @@ mod tests {
             kind,
             gpu_ms: gpu.map(stats),
             wall_ms: wall.map(stats),
+            cpu_ms: None,
         }
     }
 
@@ -1147,6 +1148,7 @@ mod tests {
             quality: None,
             images: vec!["frame.png".into()],
             warnings: Vec::new(),
+            calibration_ms: None,
         }
     }
 

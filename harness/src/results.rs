@@ -35,6 +35,10 @@ pub struct StageResult {
     /// per-task method); for CPU stages, plain wall time.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub wall_ms: Option<Stats>,
+    /// CPU stages: the thread's CPU time, beside its wall time (they differ when the thread
+    /// waits or is descheduled on a busy machine).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cpu_ms: Option<Stats>,
 }
 
 /// Whole-frame timings with no added synchronisation (Laine's FPS column).
@@ -119,6 +123,11 @@ pub struct RunResult {
     /// limit), also printed after the run.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub warnings: Vec<String>,
+    /// Wall time of the calibration workload timed in the same session
+    /// ([`crate::calibrate::calibration_ms`]): `gibench compare` divides by it so that drift of
+    /// a shared machine between sessions cancels.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub calibration_ms: Option<f64>,
 }
 
 impl RunResult {

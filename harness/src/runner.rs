@@ -385,6 +385,8 @@ impl<'a> Harness<'a> {
         prepared: &PreparedTechnique,
         progress: &mut dyn FnMut(),
     ) -> Result<(RunResult, FrameImages)> {
+        // Timed before the frames, in the same session: what `gibench compare` divides by.
+        let calibration = crate::calibrate::calibration_ms();
         let mut stages = Vec::new();
         let mut counters = BTreeMap::new();
         let mut frame_result = None;
@@ -472,6 +474,7 @@ impl<'a> Harness<'a> {
             quality: None,
             images: Vec::new(),
             warnings: Vec::new(),
+            calibration_ms: Some(calibration),
         };
         let images = images.expect("at least one timing pass");
         let mut result = result;

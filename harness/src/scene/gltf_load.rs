@@ -457,6 +457,12 @@ fn external_file(
         return Err(refuse("leaves the glTF's folder"));
     }
     let file = base.join(rel);
+    // Through symlinks too: the file itself must lie inside the folder.
+    if let (Ok(real), Ok(folder)) = (file.canonicalize(), base.canonicalize()) {
+        if !real.starts_with(&folder) {
+            return Err(refuse("leaves the glTF's folder through a symbolic link"));
+        }
+    }
     let meta = std::fs::metadata(&file).map_err(|e| {
         Error::bad_file(
             gltf,

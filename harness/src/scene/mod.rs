@@ -101,10 +101,12 @@ impl Mesh {
                     .length()
                     .max((p[2] - p[1]).length())
                     .max((p[0] - p[2]).length());
-                let n = tessellation_factor(longest, max_edge) as u64;
-                n * n
+                // Unclamped: an edge so short that `tessellated` would clamp it is refused.
+                let n = (longest / max_edge).ceil();
+                let n = if n.is_finite() { n.max(1.0) } else { f32::MAX };
+                (n as f64 * n as f64).min(u64::MAX as f64) as u64
             })
-            .sum()
+            .fold(0u64, u64::saturating_add)
     }
 
     /// A copy in which every triangle whose longest edge exceeds `max_edge` is split into an
@@ -509,8 +511,30 @@ impl Scene {
         if let Some(s) = &shadow_mesh {
             check_coordinates(name, "the shadow mesh (with its statics)", s)?;
         }
-        for m in &movers {
+        for (m, d) in movers.iter().zip(&desc.movers) {
             check_coordinates(name, &format!("mover '{}' (scaled)", m.name), &m.mesh)?;
+            // Placed along its path: its farthest vertex from its origin plus the farthest key.
+            let reach = m
+                .mesh
+                .positions
+                .iter()
+                .map(|p| p.length())
+                .fold(0.0f32, f32::max);
+            let far = d
+                .path
+                .keys
+                .iter()
+                .map(|k| Vec3::from(k.position).length())
+                .fold(0.0f32, f32::max);
+            if reach + far > MAX_COORDINATE {
+                return Err(crate::Error::bad_file(
+                    format!("scene '{name}'"),
+                    format!(
+                        "mover '{}': vertices up to {reach} from its origin on a path reaching {far} can land past ±{MAX_COORDINATE:e} scene units",
+                        m.name
+                    ),
+                ));
+            }
         }
         Ok(Scene {
             descriptor: desc.clone(),

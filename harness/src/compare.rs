@@ -1,0 +1,345 @@
+//! **Compare**: whether CURRENT runs are faster or slower than BASE runs of the same benchmark,
+//! stage by stage, with a verdict only where the repeats' spread allows one (`gibench compare`).
+//!
+//! Runs are matched by scene, technique, resolution and parameters; each side needs at least
+//! [`MIN_REPEATS`] repeats of every run it is compared on (run them alternating BASE and
+//! CURRENT, so that a shared machine's drift falls on both). For every stage (the tables'
+//! figure: flushed wall time, else GPU timestamps), and for the whole frame where it was timed:
+//!
+//! * each repeat's median is divided by the calibration workload timed in the same session
+//!   ([`crate::calibrate`]; raw when a file has none), so drift between sessions cancels;
+//! * the **ratio** is median(CURRENT) / median(BASE) over the repeats, normalised (and raw
+//!   beside it);
+//! * the **band** is [min CURRENT / max BASE, max CURRENT / min BASE]: every pairing of a
+//!   CURRENT repeat with a BASE repeat lies in it;
+//! * the **verdict** is *slower* when the whole band lies above 1 + tolerance, *faster* when it
+//!   lies below 1 / (1 + tolerance), and *unchanged* otherwise.
+//!
+//! CPU stages also report the median thread CPU time of each side.
+
+use std::collections::BTreeMap;
+
+use serde::Serialize;
+
+use crate::report::{stage_ms, Cell, Table};
+use crate::results::RunResult;
+use crate::{Error, Result};
+
+/// Repeats each side needs of every run it is compared on.
+pub const MIN_REPEATS: usize = 3;
+
+/// What a comparison concludes for one stage.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Verdict {
+    Faster,
+    Slower,
+    Unchanged,
+}
+
+impl Verdict {
+    pub fn name(self) -> &'static str {
+        match self {
+            Verdict::Faster => "faster",
+            Verdict::Slower => "slower",
+            Verdict::Unchanged => "unchanged",
+        }
+    }
+}
+
+/// One stage of one run, compared.
+#[derive(Clone, Debug, Serialize)]
+pub struct CompareRow {
+    /// `scene/technique/WxH` plus any parameters.
+    pub run: String,
+    pub stage: String,
+    /// Median over the repeats of each repeat's median, milliseconds.
+    pub base_ms: f64,
+    pub current_ms: f64,
+    /// current / base, raw.
+    pub ratio_raw: f64,
+    /// current / base, each repeat divided by its session's calibration.
+    pub ratio: f64,
+    /// The band of normalised ratios (see the module docs).
+    pub band: [f64; 2],
+    pub verdict: Verdict,
+    pub repeats: [usize; 2],
+    /// CPU stages: median thread CPU time, base and current.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cpu_ms: Option<[f64; 2]>,
+}
+
+fn median(v: &[f64]) -> f64 {
+    let mut s = v.to_vec();
+    s.sort_by(f64::total_cmp);
+    let n = s.len();
+    if n % 2 == 1 {
+        s[n / 2]
+    } else {
+        0.5 * (s[n / 2 - 1] + s[n / 2])
+    }
+}
+
+/// The key runs are matched by.
+fn run_key(r: &RunResult) -> String {
+    let params: Vec<String> = r
+        .parameters
+        .iter()
+        .map(|(k, v)| format!("{k}={}", v.to_string().trim_matches('"')))
+        .collect();
+    let mut key = format!(
+        "{}/{}/{}x{}",
+        r.scene, r.technique, r.resolution[0], r.resolution[1]
+    );
+    if !params.is_empty() {
+        key.push_str(&format!(" ({})", params.join(", ")));
+    }
+    key
+}
+
+/// One stage of one run: (raw ms, calibrated, thread CPU ms).
+type Figure = (f64, f64, Option<f64>);
+
+/// Per stage (and "frame"): the [`Figure`] of one run.
+fn figures(r: &RunResult) -> BTreeMap<String, Figure> {
+    let scale = r
+        .calibration_ms
+        .filter(|c| c.is_finite() && *c > 0.0)
+        .map_or(1.0, |c| 1.0 / c);
+    let mut out = BTreeMap::new();
+    for s in &r.stages {
+        if let Some(ms) = stage_ms(s).filter(|m| m.is_finite()) {
+            let cpu = s.cpu_ms.as_ref().map(|c| c.median);
+            out.insert(s.name.clone(), (ms, ms * scale, cpu));
+        }
+    }
+    if let Some(f) = &r.frame {
+        let ms = f.frame_ms.median;
+        if ms.is_finite() {
+            out.insert("frame".to_string(), (ms, ms * scale, None));
+        }
+    }
+    out
+}
+
+/// Runs grouped by [`run_key`].
+fn group(runs: &[RunResult]) -> BTreeMap<String, Vec<&RunResult>> {
+    let mut g: BTreeMap<String, Vec<&RunResult>> = BTreeMap::new();
+    for r in runs {
+        g.entry(run_key(r)).or_default().push(r);
+    }
+    g
+}
+
+/// Compares `current` with `base` (see the module docs). Errors name the run that has too few
+/// repeats on either side, or say that no run is on both sides.
+pub fn compare(
+    base: &[RunResult],
+    current: &[RunResult],
+    tolerance: f64,
+) -> Result<Vec<CompareRow>> {
+    if !(tolerance.is_finite() && tolerance >= 0.0) {
+        return Err(Error::param(
+            "tolerance",
+            format!("must be a number >= 0 (got {tolerance})"),
+        ));
+    }
+    let (b, c) = (group(base), group(current));
+    let common: Vec<&String> = b.keys().filter(|k| c.contains_key(*k)).collect();
+    if common.is_empty() {
+        return Err(Error::Invalid(format!(
+            "no run is in both BASE ({}) and CURRENT ({}): runs are matched by scene, technique, resolution and parameters",
+            b.keys().cloned().collect::<Vec<_>>().join("; "),
+            c.keys().cloned().collect::<Vec<_>>().join("; ")
+        )));
+    }
+    let mut rows = Vec::new();
+    for key in common {
+        let (bs, cs) = (&b[key], &c[key]);
+        for (side, runs) in [("BASE", bs), ("CURRENT", cs)] {
+            if runs.len() < MIN_REPEATS {
+                return Err(Error::Invalid(format!(
+                    "{side} has {} repeat(s) of {key}; a comparison needs at least {MIN_REPEATS} on each side (run it again into separate folders, alternating BASE and CURRENT)",
+                    runs.len()
+                )));
+            }
+        }
+        let bf: Vec<_> = bs.iter().map(|r| figures(r)).collect();
+        let cf: Vec<_> = cs.iter().map(|r| figures(r)).collect();
+        let mut stages: Vec<String> = Vec::new();
+        for f in bf.iter().chain(&cf) {
+            for name in f.keys() {
+                if !stages.contains(name) {
+                    stages.push(name.clone());
+                }
+            }
+        }
+        for stage in stages {
+            let take = |fs: &[BTreeMap<String, Figure>]| {
+                fs.iter()
+                    .filter_map(|f| f.get(&stage).copied())
+                    .collect::<Vec<_>>()
+            };
+            let (bv, cv) = (take(&bf), take(&cf));
+            if bv.len() < MIN_REPEATS || cv.len() < MIN_REPEATS {
+                continue;
+            }
+            let raw = |v: &[Figure]| v.iter().map(|x| x.0).collect::<Vec<_>>();
+            let norm = |v: &[Figure]| v.iter().map(|x| x.1).collect::<Vec<_>>();
+            let cpu = |v: &[Figure]| {
+                let c: Vec<f64> = v.iter().filter_map(|x| x.2).collect();
+                (!c.is_empty()).then(|| median(&c))
+            };
+            let (bn, cn) = (norm(&bv), norm(&cv));
+            let max_of = |v: &[f64]| v.iter().copied().fold(f64::MIN, f64::max);
+            let min_of = |v: &[f64]| v.iter().copied().fold(f64::MAX, f64::min);
+            let band = [min_of(&cn) / max_of(&bn), max_of(&cn) / min_of(&bn)];
+            let verdict = if band[0] > 1.0 + tolerance {
+                Verdict::Slower
+            } else if band[1] < 1.0 / (1.0 + tolerance) {
+                Verdict::Faster
+            } else {
+                Verdict::Unchanged
+            };
+            rows.push(CompareRow {
+                run: key.clone(),
+                stage,
+                base_ms: median(&raw(&bv)),
+                current_ms: median(&raw(&cv)),
+                ratio_raw: median(&raw(&cv)) / median(&raw(&bv)),
+                ratio: median(&cn) / median(&bn),
+                band,
+                verdict,
+                repeats: [bv.len(), cv.len()],
+                cpu_ms: cpu(&bv).zip(cpu(&cv)).map(|(a, b)| [a, b]),
+            });
+        }
+    }
+    Ok(rows)
+}
+
+/// The comparison as a table (see the module docs for the columns' meaning).
+pub fn compare_table(rows: &[CompareRow], tolerance: f64) -> Table {
+    let columns = [
+        "run",
+        "stage",
+        "base ms",
+        "current ms",
+        "ratio (raw)",
+        "ratio (calibrated)",
+        "band",
+        "verdict",
+        "CPU ms base / current",
+    ]
+    .map(String::from)
+    .to_vec();
+    let rows_out = rows
+        .iter()
+        .map(|r| {
+            vec![
+                Cell::text(&r.run),
+                Cell::text(&r.stage),
+                Cell::Ms(Some(r.base_ms)),
+                Cell::Ms(Some(r.current_ms)),
+                Cell::Num(Some(r.ratio_raw), 3),
+                Cell::Num(Some(r.ratio), 3),
+                Cell::text(format!("{:.3}–{:.3}", r.band[0], r.band[1])),
+                Cell::text(r.verdict.name()),
+                Cell::text(
+                    r.cpu_ms
+                        .map_or("–".to_string(), |[a, b]| format!("{a:.2} / {b:.2}")),
+                ),
+            ]
+        })
+        .collect();
+    let slower = rows.iter().filter(|r| r.verdict == Verdict::Slower).count();
+    let faster = rows.iter().filter(|r| r.verdict == Verdict::Faster).count();
+    Table {
+        title: format!(
+            "Comparison: {slower} slower, {faster} faster, {} unchanged",
+            rows.len() - slower - faster
+        ),
+        columns,
+        rows: rows_out,
+        notes: vec![format!(
+            "Per stage, the median over the repeats of each repeat's median (ms). Ratios are CURRENT / BASE; \
+             \"calibrated\" divides each repeat by the calibration workload timed in its session. Band: every \
+             pairing of a CURRENT repeat with a BASE repeat (calibrated). Verdict: slower when the whole band \
+             is above {:.2}, faster when it is below {:.3}, else unchanged (tolerance {tolerance}).",
+            1.0 + tolerance,
+            1.0 / (1.0 + tolerance)
+        )],
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::results::{StageKind, StageResult};
+    use crate::stats::Stats;
+
+    fn run(stages: &[(&str, f64)], calibration: f64) -> RunResult {
+        let mut r: RunResult = serde_json::from_value(serde_json::json!({
+            "schema_version": crate::results::SCHEMA_VERSION,
+            "gibench_version": "0", "git_commit": "x", "timestamp": 0, "scene": "cornell",
+            "technique": "direct", "parameters": {}, "settings": {}, "resolution": [64, 48],
+            "frames": {"warmup": 3, "measured": 10, "first": 3}, "seed": 1, "timing_mode": "stages",
+            "device": {"adapter": "a", "backend": "vulkan", "device_type": "Cpu", "driver": "d",
+                       "driver_info": "i", "timestamp_queries": false, "timestamp_period_ns": 1.0},
+            "stages": [], "frame": null
+        }))
+        .unwrap();
+        r.calibration_ms = Some(calibration);
+        r.stages = stages
+            .iter()
+            .map(|(name, ms)| StageResult {
+                name: name.to_string(),
+                kind: StageKind::Gpu,
+                gpu_ms: None,
+                wall_ms: Some(Stats::of(&[*ms])),
+                cpu_ms: None,
+            })
+            .collect();
+        r
+    }
+
+    /// Noise within the band and a machine twice as slow in one session give "unchanged"; a
+    /// stage 1.5× slower is "slower" and the others stay "unchanged"; too few repeats is an
+    /// error naming the run.
+    #[test]
+    fn verdicts_follow_the_band_and_the_calibration() {
+        let base: Vec<RunResult> = [1.0, 1.04, 0.97]
+            .iter()
+            .map(|n| run(&[("a", 2.0 * n), ("b", 5.0 * n)], 10.0))
+            .collect();
+        // The same work; the second session ran on a machine twice as slow, and its
+        // calibration says so.
+        let same: Vec<RunResult> = [(1.02, 10.0), (2.0, 20.0), (0.99, 10.0)]
+            .iter()
+            .map(|(n, c)| run(&[("a", 2.0 * n), ("b", 5.0 * n)], *c))
+            .collect();
+        let rows = compare(&base, &same, 0.1).unwrap();
+        assert!(
+            rows.iter().all(|r| r.verdict == Verdict::Unchanged),
+            "{rows:?}"
+        );
+        let slow: Vec<RunResult> = [1.0, 1.03, 0.98]
+            .iter()
+            .map(|n| run(&[("a", 3.0 * n), ("b", 5.0 * n)], 10.0))
+            .collect();
+        let rows = compare(&base, &slow, 0.1).unwrap();
+        let verdict = |s: &str| rows.iter().find(|r| r.stage == s).unwrap().verdict;
+        assert_eq!(verdict("a"), Verdict::Slower);
+        assert_eq!(verdict("b"), Verdict::Unchanged);
+        let rows = compare(&slow, &base, 0.1).unwrap();
+        assert_eq!(
+            rows.iter().find(|r| r.stage == "a").unwrap().verdict,
+            Verdict::Faster
+        );
+        let e = compare(&base[..2], &slow, 0.1).unwrap_err().to_string();
+        assert!(
+            e.contains("BASE has 2 repeat(s) of cornell/direct/64x48"),
+            "{e}"
+        );
+    }
+}
