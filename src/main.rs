@@ -512,8 +512,9 @@ pub(crate) fn writable_dir(option: &str, dir: &Path) -> Result<()> {
             format!("{} is not a writable folder: {e}", dir.display()),
         )
     };
-    std::fs::create_dir_all(dir).map_err(fail)?;
-    tempfile::NamedTempFile::new_in(dir).map_err(fail)?;
+    let dir = gibench_harness::output::without_cur_dirs(dir);
+    std::fs::create_dir_all(&dir).map_err(fail)?;
+    tempfile::NamedTempFile::new_in(&dir).map_err(fail)?;
     Ok(())
 }
 
@@ -815,6 +816,7 @@ fn results_under(option: &str, dir: &Path) -> Result<Vec<RunResult>> {
 }
 
 fn compare_cmd(args: &CompareArgs) -> Result<()> {
+    check_stem(&args.stem)?;
     let base = results_under("base", &args.base)?;
     let current = results_under("current", &args.current)?;
     let rows = gibench_harness::compare::compare(&base, &current, args.tolerance)?;
@@ -833,7 +835,19 @@ fn compare_cmd(args: &CompareArgs) -> Result<()> {
     Ok(())
 }
 
+/// A `--stem` must be a plain file name (checked before any work).
+fn check_stem(stem: &str) -> Result<()> {
+    if stem.is_empty() || stem.contains(['/', '\\']) || stem.starts_with('.') {
+        return Err(Error::param(
+            "stem",
+            format!("'{stem}' must be a file name without folders, not starting with '.'"),
+        ));
+    }
+    Ok(())
+}
+
 fn report_cmd(args: &ReportArgs) -> Result<()> {
+    check_stem(&args.stem)?;
     let results = read_results(&args.inputs)?;
     let set = OutputSet::begin("out", &args.out)?;
     let table = report::stage_table(&results);

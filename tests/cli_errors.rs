@@ -557,3 +557,46 @@ fn hostile_review_cases() {
     assert!(out.join("cornell-direct.json").exists());
     assert!(!out.join(".gibench.lock").exists() && !out.join(".gibench-staging").exists());
 }
+
+/// `--out` naming a missing folder with a trailing `.` is created; a `report --stem` that is not
+/// a plain file name is refused before any work, naming `--stem`.
+#[test]
+fn out_with_a_dot_and_a_bad_stem() {
+    let tmp = tempfile::tempdir().unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_gibench"))
+        .args([
+            "run",
+            "--technique",
+            "direct",
+            "--frames",
+            "1",
+            "--warmup",
+            "0",
+        ])
+        .args([
+            "--timing",
+            "stages",
+            "--resolution",
+            "32x24",
+            "--quiet",
+            "--out",
+        ])
+        .arg(tmp.path().join("new/."))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(tmp.path().join("new/cornell-direct.json").exists());
+    let o = Command::new(env!("CARGO_BIN_EXE_gibench"))
+        .arg("report")
+        .arg(tmp.path().join("new"))
+        .args(["--stem", "../x", "--out"])
+        .arg(tmp.path().join("rep"))
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && stderr.contains("parameter 'stem'"),
+        "{stderr}"
+    );
+    assert!(o.stdout.is_empty() && !tmp.path().join("rep").exists());
+}

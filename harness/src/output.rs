@@ -69,6 +69,19 @@ fn absolute(path: &Path) -> PathBuf {
     out
 }
 
+/// `path` without its `.` components (`create_dir_all("new/.")` fails where `new` is missing).
+pub fn without_cur_dirs(path: &Path) -> PathBuf {
+    let p: PathBuf = path
+        .components()
+        .filter(|c| !matches!(c, Component::CurDir))
+        .collect();
+    if p.as_os_str().is_empty() {
+        PathBuf::from(".")
+    } else {
+        p
+    }
+}
+
 /// Whether process `pid` is alive and runs the same program as this one (Linux: `/proc/PID`
 /// and its `comm`, so a pid reused by another program does not hold a folder; elsewhere every
 /// lock is taken as live).
@@ -119,6 +132,7 @@ impl OutputSet {
         if ACTIVE.lock().map(|a| a.is_some()).unwrap_or(true) {
             return Err(fail("another output set is open in this process".into()));
         }
+        let dir = &without_cur_dirs(dir);
         let created = !dir.exists();
         std::fs::create_dir_all(dir)
             .map_err(|e| fail(format!("{} is not a writable folder: {e}", dir.display())))?;
