@@ -463,6 +463,11 @@ pub fn vpl_count_cell(r: &RunResult) -> Cell {
     }
 }
 
+/// "adapter (backend)": what a run ran on, for tables that pool several devices.
+pub fn device_label(r: &RunResult) -> String {
+    format!("{} ({})", r.device.adapter, r.device.backend)
+}
+
 /// "fewest / most" VPLs any interleaving tile got in any measured frame (the `tile-vpls-min`
 /// and `tile-vpls-max` counters), if counted.
 pub fn tile_balance_cell(r: &RunResult) -> Cell {
@@ -485,6 +490,14 @@ pub fn stage_table(results: &[RunResult]) -> Table {
     let mut columns: Vec<String> = ["scene", "technique", "resolution"]
         .map(String::from)
         .into();
+    // Results pooled from several devices: one column says which each row ran on.
+    let mut adapters: Vec<String> = results.iter().map(device_label).collect();
+    adapters.sort();
+    adapters.dedup();
+    let pooled = adapters.len() > 1;
+    if pooled {
+        columns.insert(0, "device".into());
+    }
     if vpls {
         columns.push("VPLs (mean / min)".into());
     }
@@ -509,6 +522,9 @@ pub fn stage_table(results: &[RunResult]) -> Table {
                 Cell::text(&r.technique),
                 Cell::text(format!("{}x{}", r.resolution[0], r.resolution[1])),
             ];
+            if pooled {
+                row.insert(0, Cell::text(device_label(r)));
+            }
             if vpls {
                 row.push(vpl_count_cell(r));
             }
@@ -1177,6 +1193,22 @@ mod tests {
             4.5,
         );
         vec![a, b]
+    }
+
+    /// Runs from two devices pooled into one table get a device column naming each row's;
+    /// runs from one device do not.
+    #[test]
+    fn pooled_devices_get_a_device_column() {
+        let mut runs = two_runs();
+        assert!(!stage_table(&runs).columns.contains(&"device".to_string()));
+        runs[1].device.adapter = "NVIDIA H200".into();
+        let t = stage_table(&runs);
+        assert_eq!(t.columns[0], "device");
+        let cell = |r: usize| match &t.rows[r][0] {
+            Cell::Text(s) => s.clone(),
+            other => panic!("{other:?}"),
+        };
+        assert!(cell(1).starts_with("NVIDIA H200") && !cell(0).starts_with("NVIDIA"));
     }
 
     #[test]
