@@ -513,9 +513,24 @@ pub(crate) fn writable_dir(option: &str, dir: &Path) -> Result<()> {
         )
     };
     let dir = gibench_harness::output::without_cur_dirs(dir);
+    // The topmost folder this check creates is removed again: a command that fails later
+    // leaves no empty folder behind (the output set creates it for real).
+    let mut first_missing = None;
+    for a in dir.ancestors() {
+        if a.as_os_str().is_empty() || a.exists() {
+            break;
+        }
+        first_missing = Some(a.to_path_buf());
+    }
     std::fs::create_dir_all(&dir).map_err(fail)?;
-    tempfile::NamedTempFile::new_in(&dir).map_err(fail)?;
-    Ok(())
+    // The probe file is deleted as soon as it is made.
+    let probe = tempfile::NamedTempFile::new_in(&dir)
+        .map(|_| ())
+        .map_err(fail);
+    if let Some(top) = first_missing {
+        let _ = std::fs::remove_dir_all(top);
+    }
+    probe
 }
 
 pub(crate) fn progress_bar(quiet: bool, total: u64) -> indicatif::ProgressBar {

@@ -600,3 +600,25 @@ fn out_with_a_dot_and_a_bad_stem() {
     );
     assert!(o.stdout.is_empty() && !tmp.path().join("rep").exists());
 }
+
+/// A command that fails after its checks (an atlas that does not fit) leaves no `--out`
+/// folder behind when it created it.
+#[test]
+fn a_failed_run_leaves_no_new_folder() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("a/b");
+    let o = Command::new(env!("CARGO_BIN_EXE_gibench"))
+        .args(["run", "--technique", "laine", "--frames", "1", "--quiet"])
+        .args([
+            "--param",
+            "vpl-map-size=4096",
+            "--param",
+            "vpls=1024",
+            "--out",
+        ])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(!o.status.success());
+    assert!(!tmp.path().join("a").exists(), "{:?}", out);
+}

@@ -43,8 +43,8 @@ pub struct OutputSet {
     dir: PathBuf,
     option: String,
     published: bool,
-    /// Whether `begin` created the folder (an unpublished set then removes it if empty).
-    created: bool,
+    /// The folders `begin` created, deepest first (an unpublished set removes them if empty).
+    created: Vec<PathBuf>,
 }
 
 /// `path` made absolute against the working directory and with `.` and `..` resolved lexically.
@@ -133,7 +133,11 @@ impl OutputSet {
             return Err(fail("another output set is open in this process".into()));
         }
         let dir = &without_cur_dirs(dir);
-        let created = !dir.exists();
+        let created: Vec<PathBuf> = dir
+            .ancestors()
+            .take_while(|a| !a.as_os_str().is_empty() && !a.exists())
+            .map(Path::to_path_buf)
+            .collect();
         std::fs::create_dir_all(dir)
             .map_err(|e| fail(format!("{} is not a writable folder: {e}", dir.display())))?;
         let shown = dir.display().to_string();
@@ -238,8 +242,10 @@ impl OutputSet {
         let _ = std::fs::remove_dir_all(self.dir.join(STAGING));
         let _ = std::fs::remove_file(self.dir.join(JOURNAL));
         let _ = std::fs::remove_file(self.dir.join(LOCK));
-        if self.created && !self.published {
-            let _ = std::fs::remove_dir(&self.dir);
+        if !self.published {
+            for d in &self.created {
+                let _ = std::fs::remove_dir(d);
+            }
         }
     }
 }
