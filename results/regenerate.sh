@@ -51,6 +51,9 @@ run results/laine/budget sweep --technique laine --sweep recalc-max=4,8,16,32 --
 run results/laine/quality run --technique laine,keller-full --param vpls=256 --quality --quality-all --frames 60 --warmup 0 --timing stages --spp 64 --quiet --out results/laine/quality
 run results/laine/sibenik-vpls sweep --scene sibenik --technique laine --sweep vpls=64,128,256,512 --param vpl-map-size=64 --quality --quality-pairs 4 --frames 12 --warmup 3 --timing stages --quiet --out results/laine/sibenik-vpls
 run results/laine/sibenik-1024 run --scene sibenik --technique laine,keller-full --param vpls=1024 --param vpl-map-size=64 --frames 3 --warmup 3 --no-images --quiet --out results/laine/sibenik-1024
+# Instruction counts of the CPU kernels under callgrind: the baseline CI's gate fails against.
+run results/baseline/instructions.json instructions --write --baseline results/baseline/instructions.json
+
 # The timing baseline CI's regression report compares against: three repeats of every
 # technique at a small size (gibench compare needs at least three a side).
 for i in 1 2 3; do

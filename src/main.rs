@@ -53,6 +53,25 @@ enum Command {
     /// Compare CURRENT runs with BASE runs stage by stage: ratios, a noise band from at least
     /// three repeats on each side, and a verdict (faster / slower / unchanged).
     Compare(CompareArgs),
+    /// Count the CPU kernels' instructions under callgrind (deterministic, unlike time) and
+    /// compare them with a baseline; fails on a regression beyond the threshold.
+    Instructions(InstructionsArgs),
+}
+
+#[derive(Args)]
+struct InstructionsArgs {
+    /// The baseline counts (JSON).
+    #[arg(long, default_value = "results/baseline/instructions.json")]
+    baseline: PathBuf,
+    /// Write the counts as the new baseline instead of comparing.
+    #[arg(long)]
+    write: bool,
+    /// Relative increase counted as a regression.
+    #[arg(long, default_value_t = 0.02)]
+    threshold: f64,
+    /// Only these kernels, comma-separated (default: all; `gibench-kernels list`).
+    #[arg(long, value_delimiter = ',')]
+    kernels: Vec<String>,
 }
 
 #[derive(Args)]
@@ -268,6 +287,7 @@ fn main() -> ExitCode {
         Some(Command::Sweep(args)) => sweep(&args),
         Some(Command::PlotQuality(args)) => plot_quality(&args),
         Some(Command::Compare(args)) => compare_cmd(&args),
+        Some(Command::Instructions(args)) => instructions_cmd(&args),
         Some(Command::Reproduce(args)) => reproduce::reproduce(&args),
     };
     match outcome {
@@ -848,6 +868,178 @@ fn compare_cmd(args: &CompareArgs) -> Result<()> {
         stem = args.stem
     );
     Ok(())
+}
+
+/// The first line `program --version` prints, if it runs.
+fn tool_version(program: &str) -> Option<String> {
+    let o = std::process::Command::new(program)
+        .arg("--version")
+        .output()
+        .ok()?;
+    let text = String::from_utf8_lossy(&o.stdout).into_owned();
+    o.status
+        .success()
+        .then(|| text.lines().next().unwrap_or("").trim().to_string())
+}
+
+/// Instructions callgrind counts inside `gibench_kernel_body` for one kernel.
+fn count_instructions(kernels: &Path, name: &str) -> Result<u64> {
+    let o = std::process::Command::new("valgrind")
+        .args([
+            "--tool=callgrind",
+            "--toggle-collect=gibench_kernel_body",
+            "--callgrind-out-file=/dev/null",
+        ])
+        .arg(kernels)
+        .args(["run", name])
+        .output()
+        .map_err(|e| Error::Invalid(format!("could not run valgrind: {e}")))?;
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    if !o.status.success() {
+        return Err(Error::Invalid(format!(
+            "valgrind on kernel '{name}' failed: {stderr}"
+        )));
+    }
+    stderr
+        .lines()
+        .find_map(|l| l.split("Collected :").nth(1))
+        .and_then(|n| n.trim().parse().ok())
+        .ok_or_else(|| Error::Invalid(format!("no instruction count for '{name}' in: {stderr}")))
+}
+
+fn instructions_cmd(args: &InstructionsArgs) -> Result<()> {
+    if !(args.threshold.is_finite() && args.threshold >= 0.0) {
+        return Err(Error::param("threshold", "must be a number >= 0"));
+    }
+    let valgrind = tool_version("valgrind").ok_or_else(|| {
+        Error::Invalid(
+            "valgrind was not found; install it (Debian: apt-get install valgrind)".into(),
+        )
+    })?;
+    let kernels = std::env::current_exe()
+        .map_err(|e| Error::Invalid(e.to_string()))?
+        .with_file_name("gibench-kernels");
+    if !kernels.is_file() {
+        return Err(Error::Invalid(format!(
+            "{} not found beside gibench; build it with `cargo build --release --bins`",
+            kernels.display()
+        )));
+    }
+    let listed = std::process::Command::new(&kernels)
+        .arg("list")
+        .output()
+        .map_err(|e| Error::io(&kernels, e))?;
+    let all: Vec<String> = String::from_utf8_lossy(&listed.stdout)
+        .lines()
+        .map(str::to_string)
+        .collect();
+    let names: Vec<String> = if args.kernels.is_empty() {
+        all.clone()
+    } else {
+        for k in &args.kernels {
+            if !all.contains(k) {
+                return Err(Error::param(
+                    "kernels",
+                    format!("unknown kernel '{k}'; known: {}", all.join(", ")),
+                ));
+            }
+        }
+        args.kernels.clone()
+    };
+    let rustc = tool_version("rustc").unwrap_or_default();
+    let baseline = if args.write {
+        None
+    } else {
+        let bytes = gibench_harness::error::read_bounded(&args.baseline, 1 << 20)?;
+        let v: serde_json::Value = serde_json::from_slice(&bytes).map_err(|e| {
+            Error::bad_file(&args.baseline, format!("not an instruction baseline: {e}"))
+        })?;
+        Some(v)
+    };
+    let mut counts = serde_json::Map::new();
+    let mut rows = Vec::new();
+    let mut regressions = Vec::new();
+    for name in &names {
+        let n = count_instructions(&kernels, name)?;
+        counts.insert(name.clone(), serde_json::json!(n));
+        if let Some(b) = &baseline {
+            let base = b["kernels"][name].as_u64();
+            let (ratio, verdict) = match base {
+                Some(base) if base > 0 => {
+                    let r = n as f64 / base as f64;
+                    let v = if r > 1.0 + args.threshold {
+                        regressions.push(format!("{name} (+{:.1} %)", (r - 1.0) * 100.0));
+                        "regression"
+                    } else if r < 1.0 - args.threshold {
+                        "fewer"
+                    } else {
+                        "unchanged"
+                    };
+                    (Some(r), v)
+                }
+                _ => (None, "not in the baseline"),
+            };
+            rows.push(vec![
+                report::Cell::text(name),
+                report::Cell::Num(base.map(|b| b as f64), 0),
+                report::Cell::Num(Some(n as f64), 0),
+                report::Cell::Num(ratio, 4),
+                report::Cell::text(verdict),
+            ]);
+        }
+    }
+    if args.write {
+        let json = serde_json::json!({
+            "valgrind": valgrind,
+            "rustc": rustc,
+            "git_commit": gibench_harness::runner::git_commit(),
+            "kernels": counts,
+        });
+        let bytes = serde_json::to_vec_pretty(&json).map_err(|e| Error::Invalid(e.to_string()))?;
+        gibench_harness::error::write_atomic(&args.baseline, &bytes)?;
+        eprintln!(
+            "wrote the instruction counts of {} kernels to {}",
+            names.len(),
+            args.baseline.display()
+        );
+        return Ok(());
+    }
+    let b = baseline.expect("compared");
+    let same_tools = b["valgrind"].as_str() == Some(valgrind.as_str())
+        && b["rustc"].as_str() == Some(rustc.as_str());
+    let table = report::Table {
+        title: format!(
+            "Instructions per kernel (callgrind), against {}",
+            args.baseline.display()
+        ),
+        columns: ["kernel", "baseline", "now", "ratio", "verdict"]
+            .map(String::from)
+            .to_vec(),
+        rows,
+        notes: vec![format!(
+            "Instructions collected inside gibench_kernel_body (gibench-kernels run NAME) under {valgrind}; \
+             a regression is a count more than {:.1} % above the baseline's.",
+            args.threshold * 100.0
+        )],
+    };
+    println!("{}", table.to_terminal());
+    if regressions.is_empty() {
+        return Ok(());
+    }
+    if !same_tools {
+        eprintln!(
+            "warning: instruction counts above the baseline ({}), but the baseline was made with {} and {}, this run with {valgrind} and {rustc}: regenerate it (gibench instructions --write) rather than trust the comparison",
+            regressions.join(", "),
+            b["valgrind"].as_str().unwrap_or("?"),
+            b["rustc"].as_str().unwrap_or("?")
+        );
+        return Ok(());
+    }
+    Err(Error::Invalid(format!(
+        "instruction-count regression beyond {:.1} %: {}",
+        args.threshold * 100.0,
+        regressions.join(", ")
+    )))
 }
 
 /// A `--stem` must be a plain file name (checked before any work).

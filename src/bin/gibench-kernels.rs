@@ -1,0 +1,163 @@
+//! `gibench-kernels`: runs one CPU kernel a fixed number of times on the generated Cornell box,
+//! for counting its instructions under callgrind (`gibench instructions`). Setup (scene, BVH,
+//! a filled sampling domain) happens outside [`gibench_kernel_body`], the only function
+//! callgrind collects in (`--toggle-collect=*gibench_kernel_body*`), so the count is the
+//! kernel's alone. Everything is single-threaded and deterministic.
+//!
+//! `gibench-kernels list` prints the kernel names; `gibench-kernels run NAME` runs one.
+//! `GIBENCH_TEST_SLOW_KERNEL=NAME` runs that kernel's body twice: a deliberate regression for
+//! testing the gate, never set otherwise.
+
+use gibench_harness::assets::AssetPaths;
+use gibench_harness::bvh::SceneBvh;
+use gibench_harness::glam::{DVec3, Vec3};
+use gibench_harness::scene::Scene;
+use gibench_laine::domain::{DomainKind, SamplingDomain};
+
+/// The kernels, in the order `list` prints them.
+const KERNELS: [&str; 6] = [
+    "bvh-closest-hit-cornell",
+    "bvh-shadow-cornell",
+    "domain-delete-insert-disc-256",
+    "domain-largest-empty-circle-sphere-256",
+    "domain-voronoi-areas-disc-256",
+    "vpl-generation-cornell",
+];
+
+/// Everything a kernel needs, made before collection starts.
+pub struct Setup {
+    scene: Scene,
+    bvh: SceneBvh,
+    dirs: Vec<Vec3>,
+    targets: Vec<Vec3>,
+    disc: SamplingDomain,
+    sphere: SamplingDomain,
+}
+
+fn fibonacci(n: usize) -> Vec<Vec3> {
+    let golden = std::f32::consts::PI * (3.0 - 5f32.sqrt());
+    (0..n)
+        .map(|i| {
+            let z = 1.0 - 2.0 * (i as f32 + 0.5) / n as f32;
+            let r = (1.0 - z * z).sqrt();
+            let phi = golden * i as f32;
+            Vec3::new(r * phi.cos(), z, r * phi.sin())
+        })
+        .collect()
+}
+
+fn domain(kind: DomainKind, n: u64) -> SamplingDomain {
+    let mut d = SamplingDomain::new(kind);
+    for i in 0..n {
+        let t = (i as f64 + 0.5) / n as f64;
+        let phi = i as f64 * std::f64::consts::PI * (3.0 - 5f64.sqrt());
+        let p = match kind {
+            DomainKind::Disc => {
+                let r = t.sqrt() * 0.999;
+                DVec3::new(r * phi.cos(), r * phi.sin(), 0.0)
+            }
+            DomainKind::Sphere => {
+                let z = 1.0 - 2.0 * t;
+                let r = (1.0 - z * z).sqrt();
+                DVec3::new(r * phi.cos(), r * phi.sin(), z)
+            }
+        };
+        d.insert(i, p).expect("distinct points");
+    }
+    d
+}
+
+fn setup() -> Setup {
+    let scene = Scene::load_named("cornell", &AssetPaths::standard(None)).expect("cornell");
+    let bvh = SceneBvh::new(&scene.mesh);
+    let light = gibench_harness::anim::FrameClock::new(&scene.descriptor)
+        .frame(0)
+        .light;
+    let dirs = fibonacci(1024);
+    let targets = dirs
+        .iter()
+        .filter_map(|d| bvh.closest_hit(light.position, *d, 0.0, f32::INFINITY))
+        .map(|h| h.position + h.geometric_normal * scene.extent.ray_epsilon)
+        .collect();
+    Setup {
+        scene,
+        bvh,
+        dirs,
+        targets,
+        disc: domain(DomainKind::Disc, 256),
+        sphere: domain(DomainKind::Sphere, 256),
+    }
+}
+
+/// The kernel `name` once; what it returns keeps the work from being optimised away.
+#[inline(never)]
+#[no_mangle]
+pub extern "Rust" fn gibench_kernel_body(name: &str, s: &mut Setup, round: u64) -> f64 {
+    let light = gibench_harness::anim::FrameClock::new(&s.scene.descriptor)
+        .frame(0)
+        .light;
+    match name {
+        "bvh-closest-hit-cornell" => s
+            .dirs
+            .iter()
+            .filter_map(|d| s.bvh.closest_hit(light.position, *d, 0.0, f32::INFINITY))
+            .map(|h| h.t as f64)
+            .sum(),
+        "bvh-shadow-cornell" => s
+            .targets
+            .iter()
+            .filter(|t| s.bvh.occluded(light.position, **t, 1e-4))
+            .count() as f64,
+        "domain-delete-insert-disc-256" => {
+            let victim = round;
+            let p = s.disc.remove(victim).expect("present");
+            s.disc.insert(256 + round, p).expect("reinserted");
+            p.x
+        }
+        "domain-largest-empty-circle-sphere-256" => {
+            s.sphere.largest_empty_circle().map_or(0.0, |(_, r)| r)
+        }
+        "domain-voronoi-areas-disc-256" => s.disc.voronoi_areas().iter().map(|(_, a)| a).sum(),
+        "vpl-generation-cornell" => {
+            let rho = s.scene.average_reflectance().max_element();
+            gibench_harness::vpl::generate_at_least(&s.scene, &s.bvh, &light, 256, 1, rho)
+                .1
+                .len() as f64
+        }
+        other => panic!("unknown kernel {other}"),
+    }
+}
+
+fn main() -> std::process::ExitCode {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    match args
+        .iter()
+        .map(String::as_str)
+        .collect::<Vec<_>>()
+        .as_slice()
+    {
+        ["list"] => {
+            for k in KERNELS {
+                println!("{k}");
+            }
+            std::process::ExitCode::SUCCESS
+        }
+        ["run", name] if KERNELS.contains(name) => {
+            let mut s = setup();
+            let slow = std::env::var("GIBENCH_TEST_SLOW_KERNEL").is_ok_and(|v| v == *name);
+            let mut acc = 0.0;
+            for round in 0..if slow { 2 } else { 1 } {
+                acc += gibench_kernel_body(name, &mut s, round);
+            }
+            println!("{acc}");
+            std::process::ExitCode::SUCCESS
+        }
+        _ => {
+            eprintln!(
+                "usage: gibench-kernels list | run NAME (one of: {})",
+                KERNELS.join(", ")
+            );
+            std::process::ExitCode::FAILURE
+        }
+    }
+}
