@@ -1,6 +1,8 @@
 //! Memory stays flat over long runs: for every registered technique on the Cornell box, on
 //! every portable backend present, the process's resident set grows by less than
-//! [`MAX_GROWTH_MB`] from frame 20 to frame 100 (frame timing, the benchmark's own loop).
+//! [`MAX_GROWTH_MB`] in at least one of two 40-frame windows (frames 20–60 and 60–100; frame
+//! timing, the benchmark's own loop). Steady growth shows in both windows; a one-off step
+//! (glibc giving a worker thread its own malloc arena, seen once as 35 MB) in only one.
 //!
 //! What it catches: lavapipe (Mesa 22.3) compiling a fresh, never-freed shader variant for
 //! every draw whose control flow reads a uniform, which grew the process by 0.7 MB per frame
@@ -17,9 +19,10 @@ use gibench_harness::profiler::{ProfileMode, Profiler};
 use gibench_harness::runner::{Harness, RunConfig, TimingMode};
 use gibench_harness::scene::Scene;
 
-const MAX_GROWTH_MB: f64 = 24.0;
+const MAX_GROWTH_MB: f64 = 12.0;
 const SETTLE: u32 = 20;
-const MEASURED: u32 = 80;
+const WINDOW: u32 = 40;
+const MEASURED: u32 = 2 * WINDOW;
 
 /// The resident set size in MB (`VmRSS`).
 fn rss_mb() -> f64 {
@@ -68,25 +71,26 @@ fn memory_stays_flat_over_long_runs() {
             let prepared = h.prepare(info, &params, &config).expect("prepare");
             let (mut t, compose) = h.build(info, &params, &config, &prepared).unwrap();
             let mut profiler = Profiler::new(&gpu, ProfileMode::Frame);
-            let mut before = 0.0;
+            let mut marks = Vec::new();
             for f in 0..SETTLE + MEASURED {
-                if f == SETTLE {
+                if f == SETTLE || f == SETTLE + WINDOW {
                     gpu.flush().unwrap();
-                    before = rss_mb();
+                    marks.push(rss_mb());
                 }
                 let frame = h.clock.frame(f);
                 h.render_frame(t.as_mut(), &compose, &mut profiler, &frame, true)
                     .unwrap();
             }
             profiler.finish(&gpu).unwrap();
-            let growth = rss_mb() - before;
+            marks.push(rss_mb());
+            let (a, b) = (marks[1] - marks[0], marks[2] - marks[1]);
             eprintln!(
-                "{backend} {}: {growth:.1} MB over {MEASURED} frames",
+                "{backend} {}: {a:.1} MB, then {b:.1} MB over two {WINDOW}-frame windows",
                 info.name
             );
-            if growth >= MAX_GROWTH_MB {
+            if a.min(b) >= MAX_GROWTH_MB {
                 failures.push(format!(
-                    "{backend} {}: resident set grew {growth:.1} MB over {MEASURED} frames (bound {MAX_GROWTH_MB} MB)",
+                    "{backend} {}: resident set grew {a:.1} MB and then {b:.1} MB over two {WINDOW}-frame windows (bound {MAX_GROWTH_MB} MB in either)",
                     info.name
                 ));
             }
