@@ -19,19 +19,6 @@ use gibench_harness::scene::Scene;
 #[path = "../src/registry.rs"]
 mod registry;
 
-/// Deterministic directions spread over the sphere (Fibonacci lattice).
-fn directions(n: usize) -> Vec<Vec3> {
-    let golden = std::f32::consts::PI * (3.0 - 5f32.sqrt());
-    (0..n)
-        .map(|i| {
-            let z = 1.0 - 2.0 * (i as f32 + 0.5) / n as f32;
-            let r = (1.0 - z * z).sqrt();
-            let phi = golden * i as f32;
-            Vec3::new(r * phi.cos(), z, r * phi.sin())
-        })
-        .collect()
-}
-
 fn rays(c: &mut Criterion) {
     let assets = AssetPaths::standard(None);
     for name in ["cornell", "sibenik"] {
@@ -44,7 +31,7 @@ fn rays(c: &mut Criterion) {
             .frame(0)
             .light
             .position;
-        let dirs = directions(1024);
+        let dirs = gibench_harness::vpl::fibonacci_sphere(1024);
         c.bench_function(&format!("rays/closest-hit-1024/{name}"), |b| {
             b.iter(|| {
                 dirs.iter()
@@ -75,26 +62,7 @@ fn domains(c: &mut Criterion) {
     use gibench_laine::domain::{DomainKind, SamplingDomain};
     for kind in [DomainKind::Disc, DomainKind::Sphere] {
         for n in [256u64, 1024] {
-            let mut d = SamplingDomain::new(kind);
-            let point = |i: u64| {
-                // Quasi-random points on the domain (Fibonacci spiral).
-                let t = (i as f64 + 0.5) / n as f64;
-                let phi = i as f64 * std::f64::consts::PI * (3.0 - 5f64.sqrt());
-                match kind {
-                    DomainKind::Disc => {
-                        let r = t.sqrt() * 0.999;
-                        gibench_harness::glam::DVec3::new(r * phi.cos(), r * phi.sin(), 0.0)
-                    }
-                    DomainKind::Sphere => {
-                        let z = 1.0 - 2.0 * t;
-                        let r = (1.0 - z * z).sqrt();
-                        gibench_harness::glam::DVec3::new(r * phi.cos(), r * phi.sin(), z)
-                    }
-                }
-            };
-            for i in 0..n {
-                d.insert(i, point(i)).expect("distinct points");
-            }
+            let mut d = SamplingDomain::spiral(kind, n);
             let tag = format!("{}-{n}", format!("{kind:?}").to_lowercase());
             let mut next = n;
             c.bench_function(&format!("domain/delete-insert/{tag}"), |b| {

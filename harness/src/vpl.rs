@@ -162,6 +162,20 @@ pub fn hemisphere_to_disc(d: Vec3) -> Vec2 {
     d.truncate()
 }
 
+/// `n` deterministic unit directions spread evenly over the sphere (a Fibonacci lattice): ray
+/// sets for benchmarks and instruction counts.
+pub fn fibonacci_sphere(n: usize) -> Vec<Vec3> {
+    let golden = std::f32::consts::PI * (3.0 - 5f32.sqrt());
+    (0..n)
+        .map(|i| {
+            let z = 1.0 - 2.0 * (i as f32 + 0.5) / n as f32;
+            let r = (1.0 - z * z).sqrt();
+            let phi = golden * i as f32;
+            Vec3::new(r * phi.cos(), z, r * phi.sin())
+        })
+        .collect()
+}
+
 /// Maps `(u, v)` in [0, 1)² uniformly onto the unit sphere: z = 1 − 2u, azimuth 2πv (the
 /// cylindrical, Archimedes projection, which preserves area).
 pub fn square_to_sphere(u: f64, v: f64) -> Vec3 {

@@ -10,7 +10,7 @@
 
 use gibench_harness::assets::AssetPaths;
 use gibench_harness::bvh::SceneBvh;
-use gibench_harness::glam::{DVec3, Vec3};
+use gibench_harness::glam::Vec3;
 use gibench_harness::scene::Scene;
 use gibench_laine::domain::{DomainKind, SamplingDomain};
 
@@ -34,46 +34,13 @@ pub struct Setup {
     sphere: SamplingDomain,
 }
 
-fn fibonacci(n: usize) -> Vec<Vec3> {
-    let golden = std::f32::consts::PI * (3.0 - 5f32.sqrt());
-    (0..n)
-        .map(|i| {
-            let z = 1.0 - 2.0 * (i as f32 + 0.5) / n as f32;
-            let r = (1.0 - z * z).sqrt();
-            let phi = golden * i as f32;
-            Vec3::new(r * phi.cos(), z, r * phi.sin())
-        })
-        .collect()
-}
-
-fn domain(kind: DomainKind, n: u64) -> SamplingDomain {
-    let mut d = SamplingDomain::new(kind);
-    for i in 0..n {
-        let t = (i as f64 + 0.5) / n as f64;
-        let phi = i as f64 * std::f64::consts::PI * (3.0 - 5f64.sqrt());
-        let p = match kind {
-            DomainKind::Disc => {
-                let r = t.sqrt() * 0.999;
-                DVec3::new(r * phi.cos(), r * phi.sin(), 0.0)
-            }
-            DomainKind::Sphere => {
-                let z = 1.0 - 2.0 * t;
-                let r = (1.0 - z * z).sqrt();
-                DVec3::new(r * phi.cos(), r * phi.sin(), z)
-            }
-        };
-        d.insert(i, p).expect("distinct points");
-    }
-    d
-}
-
 fn setup() -> Setup {
     let scene = Scene::load_named("cornell", &AssetPaths::standard(None)).expect("cornell");
     let bvh = SceneBvh::new(&scene.mesh);
     let light = gibench_harness::anim::FrameClock::new(&scene.descriptor)
         .frame(0)
         .light;
-    let dirs = fibonacci(1024);
+    let dirs = gibench_harness::vpl::fibonacci_sphere(1024);
     let targets = dirs
         .iter()
         .filter_map(|d| bvh.closest_hit(light.position, *d, 0.0, f32::INFINITY))
@@ -84,8 +51,8 @@ fn setup() -> Setup {
         bvh,
         dirs,
         targets,
-        disc: domain(DomainKind::Disc, 256),
-        sphere: domain(DomainKind::Sphere, 256),
+        disc: SamplingDomain::spiral(DomainKind::Disc, 256),
+        sphere: SamplingDomain::spiral(DomainKind::Sphere, 256),
     }
 }
 

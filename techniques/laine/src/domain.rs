@@ -261,6 +261,31 @@ const BOX: f64 = 2.0;
 const CELL_EPS: f64 = 1e-12;
 
 impl SamplingDomain {
+    /// A domain holding `n` points on a Fibonacci spiral (ids 0..n): evenly spread, the same
+    /// every time — the filled domain of benchmarks and instruction counts.
+    pub fn spiral(kind: DomainKind, n: u64) -> Self {
+        let mut d = Self::new(kind);
+        let golden = PI * (3.0 - 5f64.sqrt());
+        for i in 0..n {
+            let t = (i as f64 + 0.5) / n as f64;
+            let phi = i as f64 * golden;
+            let p = match kind {
+                DomainKind::Disc => {
+                    let r = t.sqrt() * 0.999;
+                    DVec3::new(r * phi.cos(), r * phi.sin(), 0.0)
+                }
+                DomainKind::Sphere => {
+                    let z = 1.0 - 2.0 * t;
+                    let r = (1.0 - z * z).sqrt();
+                    DVec3::new(r * phi.cos(), r * phi.sin(), z)
+                }
+            };
+            d.insert(i, p)
+                .expect("spiral points are distinct and inside the domain");
+        }
+        d
+    }
+
     /// An empty domain of `kind`.
     pub fn new(kind: DomainKind) -> Self {
         SamplingDomain {
