@@ -53,6 +53,30 @@ fn descriptor(dir: &Path, name: &str, edit: impl FnOnce(&mut serde_json::Value))
     p
 }
 
+/// One `direct` frame (stage timing, no warm-up) at `resolution` into `out`, on `scene` or the
+/// default Cornell box.
+fn one_direct_frame(
+    resolution: &str,
+    scene: Option<&Path>,
+    out: impl AsRef<std::ffi::OsStr>,
+) -> std::process::Output {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_gibench"));
+    c.args([
+        "run",
+        "--technique",
+        "direct",
+        "--frames",
+        "1",
+        "--warmup",
+        "0",
+    ])
+    .args(["--timing", "stages", "--quiet", "--resolution", resolution]);
+    if let Some(scene) = scene {
+        c.arg("--scene").arg(scene);
+    }
+    c.arg("--out").arg(out).output().unwrap()
+}
+
 fn shared_scene(name: &str) -> PathBuf {
     root().join("../shared/scenes").join(name)
 }
@@ -350,29 +374,7 @@ fn half_float_saturation_is_reported() {
         v["light"]["power"] = serde_json::json!([1e12, 1e12, 1e12])
     });
     let out = tmp.path().join("out");
-    let o = Command::new(env!("CARGO_BIN_EXE_gibench"))
-        .args([
-            "run",
-            "--technique",
-            "direct",
-            "--frames",
-            "1",
-            "--warmup",
-            "0",
-        ])
-        .args([
-            "--timing",
-            "stages",
-            "--resolution",
-            "64x48",
-            "--quiet",
-            "--scene",
-        ])
-        .arg(&d)
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .unwrap();
+    let o = one_direct_frame("64x48", Some(&d), &out);
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success(), "{stderr}");
     assert!(stderr.contains("half-float limit"), "{stderr}");
@@ -390,27 +392,7 @@ fn half_float_saturation_is_reported() {
         .unwrap()
         .contains("direct irradiance"));
     // The ordinary scene gets no such warning.
-    let o = Command::new(env!("CARGO_BIN_EXE_gibench"))
-        .args([
-            "run",
-            "--technique",
-            "direct",
-            "--frames",
-            "1",
-            "--warmup",
-            "0",
-        ])
-        .args([
-            "--timing",
-            "stages",
-            "--resolution",
-            "64x48",
-            "--quiet",
-            "--out",
-        ])
-        .arg(tmp.path().join("plain"))
-        .output()
-        .unwrap();
+    let o = one_direct_frame("64x48", None, tmp.path().join("plain"));
     assert!(!String::from_utf8_lossy(&o.stderr).contains("half-float"));
 }
 
@@ -532,27 +514,7 @@ fn hostile_review_cases() {
     std::fs::create_dir(&out).unwrap();
     std::fs::write(out.join(".gibench.lock"), b"1").unwrap();
     std::fs::write(out.join(".gibench-staging"), b"junk").unwrap();
-    let o = Command::new(env!("CARGO_BIN_EXE_gibench"))
-        .args([
-            "run",
-            "--technique",
-            "direct",
-            "--frames",
-            "1",
-            "--warmup",
-            "0",
-        ])
-        .args([
-            "--timing",
-            "stages",
-            "--resolution",
-            "32x24",
-            "--quiet",
-            "--out",
-        ])
-        .arg(&out)
-        .output()
-        .unwrap();
+    let o = one_direct_frame("32x24", None, &out);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(out.join("cornell-direct.json").exists());
     assert!(!out.join(".gibench.lock").exists() && !out.join(".gibench-staging").exists());
@@ -563,27 +525,7 @@ fn hostile_review_cases() {
 #[test]
 fn out_with_a_dot_and_a_bad_stem() {
     let tmp = tempfile::tempdir().unwrap();
-    let o = Command::new(env!("CARGO_BIN_EXE_gibench"))
-        .args([
-            "run",
-            "--technique",
-            "direct",
-            "--frames",
-            "1",
-            "--warmup",
-            "0",
-        ])
-        .args([
-            "--timing",
-            "stages",
-            "--resolution",
-            "32x24",
-            "--quiet",
-            "--out",
-        ])
-        .arg(tmp.path().join("new/."))
-        .output()
-        .unwrap();
+    let o = one_direct_frame("32x24", None, tmp.path().join("new/."));
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(tmp.path().join("new/cornell-direct.json").exists());
     let o = Command::new(env!("CARGO_BIN_EXE_gibench"))

@@ -25,6 +25,17 @@ const SMALL: [&str; 8] = [
     "64",
 ];
 
+/// A small `direct` run into `out`.
+fn small_direct(out: &Path) -> std::process::Output {
+    gibench()
+        .args(["run", "--technique", "direct", "--quiet"])
+        .args(SMALL)
+        .arg("--out")
+        .arg(out)
+        .output()
+        .unwrap()
+}
+
 /// Every file under `dir` (relative path → bytes), hidden ones too.
 fn files(dir: &Path) -> BTreeMap<String, Vec<u8>> {
     let mut out = BTreeMap::new();
@@ -82,13 +93,7 @@ fn killed_runs_leave_only_complete_sets() {
     let tmp = tempfile::tempdir().unwrap();
     let (out, cache) = (tmp.path().join("out"), tmp.path().join("cache"));
     // A complete earlier run: a killed one must leave it exactly as it was.
-    let o = gibench()
-        .args(["run", "--technique", "direct", "--quiet"])
-        .args(SMALL)
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .unwrap();
+    let o = small_direct(&out);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let before = files(&out);
     assert!(before.keys().any(|k| k.ends_with("cornell-direct.json")));
@@ -157,13 +162,7 @@ fn a_second_command_into_a_folder_in_use_is_refused() {
     while !out.join(".gibench.lock").exists() && start.elapsed() < Duration::from_secs(20) {
         std::thread::sleep(Duration::from_millis(20));
     }
-    let o = gibench()
-        .args(["run", "--technique", "direct", "--quiet"])
-        .args(SMALL)
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .unwrap();
+    let o = small_direct(&out);
     let _ = first.kill();
     let _ = first.wait();
     let stderr = String::from_utf8_lossy(&o.stderr);
@@ -198,13 +197,7 @@ fn symlinked_out_and_a_folder_in_the_way() {
     let before = files(&out);
     std::fs::remove_file(out.join("cornell-summary.md")).unwrap();
     std::fs::create_dir(out.join("cornell-summary.md")).unwrap();
-    let o = gibench()
-        .args(["run", "--technique", "direct", "--quiet"])
-        .args(SMALL)
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .unwrap();
+    let o = small_direct(&out);
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(
         !o.status.success() && stderr.contains("is a folder"),
