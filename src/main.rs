@@ -45,7 +45,7 @@ enum Command {
     /// Run one technique over a list of values of one parameter (e.g. vpls=64,128,256 or
     /// tiles=1x1,2x2,4x4,8x8) and tabulate and plot per-stage times against it.
     Sweep(SweepArgs),
-    /// Regenerate a paper's table: laine-table1, laine-table2 or laine-management.
+    /// Regenerate paper tables, figures and sweeps: `all`, or one target (`reproduce all --list`).
     Reproduce(reproduce::ReproduceArgs),
     /// Plot per-frame error against the reference from results files made with
     /// `run --quality --quality-all` (e.g. the lag of keller-incremental).
@@ -506,22 +506,56 @@ impl Plan {
 
 /// Runs `spec` with a progress bar (hidden when `quiet`).
 pub(crate) fn execute_with_bar(
-    quiet: bool,
+    bars: &Bars,
     gpu: &GpuContext,
     spec: &RunSpec,
 ) -> Result<Vec<RunResult>> {
-    let bar = progress_bar(quiet, spec.total_frames());
-    let results = session::execute(gpu, spec, &mut |p| match p {
-        Progress::Technique(name) => bar.set_message(name.to_string()),
-        Progress::Frame => bar.inc(1),
-    });
-    bar.finish_and_clear();
+    let results = match bars {
+        Bars::Own(quiet) => {
+            let bar = progress_bar(*quiet, spec.total_frames());
+            let results = session::execute(gpu, spec, &mut |p| match p {
+                Progress::Technique(name) => bar.set_message(name.to_string()),
+                Progress::Frame => bar.inc(1),
+            });
+            bar.finish_and_clear();
+            results
+        }
+        Bars::Shared(all) => session::execute(gpu, spec, &mut |p| match p {
+            Progress::Technique(name) => all.technique(name),
+            Progress::Frame => all.frame(),
+        }),
+    };
     for r in results.iter().flatten() {
         for w in &r.warnings {
-            eprintln!("warning: {} on {}: {w}", r.technique, r.scene);
+            bars.note(&format!("warning: {} on {}: {w}", r.technique, r.scene));
         }
     }
     results
+}
+
+/// Where a command reports its progress: a bar of its own (hidden when quiet), or its share of
+/// `gibench reproduce all`'s bar.
+pub(crate) enum Bars<'a> {
+    Own(bool),
+    Shared(&'a reproduce::all::Overall),
+}
+
+impl Bars<'_> {
+    /// A line for the terminal (above the shared bar, not through it).
+    pub(crate) fn note(&self, line: &str) {
+        match self {
+            Bars::Own(_) => eprintln!("{line}"),
+            Bars::Shared(all) => all.note(line),
+        }
+    }
+
+    /// A result table for the terminal: printed by a command of its own; under `reproduce all`
+    /// it is in the files only.
+    pub(crate) fn table(&self, table: &report::Table) {
+        if let Bars::Own(_) = self {
+            println!("{}", table.to_terminal());
+        }
+    }
 }
 
 /// Creates `dir` if needed and checks a file can be written there; the error names `option`.
@@ -568,9 +602,9 @@ pub(crate) fn progress_bar(quiet: bool, total: u64) -> indicatif::ProgressBar {
     bar
 }
 
-pub(crate) fn announce(plan: &Plan, gpu: &GpuContext) {
+pub(crate) fn announcement(plan: &Plan, gpu: &GpuContext) -> String {
     let c = &plan.config;
-    eprintln!(
+    format!(
         "gibench: scene '{}' ({} triangles) at {}x{} on {} ({}), {} measured + {} warm-up frames, timing '{}'",
         plan.desc.name,
         plan.scene.mesh.triangle_count(),
@@ -581,7 +615,7 @@ pub(crate) fn announce(plan: &Plan, gpu: &GpuContext) {
         c.frames,
         c.warmup,
         c.timing.name()
-    );
+    )
 }
 
 pub(crate) fn open_gpu(args: &RunArgs) -> Result<GpuContext> {
@@ -594,15 +628,29 @@ pub(crate) fn open_gpu(args: &RunArgs) -> Result<GpuContext> {
 fn run(args: &RunArgs) -> Result<()> {
     // Everything that can be checked without running is checked before anything is written.
     let plan = plan(args, &[])?;
-    let spec = plan.spec(args);
-    spec.validate()?;
+    plan.spec(args).validate()?;
     let set = OutputSet::begin("out", &args.out)?;
     let gpu = open_gpu(args)?;
-    announce(&plan, &gpu);
-    let results = execute_with_bar(args.quiet, &gpu, &spec)?;
+    let done = run_planned(args, &plan, &gpu, &Bars::Own(args.quiet))?;
+    set.publish()?;
+    eprintln!("{done}");
+    Ok(())
+}
+
+/// The work of `gibench run` once planned and its output set is open: runs, tables, plots.
+/// Returns what it wrote, as a line for the terminal.
+pub(crate) fn run_planned(
+    args: &RunArgs,
+    plan: &Plan,
+    gpu: &GpuContext,
+    bars: &Bars,
+) -> Result<String> {
+    let spec = plan.spec(args);
+    bars.note(&announcement(plan, gpu));
+    let results = execute_with_bar(bars, gpu, &spec)?;
     let name = &plan.desc.name;
     let table = report::stage_table(&results);
-    println!("{}", table.to_terminal());
+    bars.table(&table);
     let stem = format!("{name}-summary");
     let mut written: Vec<String> = report::write_tables(&table, &args.out, &stem)?
         .iter()
@@ -626,18 +674,53 @@ fn run(args: &RunArgs) -> Result<()> {
             written.push(file_name(&svg));
         }
     }
-    set.publish()?;
-    eprintln!(
+    Ok(format!(
         "wrote {} results, images and {} to {}",
         results.len(),
         written.join(", "),
         args.out.display()
-    );
-    Ok(())
+    ))
 }
 
 /// `gibench sweep`: one technique, one parameter over a list of values.
 fn sweep(args: &SweepArgs) -> Result<()> {
+    let planned = sweep_plan(args)?;
+    let set = OutputSet::begin("out", &args.run.out)?;
+    let gpu = open_gpu(&args.run)?;
+    let done = sweep_planned(args, &planned, &gpu, &Bars::Own(args.run.quiet))?;
+    set.publish()?;
+    eprintln!("{done}");
+    Ok(())
+}
+
+/// A sweep checked before it runs: the parameter, its values and one plan per value.
+pub(crate) struct SweepPlan {
+    name: String,
+    values: Vec<String>,
+    plans: Vec<Plan>,
+}
+
+impl SweepPlan {
+    /// The typed run of every point.
+    fn spec(&self, args: &SweepArgs) -> RunSpec<'_> {
+        let first = &self.plans[0];
+        let info = first.techniques[0];
+        let mut spec = first.spec(&args.run);
+        spec.runs = self
+            .values
+            .iter()
+            .zip(&self.plans)
+            .map(|(v, p)| TechniqueRun {
+                info,
+                params: p.params[0].clone(),
+                stem: format!("{}-{}-{}-{v}", first.desc.name, info.name, self.name),
+            })
+            .collect();
+        spec
+    }
+}
+
+pub(crate) fn sweep_plan(args: &SweepArgs) -> Result<SweepPlan> {
     let (name, values) = args
         .sweep
         .split_once('=')
@@ -679,23 +762,34 @@ fn sweep(args: &SweepArgs) -> Result<()> {
         .iter()
         .map(|v| plan(&args.run, &[format!("{name}={v}")]))
         .collect::<Result<_>>()?;
+    let planned = SweepPlan {
+        name,
+        values,
+        plans,
+    };
+    planned.spec(args).validate()?;
+    Ok(planned)
+}
+
+/// The work of `gibench sweep` once planned and its output set is open. Returns what it
+/// wrote, as a line for the terminal.
+pub(crate) fn sweep_planned(
+    args: &SweepArgs,
+    planned: &SweepPlan,
+    gpu: &GpuContext,
+    bars: &Bars,
+) -> Result<String> {
+    let SweepPlan {
+        name,
+        values,
+        plans,
+    } = planned;
+    let (name, values) = (name.clone(), values.clone());
     let first = &plans[0];
     let info = first.techniques[0];
-    let mut spec = first.spec(&args.run);
-    spec.runs = values
-        .iter()
-        .zip(&plans)
-        .map(|(v, p)| TechniqueRun {
-            info,
-            params: p.params[0].clone(),
-            stem: format!("{}-{}-{name}-{v}", first.desc.name, info.name),
-        })
-        .collect();
-    spec.validate()?;
-    let set = OutputSet::begin("out", &args.run.out)?;
-    let gpu = open_gpu(&args.run)?;
-    announce(first, &gpu);
-    let runs = execute_with_bar(args.run.quiet, &gpu, &spec)?;
+    let spec = planned.spec(args);
+    bars.note(&announcement(first, gpu));
+    let runs = execute_with_bar(bars, gpu, &spec)?;
     let points: Vec<(String, RunResult)> = values.iter().cloned().zip(runs).collect();
     let results: Vec<RunResult> = points.iter().map(|(_, r)| r.clone()).collect();
     let mut table = report::stage_table(&results);
@@ -707,7 +801,7 @@ fn sweep(args: &SweepArgs) -> Result<()> {
     for (row, v) in table.rows.iter_mut().zip(&values) {
         row.insert(0, report::Cell::text(v));
     }
-    println!("{}", table.to_terminal());
+    bars.table(&table);
     let stem = format!("{}-{}-sweep-{name}", first.desc.name, info.name);
     report::write_tables(&table, &args.run.out, &stem)?;
     report::sweep_plot_svg(
@@ -719,13 +813,11 @@ fn sweep(args: &SweepArgs) -> Result<()> {
         ),
         &name,
     )?;
-    set.publish()?;
-    eprintln!(
+    Ok(format!(
         "wrote {} points and {stem}.md/.csv/.tex/.svg to {}",
         points.len(),
         args.run.out.display()
-    );
-    Ok(())
+    ))
 }
 
 fn file_name(p: &Path) -> String {
@@ -1074,6 +1166,23 @@ fn report_cmd(args: &ReportArgs) -> Result<()> {
 }
 
 fn reference_cmd(args: &ReferenceArgs) -> Result<()> {
+    let planned = reference_plan(args)?;
+    let set = OutputSet::begin("out", &args.out)?;
+    let done = reference_planned(args, &planned, &Bars::Own(false))?;
+    set.publish()?;
+    eprintln!("{done}");
+    Ok(())
+}
+
+/// A reference render checked before it runs.
+pub(crate) struct ReferencePlan {
+    resolution: [u32; 2],
+    settings: ReferenceSettings,
+    desc: SceneDescriptor,
+    scene: Scene,
+}
+
+pub(crate) fn reference_plan(args: &ReferenceArgs) -> Result<ReferencePlan> {
     let resolution = parse_resolution(&args.resolution)?;
     RunConfig {
         resolution,
@@ -1088,13 +1197,35 @@ fn reference_cmd(args: &ReferenceArgs) -> Result<()> {
     let settings = args.reference.settings()?;
     let desc = SceneDescriptor::resolve(&args.scene)?;
     let scene = Scene::load(&desc, &AssetPaths::standard(args.assets.as_deref()))?;
-    let frame = gibench_harness::anim::FrameClock::new(&desc).frame(args.frame);
     if !args.reference.no_cache {
         writable_dir("cache", &args.reference.cache)?;
     }
+    writable_dir("out", &args.out)?;
+    Ok(ReferencePlan {
+        resolution,
+        settings,
+        desc,
+        scene,
+    })
+}
+
+/// The work of `gibench reference` once planned and its output set is open. Returns what it
+/// wrote, as a line for the terminal.
+pub(crate) fn reference_planned(
+    args: &ReferenceArgs,
+    planned: &ReferencePlan,
+    bars: &Bars,
+) -> Result<String> {
+    let ReferencePlan {
+        resolution,
+        settings,
+        desc,
+        scene,
+    } = planned;
+    let (resolution, settings) = (*resolution, *settings);
+    let frame = gibench_harness::anim::FrameClock::new(desc).frame(args.frame);
     let cache = args.reference.cache();
-    let set = OutputSet::begin("out", &args.out)?;
-    eprintln!(
+    bars.note(&format!(
         "gibench: reference for '{}' frame {} at {}x{}: {} spp, {} bounces, seed {}",
         desc.name,
         args.frame,
@@ -1103,9 +1234,9 @@ fn reference_cmd(args: &ReferenceArgs) -> Result<()> {
         settings.spp,
         settings.bounces,
         settings.seed
-    );
+    ));
     let start = std::time::Instant::now();
-    let r = cache.get(&scene, &frame, resolution, &settings)?;
+    let r = cache.get(scene, &frame, resolution, &settings)?;
     let seconds = start.elapsed().as_secs_f64();
     let mut estimate = None;
     if args.error_estimate {
@@ -1113,14 +1244,14 @@ fn reference_cmd(args: &ReferenceArgs) -> Result<()> {
             seed: settings.seed + 1,
             ..settings
         };
-        let r2 = cache.get(&scene, &frame, resolution, &other)?;
+        let r2 = cache.get(scene, &frame, resolution, &other)?;
         let one = gibench_harness::metrics::relative_mse(&r.one_bounce, &r2.one_bounce, &r.hit);
         let multi =
             gibench_harness::metrics::relative_mse(&r.multi_bounce, &r2.multi_bounce, &r.hit);
-        println!(
+        bars.note(&format!(
             "relative MSE between seeds {} and {}: one-bounce {one:.5}, multi-bounce {multi:.5}",
             settings.seed, other.seed
-        );
+        ));
         estimate = Some(
             serde_json::json!({"seeds": [settings.seed, other.seed], "one_bounce_rel_mse": one, "multi_bounce_rel_mse": multi}),
         );
@@ -1163,7 +1294,73 @@ fn reference_cmd(args: &ReferenceArgs) -> Result<()> {
     });
     let json = serde_json::to_vec_pretty(&info).map_err(|e| Error::Invalid(e.to_string()))?;
     gibench_harness::error::write_atomic(&out(".json"), &json)?;
-    set.publish()?;
-    eprintln!("wrote {stem}.png, .json and -direct/-one-bounce/-multi-bounce/-radiance.exr to {} ({seconds:.1} s)", args.out.display());
-    Ok(())
+    Ok(format!("wrote {stem}.png, .json and -direct/-one-bounce/-multi-bounce/-radiance.exr to {} ({seconds:.1} s)", args.out.display()))
+}
+
+/// A gibench command run as a target of `gibench reproduce`, checked before anything runs.
+pub(crate) enum Job {
+    Run(Box<RunArgs>, Box<Plan>),
+    Sweep(Box<SweepArgs>, Box<SweepPlan>),
+    Reference(Box<ReferenceArgs>, Box<ReferencePlan>),
+}
+
+impl Job {
+    /// Parses and checks `gibench ARGV...` (run, sweep or reference).
+    pub(crate) fn plan(argv: &[String]) -> Result<Job> {
+        let cli =
+            Cli::try_parse_from(std::iter::once("gibench").chain(argv.iter().map(String::as_str)))
+                .map_err(|e| Error::Invalid(e.to_string().trim().to_string()))?;
+        match cli.command {
+            Some(Command::Run(a)) => {
+                let p = plan(&a, &[])?;
+                p.spec(&a).validate()?;
+                Ok(Job::Run(Box::new(a), Box::new(p)))
+            }
+            Some(Command::Sweep(a)) => {
+                let p = sweep_plan(&a)?;
+                Ok(Job::Sweep(Box::new(a), Box::new(p)))
+            }
+            Some(Command::Reference(a)) => {
+                let p = reference_plan(&a)?;
+                Ok(Job::Reference(Box::new(a), Box::new(p)))
+            }
+            _ => Err(Error::Invalid(format!(
+                "`gibench {}` is not a run, sweep or reference command",
+                argv.join(" ")
+            ))),
+        }
+    }
+
+    pub(crate) fn needs_gpu(&self) -> bool {
+        !matches!(self, Job::Reference(..))
+    }
+
+    /// (frames rendered, frames × pixels; reference: samples × pixels).
+    pub(crate) fn work(&self) -> (u64, u64) {
+        let of = |spec: &RunSpec| {
+            let frames = spec.total_frames();
+            let [w, h] = spec.config.resolution;
+            (frames, frames * w as u64 * h as u64)
+        };
+        match self {
+            Job::Run(a, p) => of(&p.spec(a)),
+            Job::Sweep(a, p) => of(&p.spec(a)),
+            Job::Reference(a, p) => {
+                let seeds = 1 + a.error_estimate as u64;
+                let [w, h] = p.resolution;
+                (0, seeds * p.settings.spp as u64 * w as u64 * h as u64)
+            }
+        }
+    }
+
+    /// Runs it into its `--out` (inside an open output set) on `gpu`; returns what it wrote.
+    pub(crate) fn execute(&self, gpu: Option<&GpuContext>, bars: &Bars) -> Result<String> {
+        let gpu =
+            || gpu.ok_or_else(|| Error::Invalid("no adapter was opened for a GPU run".into()));
+        match self {
+            Job::Run(a, p) => run_planned(a, p, gpu()?, bars),
+            Job::Sweep(a, p) => sweep_planned(a, p, gpu()?, bars),
+            Job::Reference(a, p) => reference_planned(a, p, bars),
+        }
+    }
 }

@@ -104,3 +104,147 @@ fn gibench_row(csv: &std::path::Path) -> std::collections::HashMap<String, f64> 
         .filter_map(|(h, v)| v.parse::<f64>().ok().map(|v| (h.to_string(), v)))
         .collect()
 }
+
+fn gibench(args: &[&str], out: &std::path::Path) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_gibench"))
+        .args(args)
+        .arg("--out")
+        .arg(out)
+        .output()
+        .unwrap()
+}
+
+/// `reproduce all --list` names every target with its folder and command and runs none.
+#[test]
+fn reproduce_all_lists_every_target_and_runs_nothing() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("all");
+    let o = gibench(&["reproduce", "all", "--quick", "--list"], &out);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{stderr}");
+    for target in [
+        "reference",
+        "keller-tiles",
+        "keller-vpls",
+        "keller-lag",
+        "clamp-cornell-laine",
+        "clamp-maze-laine",
+        "clamp-sibenik-laine",
+        "clamp-cornell-keller-full",
+        "laine-tables",
+        "laine-management",
+        "laine-dispersion",
+        "laine-tiles",
+        "laine-vpls",
+        "laine-budget",
+        "laine-quality",
+        "laine-sibenik-vpls",
+        "laine-sibenik-1024",
+    ] {
+        assert!(
+            stderr.lines().any(|l| l.trim_start().starts_with(target)),
+            "{target} missing:\n{stderr}"
+        );
+    }
+    assert!(stderr.contains("estimate:"), "{stderr}");
+    // Paper sizes unless --quick: the paper resolution appears in the sweeps' commands.
+    assert!(stderr.contains(
+        "sweep --technique keller-full --sweep tiles=1x1,2x2,4x4,8x8 --param vpls=256 --frames 20"
+    ));
+    let paper = gibench(&["reproduce", "all", "--list"], &out);
+    assert!(String::from_utf8_lossy(&paper.stderr).contains("--resolution 1024x768"));
+    assert!(!out.exists(), "--list wrote {out:?}");
+}
+
+/// `reproduce all` runs the chosen targets under one output set: it lists every table and
+/// figure it wrote (and records them in reproduce-all.json), replaces each target's folder
+/// (a stale file there is removed, a file beside the targets' folders is kept), and a second
+/// run estimates its time from the first.
+#[test]
+fn reproduce_all_writes_lists_replaces_and_estimates() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("all");
+    let args = [
+        "reproduce",
+        "all",
+        "--quick",
+        "--quiet",
+        "--only",
+        "laine-dispersion,keller-tiles",
+        "--frames",
+        "2",
+    ];
+    let first = gibench(&args, &out);
+    let stdout = String::from_utf8_lossy(&first.stdout);
+    let stderr = String::from_utf8_lossy(&first.stderr);
+    assert!(first.status.success(), "{stderr}");
+    for listed in [
+        "table  keller/tiles/cornell-keller-full-sweep-tiles.md",
+        "figure keller/tiles/cornell-keller-full-sweep-tiles.svg",
+        "table  laine/laine-dispersion.md",
+        "figure laine/laine-dispersion.svg",
+    ] {
+        assert!(stdout.contains(listed), "'{listed}' not listed:\n{stdout}");
+        let file = listed.split_whitespace().nth(1).unwrap();
+        assert!(out.join(file).is_file(), "{file} listed but not written");
+    }
+    assert!(stderr.contains("estimate: none"), "{stderr}");
+    let manifest: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("reproduce-all.json")).unwrap()).unwrap();
+    let targets = manifest["targets"].as_array().unwrap();
+    assert_eq!(targets.len(), 2);
+    assert!(targets.iter().all(|t| t["seconds"].as_f64().unwrap() > 0.0));
+    std::fs::write(out.join("keller/tiles/stale.json"), "{}").unwrap();
+    std::fs::write(out.join("laine/notes.txt"), "mine").unwrap();
+    let second = gibench(&args, &out);
+    let stderr = String::from_utf8_lossy(&second.stderr);
+    assert!(second.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("estimate: ") && !stderr.contains("estimate: none"),
+        "{stderr}"
+    );
+    assert!(!out.join("keller/tiles/stale.json").exists());
+    assert!(out.join("laine/notes.txt").exists());
+}
+
+/// Bad `reproduce` input is refused before any work, naming the option.
+#[test]
+fn reproduce_all_refuses_bad_input_before_any_work() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("all");
+    for (args, expect) in [
+        (
+            vec!["reproduce", "all", "--only", "laine-table9"],
+            "parameter 'only'",
+        ),
+        (
+            vec!["reproduce", "all", "--scenes", "maze"],
+            "parameter 'scenes'",
+        ),
+        (
+            vec!["reproduce", "keller-tiles", "--scenes", "maze"],
+            "parameter 'scenes'",
+        ),
+        (
+            vec!["reproduce", "laine-tables", "--only", "laine-tables"],
+            "parameter 'only'",
+        ),
+        (
+            vec!["reproduce", "laine-table9"],
+            "unknown target 'laine-table9'",
+        ),
+        // The dispersion target needs two frames: found before the other targets run.
+        (
+            vec!["reproduce", "all", "--quick", "--frames", "1"],
+            "at least 2 frames",
+        ),
+    ] {
+        let o = gibench(&args, &out);
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert!(
+            !o.status.success() && stderr.contains(expect),
+            "{args:?}: {stderr}"
+        );
+        assert!(!out.exists(), "{args:?} wrote {out:?}");
+    }
+}

@@ -14,6 +14,11 @@
 //!   leaves only the staging folder, which the next command removes. Dropping an unpublished
 //!   set (an error) removes the staging folder and the lock at once.
 //!
+//! A set can also **replace** subfolders ([`OutputSet::replace`]): at publication, files under
+//! such a subfolder that this set did not write are removed, so a regenerated result holds only
+//! what its command wrote (the journal lists the replaced subfolders too, so a killed
+//! publication is finished the same way).
+//!
 //! Files written with [`crate::error::write_atomic_direct`] (the reference cache, whose entries
 //! are shared across runs and read back within one) bypass the set.
 //!
@@ -32,7 +37,11 @@ const JOURNAL: &str = ".gibench-publish";
 struct Active {
     dir: PathBuf,
     staged: Vec<PathBuf>,
+    replaced: Vec<PathBuf>,
 }
+
+/// The journal's prefix for a replaced subfolder (no file gibench writes starts with it).
+const REPLACE: &str = "replace:";
 
 static ACTIVE: Mutex<Option<Active>> = Mutex::new(None);
 
@@ -198,17 +207,52 @@ impl OutputSet {
         *active = Some(Active {
             dir: dir.to_path_buf(),
             staged: Vec::new(),
+            replaced: Vec::new(),
         });
         Ok(set)
     }
 
+    /// Declares `sub` (relative to the set's folder, plain names only) replaced: at publication
+    /// the files under it that this set did not write are removed.
+    pub fn replace(&self, sub: &Path) -> Result<()> {
+        if sub.as_os_str().is_empty()
+            || !sub.components().all(|c| matches!(c, Component::Normal(_)))
+        {
+            return Err(Error::param(
+                &self.option,
+                format!("{} is not a plain subfolder name", sub.display()),
+            ));
+        }
+        let mut active = ACTIVE
+            .lock()
+            .map_err(|_| Error::param(&self.option, "output state poisoned"))?;
+        if let Some(a) = active.as_mut() {
+            if !a.replaced.iter().any(|r| r == sub) {
+                a.replaced.push(sub.to_path_buf());
+            }
+        }
+        Ok(())
+    }
+
+    /// The files staged so far, relative to the set's folder, in the order first written.
+    pub fn staged(&self) -> Vec<PathBuf> {
+        ACTIVE
+            .lock()
+            .ok()
+            .and_then(|a| a.as_ref().map(|a| a.staged.clone()))
+            .unwrap_or_default()
+    }
+
     /// Moves every staged file into place (see the module docs) and closes the set.
     pub fn publish(mut self) -> Result<()> {
-        let staged = {
+        let (staged, replaced) = {
             let mut active = ACTIVE
                 .lock()
                 .map_err(|_| Error::param(&self.option, "output state poisoned"))?;
-            active.take().map(|a| a.staged).unwrap_or_default()
+            active
+                .take()
+                .map(|a| (a.staged, a.replaced))
+                .unwrap_or_default()
         };
         // Every destination must be free to take a file before any is moved, so a failure
         // cannot leave some files new and others old.
@@ -225,9 +269,10 @@ impl OutputSet {
             }
         }
         let journal = self.dir.join(JOURNAL);
-        let list: Vec<String> = staged
+        let list: Vec<String> = replaced
             .iter()
-            .map(|p| p.to_string_lossy().into_owned())
+            .map(|p| format!("{REPLACE}{}", p.to_string_lossy()))
+            .chain(staged.iter().map(|p| p.to_string_lossy().into_owned()))
             .collect();
         crate::error::write_atomic_direct(&journal, list.join("\n").as_bytes())?;
         move_staged(&self.dir)?;
@@ -261,12 +306,25 @@ impl Drop for OutputSet {
     }
 }
 
-/// Moves the files the journal in `dir` lists from the staging folder into place (skipping
-/// any already moved).
+/// Removes, under the subfolders the journal in `dir` marks replaced, every file the journal
+/// does not list, then moves the listed files from the staging folder into place (skipping any
+/// already moved). Running it again after an interruption finishes the same work.
 fn move_staged(dir: &Path) -> Result<()> {
     let journal = dir.join(JOURNAL);
     let text = std::fs::read_to_string(&journal).map_err(|e| Error::io(&journal, e))?;
-    for rel in text.lines().filter(|l| !l.is_empty()) {
+    let lines: Vec<&str> = text.lines().filter(|l| !l.is_empty()).collect();
+    let listed: std::collections::HashSet<&Path> = lines
+        .iter()
+        .filter(|l| !l.starts_with(REPLACE))
+        .map(Path::new)
+        .collect();
+    for sub in lines.iter().filter_map(|l| l.strip_prefix(REPLACE)) {
+        let sub = Path::new(sub);
+        if sub.components().all(|c| matches!(c, Component::Normal(_))) {
+            remove_unlisted(dir, sub, &listed)?;
+        }
+    }
+    for rel in lines.iter().filter(|l| !l.starts_with(REPLACE)) {
         let rel = Path::new(rel);
         if !rel.components().all(|c| matches!(c, Component::Normal(_))) {
             // Not written by gibench: ignored.
@@ -281,6 +339,26 @@ fn move_staged(dir: &Path) -> Result<()> {
             std::fs::create_dir_all(parent).map_err(|e| Error::io(parent, e))?;
         }
         std::fs::rename(&from, &to).map_err(|e| Error::io(&to, e))?;
+    }
+    Ok(())
+}
+
+/// Removes the files under `dir/sub` (recursively; links themselves, never followed) whose
+/// path relative to `dir` is not in `keep`, then the folders left empty.
+fn remove_unlisted(dir: &Path, sub: &Path, keep: &std::collections::HashSet<&Path>) -> Result<()> {
+    let folder = dir.join(sub);
+    let Ok(entries) = std::fs::read_dir(&folder) else {
+        return Ok(());
+    };
+    for e in entries.flatten() {
+        let rel = sub.join(e.file_name());
+        let kind = e.file_type().map_err(|err| Error::io(e.path(), err))?;
+        if kind.is_dir() {
+            remove_unlisted(dir, &rel, keep)?;
+            let _ = std::fs::remove_dir(e.path());
+        } else if !keep.contains(rel.as_path()) {
+            std::fs::remove_file(e.path()).map_err(|err| Error::io(e.path(), err))?;
+        }
     }
     Ok(())
 }

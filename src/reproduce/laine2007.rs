@@ -27,23 +27,96 @@ use gibench_harness::technique::TechniqueInfo;
 use gibench_harness::{Error, Result};
 
 use super::{device_note, load_scene, paper_cells, ReproduceArgs, Reproduction};
+use crate::Bars;
+use gibench_harness::gpu::GpuContext;
 
-/// The targets of this paper.
-pub const TARGETS: &[&str] = &[
-    "laine-table1",
-    "laine-table2",
-    "laine-tables",
-    "laine-management",
-    "laine-dispersion",
-];
+/// What each target regenerates (for `gibench reproduce all --list` and its manifest).
+pub fn describe(target: &str) -> &'static str {
+    match target {
+        "laine-table1" => "Laine et al. 2007 Table 1: per-stage times of laine and keller-full",
+        "laine-table2" => "Laine et al. 2007 Table 2: the common steps per resolution",
+        "laine-tables" => "Laine et al. 2007 Tables 1 and 2 from one set of runs",
+        "laine-management" => "Laine et al. 2007 §6: VPL management cost on the CPU",
+        "laine-dispersion" => "Laine et al. 2007 §4.3: dispersion of the sampling points",
+        _ => "",
+    }
+}
 
-/// Regenerates `target` (one of [`TARGETS`]).
-pub fn reproduce(target: &str, args: &ReproduceArgs) -> Result<Vec<Reproduction>> {
+/// Subfolders of its output folder that `target` owns entirely (replaced by `reproduce all`).
+pub fn owned_folders(target: &str) -> &'static [&'static str] {
+    match target {
+        "laine-table1" | "laine-table2" | "laine-tables" => &["runs"],
+        _ => &[],
+    }
+}
+
+/// The scenes `target` runs on.
+fn scenes_of(target: &str, args: &ReproduceArgs) -> Vec<String> {
+    match target {
+        "laine-management" | "laine-dispersion" => {
+            let default = if target == "laine-management" {
+                "sibenik"
+            } else {
+                "cornell"
+            };
+            vec![args
+                .scenes
+                .first()
+                .cloned()
+                .unwrap_or_else(|| default.to_string())]
+        }
+        _ if args.scenes.is_empty() => ["cornell", "maze", "sibenik"].map(String::from).to_vec(),
+        _ => args.scenes.clone(),
+    }
+}
+
+/// Checks what can be checked before any work: the scenes load, the frame counts suffice.
+pub fn check(target: &str, args: &ReproduceArgs) -> Result<()> {
+    if target == "laine-dispersion" {
+        dispersion_frames(args)?;
+    }
+    for name in scenes_of(target, args) {
+        load_scene(&name, args)?;
+    }
+    Ok(())
+}
+
+/// The work `target` does: (frames rendered or stepped, work units: frames × pixels for
+/// rendered frames, frames × VPLs for the CPU-only targets). Estimates scale with the units.
+pub fn work(target: &str, args: &ReproduceArgs) -> (u64, u64) {
+    match target {
+        "laine-management" => {
+            let frames = management_frames(args) as u64;
+            (4 * frames, frames * 2 * (256 + 1024))
+        }
+        "laine-dispersion" => {
+            let frames = dispersion_frames(args).unwrap_or(2) as u64;
+            (4 * frames, 4 * frames * 256)
+        }
+        _ => {
+            let s = sizes(args);
+            let scenes = scenes_of(target, args).len() as u64;
+            // Two techniques, timed per stage and per frame.
+            let per_res = 2 * 2 * (s.frames + s.warmup) as u64 * scenes;
+            s.resolutions.iter().fold((0, 0), |(f, u), r| {
+                (f + per_res, u + per_res * r[0] as u64 * r[1] as u64)
+            })
+        }
+    }
+}
+
+/// Regenerates `target` (a `laine-*` target of [`super::all::TARGETS`]) on `gpu` (opened here if `None` and needed).
+pub fn reproduce(
+    target: &str,
+    args: &ReproduceArgs,
+    gpu: Option<&GpuContext>,
+    bars: &Bars,
+) -> Result<Vec<Reproduction>> {
     Ok(match target {
-        "laine-table1" => vec![(table1(&run_pairs(args)?)?, "laine-table1")],
-        "laine-table2" => vec![(table2(&run_pairs(args)?)?, "laine-table2")],
+        "laine-table1" => vec![(table1(&run_pairs(args, gpu, bars)?)?, "laine-table1")],
+        "laine-table2" => vec![(table2(&run_pairs(args, gpu, bars)?)?, "laine-table2")],
         "laine-tables" => {
-            let pairs = run_pairs(args)?;
+            let pairs = run_pairs(args, gpu, bars)?;
             vec![
                 (table1(&pairs)?, "laine-table1"),
                 (table2(&pairs)?, "laine-table2"),
@@ -74,8 +147,9 @@ struct Sizes {
     warmup: u32,
 }
 
-fn sizes(quick: bool) -> Sizes {
-    if quick {
+/// The target's sizes: the paper's, or `--quick`'s; `--frames` overrides the frame count.
+fn sizes(args: &ReproduceArgs) -> Sizes {
+    let mut s = if args.quick {
         Sizes {
             resolutions: vec![[256, 192], [400, 300]],
             frames: 12,
@@ -87,7 +161,11 @@ fn sizes(quick: bool) -> Sizes {
             frames: 1000,
             warmup: 20,
         }
+    };
+    if let Some(f) = args.frames {
+        s.frames = f;
     }
+    s
 }
 
 /// VPL map size per scene: the paper's 256², or quick ones.
@@ -106,16 +184,9 @@ const VPLS: u32 = 256;
 type Pair = (String, [u32; 2], RunResult, RunResult);
 
 /// Runs `laine` and `keller-full` on each scene and resolution.
-fn run_pairs(args: &ReproduceArgs) -> Result<Vec<Pair>> {
-    let mut s = sizes(args.quick);
-    if let Some(f) = args.frames {
-        s.frames = f;
-    }
-    let scenes = if args.scenes.is_empty() {
-        ["cornell", "maze", "sibenik"].map(String::from).to_vec()
-    } else {
-        args.scenes.clone()
-    };
+fn run_pairs(args: &ReproduceArgs, gpu: Option<&GpuContext>, bars: &Bars) -> Result<Vec<Pair>> {
+    let s = sizes(args);
+    let scenes = scenes_of("laine-tables", args);
     let shadow_size = if args.quick { 256 } else { 1024 };
     let laine = TechniqueInfo::find(crate::registry::all(), "laine")?;
     let keller = TechniqueInfo::find(crate::registry::all(), "keller-full")?;
@@ -158,7 +229,7 @@ fn run_pairs(args: &ReproduceArgs) -> Result<Vec<Pair>> {
                     },
                     quality: None,
                     cache: Default::default(),
-                    out: args.out.join("runs"),
+                    out: out(args).join("runs"),
                     images: false,
                 },
             ));
@@ -167,10 +238,17 @@ fn run_pairs(args: &ReproduceArgs) -> Result<Vec<Pair>> {
     for (_, _, spec) in &specs {
         spec.validate()?;
     }
-    let gpu = super::open_gpu(args)?;
+    let opened;
+    let gpu = match gpu {
+        Some(g) => g,
+        None => {
+            opened = super::open_gpu(args)?;
+            &opened
+        }
+    };
     let mut out = Vec::new();
     for (name, res, spec) in &specs {
-        let mut results = crate::execute_with_bar(args.quiet, &gpu, spec)?;
+        let mut results = crate::execute_with_bar(bars, gpu, spec)?;
         let keller = results.pop().expect("two runs");
         let laine = results.pop().expect("two runs");
         out.push((name.clone(), *res, laine, keller));
@@ -381,7 +459,7 @@ fn clock_with_light(
 fn management(args: &ReproduceArgs) -> Result<Table> {
     use gibench_harness::scene::descriptor::LightKind;
     use gibench_harness::stats::Stats;
-    let frames = args.frames.unwrap_or(if args.quick { 100 } else { 1000 });
+    let frames = management_frames(args);
     let (name, scene, bvh) = cpu_scene(args, "sibenik")?;
     let paper = paper()?;
     let mut rows = Vec::new();
@@ -430,7 +508,7 @@ fn management(args: &ReproduceArgs) -> Result<Table> {
         "per_frame_ms": records,
     });
     let bytes = serde_json::to_vec_pretty(&json).map_err(|e| Error::Invalid(e.to_string()))?;
-    gibench_harness::error::write_atomic(&args.out.join("laine-management.json"), &bytes)?;
+    gibench_harness::error::write_atomic(&out(args).join("laine-management.json"), &bytes)?;
     Ok(Table {
         title: format!("VPL management per frame on the CPU ({name}, {frames} frames, recalcMin 4, recalcMax 8)"),
         columns: ["source", "light", "VPLs", "median ms", "p99 ms", "max ms"].map(String::from).into(),
@@ -450,14 +528,7 @@ fn management(args: &ReproduceArgs) -> Result<Table> {
 fn dispersion(args: &ReproduceArgs) -> Result<Table> {
     use gibench_harness::scene::descriptor::LightKind;
     use gibench_harness::stats::Stats;
-    let frames = args.frames.unwrap_or(if args.quick { 120 } else { 600 });
-    if frames < 2 {
-        // The median and maximum are over the frames after the fill frame.
-        return Err(Error::param(
-            "frames",
-            format!("the dispersion table needs at least 2 frames: frame 0 and one after it (got {frames})"),
-        ));
-    }
+    let frames = dispersion_frames(args)?;
     let (name, scene, bvh) = cpu_scene(args, "cornell")?;
     let mut lines = Vec::new();
     let mut rows = Vec::new();
@@ -496,10 +567,10 @@ fn dispersion(args: &ReproduceArgs) -> Result<Table> {
         "git_commit": gibench_harness::runner::git_commit(), "dispersion_per_frame_after_the_first": records,
     });
     let bytes = serde_json::to_vec_pretty(&json).map_err(|e| Error::Invalid(e.to_string()))?;
-    gibench_harness::error::write_atomic(&args.out.join("laine-dispersion.json"), &bytes)?;
+    gibench_harness::error::write_atomic(&out(args).join("laine-dispersion.json"), &bytes)?;
     report::lines_svg(
         &lines,
-        &args.out.join("laine-dispersion.svg"),
+        &out(args).join("laine-dispersion.svg"),
         &format!("Dispersion of laine's sampling points on {name} (256 VPLs)"),
         "frame",
         "dispersion (largest empty circle radius)",
@@ -515,4 +586,27 @@ fn dispersion(args: &ReproduceArgs) -> Result<Table> {
                 .into(),
         ],
     })
+}
+
+/// Frames of the management table.
+fn management_frames(args: &ReproduceArgs) -> u32 {
+    args.frames.unwrap_or(if args.quick { 100 } else { 1000 })
+}
+
+/// Frames of the dispersion table (at least two: the median and maximum are over the frames
+/// after the fill frame).
+fn dispersion_frames(args: &ReproduceArgs) -> Result<u32> {
+    let frames = args.frames.unwrap_or(if args.quick { 120 } else { 600 });
+    if frames < 2 {
+        return Err(Error::param(
+            "frames",
+            format!("the dispersion table needs at least 2 frames: frame 0 and one after it (got {frames})"),
+        ));
+    }
+    Ok(frames)
+}
+
+/// Where this paper's files go.
+fn out(args: &ReproduceArgs) -> std::path::PathBuf {
+    super::out_dir(args, "laine")
 }

@@ -3,7 +3,11 @@
 //! `results/papers/<paper>.json` and printed beside ours, each labelled with its source.
 //!
 //! * [`laine2007`]: Laine et al. 2007, Tables 1 and 2, VPL management, dispersion.
+//! * [`all`]: every paper table, figure and sweep (`gibench reproduce all`), and the sweeps
+//!   that are gibench commands (Keller's and Laine's tile, VPL and clamp sweeps, the lag and
+//!   quality runs, the reference) as targets of their own.
 
+pub mod all;
 pub mod laine2007;
 
 use std::path::PathBuf;
@@ -11,28 +15,36 @@ use std::path::PathBuf;
 use clap::Args;
 use gibench_harness::assets::AssetPaths;
 use gibench_harness::gpu::{GpuContext, GpuOptions};
-use gibench_harness::report::{self, Cell, Table};
+use gibench_harness::report::{Cell, Table};
 use gibench_harness::results::RunResult;
 use gibench_harness::scene::{Scene, SceneDescriptor};
 use gibench_harness::{Error, Result};
 
-#[derive(Args)]
+#[derive(Args, Clone)]
 pub struct ReproduceArgs {
-    /// What to regenerate: laine-table1, laine-table2, laine-tables (both from one set of runs),
-    /// laine-management or laine-dispersion.
+    /// What to regenerate: `all` (every target below), or one target: laine-table1,
+    /// laine-table2, laine-tables (both from one set of runs), laine-management,
+    /// laine-dispersion, or a sweep or run target (`gibench reproduce all --list` lists them).
     pub target: String,
     /// Small sizes for machines without a GPU (each target says which).
     #[arg(long)]
     pub quick: bool,
-    /// Scenes (default: the paper's).
+    /// Scenes (default: the paper's; Laine targets only).
     #[arg(long, value_delimiter = ',')]
     pub scenes: Vec<String>,
-    /// Output directory.
-    #[arg(long, default_value = "results/laine")]
-    pub out: PathBuf,
+    /// Output directory (default: results/<the target's folder>; for `all`, results, with
+    /// each target in its folder under it).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
     /// Override the measured frame count (e.g. for a smoke test).
     #[arg(long)]
     pub frames: Option<u32>,
+    /// With `all`: only these targets, comma-separated.
+    #[arg(long, value_delimiter = ',')]
+    pub only: Vec<String>,
+    /// Print the targets, their commands, folders and the time estimate; run nothing.
+    #[arg(long)]
+    pub list: bool,
     /// Extra directory searched first for scene assets (glTF files).
     #[arg(long)]
     pub assets: Option<PathBuf>,
@@ -99,9 +111,15 @@ pub fn paper_cells(values: &serde_json::Value) -> Vec<Cell> {
         .unwrap_or_default()
 }
 
-/// Runs `args.target` and writes its tables (Markdown, CSV, LaTeX) into `args.out`.
+/// The folder a target writes into: `--out`, else `results/<dir>`.
+pub fn out_dir(args: &ReproduceArgs, dir: &str) -> PathBuf {
+    args.out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("results").join(dir))
+}
+
+/// Runs `args.target` (one target, or `all`) and writes its files.
 pub fn reproduce(args: &ReproduceArgs) -> Result<()> {
-    let target = args.target.as_str();
     if args.frames == Some(0) {
         // Statistics of no samples are not a table.
         return Err(Error::param(
@@ -109,29 +127,5 @@ pub fn reproduce(args: &ReproduceArgs) -> Result<()> {
             "at least one frame is needed (got 0)",
         ));
     }
-    if !laine2007::TARGETS.contains(&target) {
-        return Err(Error::param(
-            "target",
-            format!(
-                "unknown target '{target}'; expected one of: {}",
-                laine2007::TARGETS.join(", ")
-            ),
-        ));
-    }
-    crate::writable_dir("out", &args.out)?;
-    let set = gibench_harness::output::OutputSet::begin("out", &args.out)?;
-    let tables = laine2007::reproduce(target, args)?;
-    for (table, stem) in tables {
-        println!("{}", table.to_terminal());
-        let written = report::write_tables(&table, &args.out, stem)?;
-        eprintln!(
-            "wrote {}",
-            written
-                .iter()
-                .map(|p| p.display().to_string())
-                .collect::<Vec<_>>()
-                .join(", ")
-        );
-    }
-    set.publish()
+    all::reproduce(args)
 }
