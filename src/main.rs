@@ -254,6 +254,10 @@ pub(crate) struct RunArgs {
     /// multi-bounce (default: each technique's declared component, see `gibench list`).
     #[arg(long)]
     quality_reference: Option<String>,
+    /// Also write an HTML page of the run (`{scene}-report.html`, or `{stem}.html` for a
+    /// sweep): tables, images beside the reference, error maps, time versus error.
+    #[arg(long)]
+    html: bool,
     #[command(flatten)]
     reference: ReferenceOpts,
     #[command(flatten)]
@@ -274,6 +278,10 @@ struct ReportArgs {
     /// Also print full statistics (median, mean, p5, p95, min, max) per stage.
     #[arg(long)]
     detailed: bool,
+    /// Also write an HTML page (`{stem}.html`): the table, the runs' images beside the
+    /// reference (from their folders), error maps, time versus error.
+    #[arg(long)]
+    html: bool,
 }
 
 fn main() -> ExitCode {
@@ -300,9 +308,10 @@ fn main() -> ExitCode {
 }
 
 impl RunArgs {
-    /// The defaults of `gibench run`, for `gibench` with no arguments.
+    /// `gibench` with no arguments: `gibench run`'s defaults, compared with the CPU reference
+    /// (cached after the first run) and written up as an HTML page.
     fn parse_default() -> RunArgs {
-        RunArgs::parse_args(["gibench"])
+        RunArgs::parse_args(["gibench", "--quality", "--html"])
     }
 
     /// `gibench run` options from an argument list (the first item is the program name).
@@ -674,12 +683,67 @@ pub(crate) fn run_planned(
             written.push(file_name(&svg));
         }
     }
-    Ok(format!(
+    if plan.quality.is_some() {
+        let svg = args.out.join(format!("{name}-time-vs-error.svg"));
+        report::time_vs_error_svg(&results, &svg, &format!("Time versus error on {name}"))?;
+        written.push(file_name(&svg));
+    }
+    let mut done = format!(
         "wrote {} results, images and {} to {}",
         results.len(),
         written.join(", "),
         args.out.display()
-    ))
+    );
+    if args.html {
+        let page = args.out.join(format!("{name}-report.html"));
+        write_page(
+            &page,
+            format!("gibench run on {name}"),
+            vec![table],
+            written
+                .iter()
+                .filter(|w| w.ends_with(".svg"))
+                .map(|w| args.out.join(w))
+                .collect(),
+            with_folder(&args.out, results),
+        )?;
+        done.push_str(&page_line(&page));
+    }
+    Ok(done)
+}
+
+/// The runs paired with the folder they were written to.
+pub(crate) fn with_folder(dir: &Path, results: Vec<RunResult>) -> Vec<(PathBuf, RunResult)> {
+    results
+        .into_iter()
+        .map(|r| (dir.to_path_buf(), r))
+        .collect()
+}
+
+/// Writes an HTML page ([`gibench_harness::html`]) with this process's command line.
+pub(crate) fn write_page(
+    path: &Path,
+    title: String,
+    tables: Vec<report::Table>,
+    figures: Vec<PathBuf>,
+    runs: Vec<(PathBuf, RunResult)>,
+) -> Result<()> {
+    gibench_harness::html::Page {
+        title,
+        command: std::env::args().collect::<Vec<_>>().join(" "),
+        tables,
+        figures,
+        runs,
+    }
+    .write(path)
+}
+
+/// "\nreport: PATH (open it in a browser)", the page's path made absolute.
+pub(crate) fn page_line(page: &Path) -> String {
+    let shown = std::env::current_dir()
+        .map(|d| d.join(page))
+        .unwrap_or_else(|_| page.to_path_buf());
+    format!("\nreport: {} (open it in a browser)", shown.display())
 }
 
 /// `gibench sweep`: one technique, one parameter over a list of values.
@@ -813,11 +877,41 @@ pub(crate) fn sweep_planned(
         ),
         &name,
     )?;
-    Ok(format!(
-        "wrote {} points and {stem}.md/.csv/.tex/.svg to {}",
+    let mut figures = vec![args.run.out.join(format!("{stem}.svg"))];
+    if first.quality.is_some() {
+        let svg = args.run.out.join(format!("{stem}-time-vs-error.svg"));
+        report::time_vs_error_svg(
+            &results,
+            &svg,
+            &format!(
+                "{} on {}: time versus error over {name}",
+                info.name, first.desc.name
+            ),
+        )?;
+        figures.push(svg);
+    }
+    let mut done = format!(
+        "wrote {} points and {stem}.md/.csv/.tex/.svg{} to {}",
         points.len(),
+        if figures.len() > 1 {
+            ", -time-vs-error.svg"
+        } else {
+            ""
+        },
         args.run.out.display()
-    ))
+    );
+    if args.run.html {
+        let page = args.run.out.join(format!("{stem}.html"));
+        write_page(
+            &page,
+            table.title.clone(),
+            vec![table],
+            figures,
+            with_folder(&args.run.out, results),
+        )?;
+        done.push_str(&page_line(&page));
+    }
+    Ok(done)
 }
 
 fn file_name(p: &Path) -> String {
@@ -862,6 +956,14 @@ fn list() -> Result<()> {
 }
 
 fn read_results(inputs: &[PathBuf]) -> Result<Vec<RunResult>> {
+    Ok(read_results_with_folders(inputs)?
+        .into_iter()
+        .map(|(_, r)| r)
+        .collect())
+}
+
+/// The results files given (or found in the given folders), each with its folder.
+fn read_results_with_folders(inputs: &[PathBuf]) -> Result<Vec<(PathBuf, RunResult)>> {
     let mut files = Vec::new();
     for input in inputs {
         if input.is_dir() {
@@ -876,9 +978,16 @@ fn read_results(inputs: &[PathBuf]) -> Result<Vec<RunResult>> {
             files.push(input.clone());
         }
     }
-    let results: Vec<RunResult> = files
+    let results: Vec<(PathBuf, RunResult)> = files
         .iter()
-        .map(|f| RunResult::read(f))
+        .map(|f| {
+            let folder = f
+                .parent()
+                .filter(|p| !p.as_os_str().is_empty())
+                .unwrap_or(Path::new("."))
+                .to_path_buf();
+            RunResult::read(f).map(|r| (folder, r))
+        })
         .collect::<Result<_>>()?;
     if results.is_empty() {
         return Err(Error::Invalid(
@@ -1147,7 +1256,8 @@ fn check_stem(stem: &str) -> Result<()> {
 
 fn report_cmd(args: &ReportArgs) -> Result<()> {
     check_stem(&args.stem)?;
-    let results = read_results(&args.inputs)?;
+    let runs = read_results_with_folders(&args.inputs)?;
+    let results: Vec<RunResult> = runs.iter().map(|(_, r)| r.clone()).collect();
     let set = OutputSet::begin("out", &args.out)?;
     let table = report::stage_table(&results);
     println!("{}", table.to_terminal());
@@ -1157,12 +1267,22 @@ fn report_cmd(args: &ReportArgs) -> Result<()> {
         }
     }
     report::write_tables(&table, &args.out, &args.stem)?;
-    report::stacked_bar_svg(
-        &results,
-        &args.out.join(format!("{}.svg", args.stem)),
-        "Per-stage times",
-    )?;
-    set.publish()
+    let mut figures = vec![args.out.join(format!("{}.svg", args.stem))];
+    report::stacked_bar_svg(&results, &figures[0], "Per-stage times")?;
+    if !report::time_error_points(&results).is_empty() {
+        let svg = args.out.join(format!("{}-time-vs-error.svg", args.stem));
+        report::time_vs_error_svg(&results, &svg, "Time versus error")?;
+        figures.push(svg);
+    }
+    let page = args.out.join(format!("{}.html", args.stem));
+    if args.html {
+        write_page(&page, table.title.clone(), vec![table], figures, runs)?;
+    }
+    set.publish()?;
+    if args.html {
+        eprintln!("{}", page_line(&page).trim_start());
+    }
+    Ok(())
 }
 
 fn reference_cmd(args: &ReferenceArgs) -> Result<()> {

@@ -33,6 +33,7 @@ pub mod calibrate;
 pub mod compare;
 pub mod error;
 pub mod gpu;
+pub mod html;
 pub mod image_io;
 pub mod ir;
 pub mod light;

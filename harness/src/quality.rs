@@ -376,11 +376,40 @@ pub struct CapturedFrame {
     pub radiance: Vec<Vec3>,
 }
 
-/// Images kept for a person to look at: the last compared frame's reference and FLIP map.
+/// Images kept for a person to look at, all of the last compared frame (sRGB RGBA8): the
+/// technique's composed image and the reference's at the scene's exposure, the FLIP map, and
+/// the indirect light alone (ρ/π · E_indirect) of both at one exposure derived from the
+/// reference ([`indirect_exposure`]), so every technique compared on the same frame shares it.
 pub struct QualityImages {
     pub size: [u32; 2],
+    pub compared_display: Vec<u8>,
     pub reference_display: Vec<u8>,
     pub flip_map: Vec<u8>,
+    pub indirect_display: Vec<u8>,
+    pub reference_indirect_display: Vec<u8>,
+}
+
+/// The exposure that puts the 99th percentile of the reference's indirect radiance (the
+/// brightest channel, over the pixels that hit geometry) at 0.9 before sRGB encoding; 1 where
+/// there is no indirect light.
+pub fn indirect_exposure(reference_indirect: &[Vec3], hit: &[bool]) -> f32 {
+    let mut v: Vec<f32> = reference_indirect
+        .iter()
+        .zip(hit)
+        .filter(|(_, h)| **h)
+        .map(|(c, _)| c.max_element())
+        .filter(|x| x.is_finite())
+        .collect();
+    if v.is_empty() {
+        return 1.0;
+    }
+    let i = ((v.len() - 1) as f64 * 0.99).round() as usize;
+    let (_, p99, _) = v.select_nth_unstable_by(i, f32::total_cmp);
+    if *p99 > 0.0 {
+        0.9 / *p99
+    } else {
+        1.0
+    }
 }
 
 /// Compares captured frames with their references.
@@ -427,10 +456,30 @@ pub fn compare(
                     .flat_map(|p| [p[0], p[1], p[2], 255])
                     .collect::<Vec<u8>>()
             };
+            // Indirect light alone: ρ/π · E over the reference's hits.
+            let indirect = |e: &[Vec3]| -> Vec<Vec3> {
+                r.hit
+                    .iter()
+                    .zip(&r.albedo)
+                    .zip(e)
+                    .map(|((h, a), e)| {
+                        if *h {
+                            *a * std::f32::consts::FRAC_1_PI * *e
+                        } else {
+                            Vec3::ZERO
+                        }
+                    })
+                    .collect()
+            };
+            let (test_ind, ref_ind) = (indirect(&c.indirect), indirect(component));
+            let k = indirect_exposure(&ref_ind, &r.hit);
             images = Some(QualityImages {
                 size,
+                compared_display: rgba(&test8),
                 reference_display: rgba(&ref8),
                 flip_map: metrics::flip_error_png(&flip, size),
+                indirect_display: rgba(&metrics::tonemap_srgb8(&test_ind, k)),
+                reference_indirect_display: rgba(&metrics::tonemap_srgb8(&ref_ind, k)),
             });
         }
     }

@@ -1093,12 +1093,151 @@ pub fn lines_svg(
     })
 }
 
+/// "technique" plus the parameters whose values differ between runs of that technique in
+/// `all` (e.g. "laine clamp=3"), to tell sweep points apart.
+pub fn distinct_label(all: &[RunResult], r: &RunResult) -> String {
+    let same: Vec<&RunResult> = all
+        .iter()
+        .filter(|o| o.technique == r.technique && o.scene == r.scene)
+        .collect();
+    let mut label = r.technique.clone();
+    for (k, v) in &r.parameters {
+        if same.iter().any(|o| o.parameters.get(k) != Some(v)) {
+            label.push_str(&format!(
+                " {k}={}",
+                v.as_str()
+                    .map(String::from)
+                    .unwrap_or_else(|| v.to_string())
+            ));
+        }
+    }
+    if all.iter().any(|o| o.scene != r.scene) {
+        label.push_str(&format!(" @ {}", r.scene));
+    }
+    label
+}
+
+/// A run's time per frame for the time-versus-error plot: the median of whole frames where
+/// they were timed, else the sum of the per-stage medians.
+pub fn frame_time_ms(r: &RunResult) -> Option<f64> {
+    r.frame
+        .as_ref()
+        .map(|f| f.frame_ms.median)
+        .or_else(|| r.stages.iter().map(stage_ms).sum())
+        .filter(|t| t.is_finite())
+}
+
+/// The points of the time-versus-error plot: (label, frame ms, mean relative MSE against the
+/// reference), runs without quality left out.
+pub fn time_error_points(results: &[RunResult]) -> Vec<(String, f64, f64)> {
+    results
+        .iter()
+        .filter_map(|r| {
+            let q = r.quality.as_ref()?;
+            let t = frame_time_ms(r)?;
+            q.rel_mse
+                .mean
+                .is_finite()
+                .then(|| (distinct_label(results, r), t, q.rel_mse.mean))
+        })
+        .collect()
+}
+
+/// Indices of the Pareto front of (time, error) points: those no other point beats in both
+/// (at most equal in one and lower in the other), ordered by time.
+pub fn pareto_front(points: &[(String, f64, f64)]) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..points.len()).collect();
+    order.sort_by(|&a, &b| {
+        points[a]
+            .1
+            .total_cmp(&points[b].1)
+            .then(points[a].2.total_cmp(&points[b].2))
+    });
+    let mut front = Vec::new();
+    let mut best = f64::INFINITY;
+    for i in order {
+        if points[i].2 < best {
+            best = points[i].2;
+            front.push(i);
+        }
+    }
+    front
+}
+
+/// Time versus error: one point per run with quality (technique and setting), the Pareto
+/// front joined by a line and drawn filled, the others hollow. Errors when no run has both.
+pub fn time_vs_error_svg(results: &[RunResult], path: &Path, title: &str) -> Result<()> {
+    let points = time_error_points(results);
+    if points.is_empty() {
+        return Err(Error::Invalid(format!(
+            "{}: no run has both a frame time and an error against the reference (run with --quality)",
+            path.display()
+        )));
+    }
+    let front = pareto_front(&points);
+    let xmax = axis_max(points.iter().map(|p| p.1).fold(0.0, f64::max), 1.15);
+    let ymax = axis_max(points.iter().map(|p| p.2).fold(0.0, f64::max), 1.15);
+    let (width, height) = (1000u32, 600u32);
+    write_svg(path, (width, height), |root| {
+        root.fill(&WHITE)?;
+        let (plot, legend) = root.split_horizontally(width - LEGEND_W);
+        let mut chart = ChartBuilder::on(&plot)
+            .caption(title, (FONT, 22))
+            .margin(12)
+            .x_label_area_size(50)
+            .y_label_area_size(80)
+            .build_cartesian_2d(0.0..xmax, 0.0..ymax)?;
+        chart
+            .configure_mesh()
+            .x_desc("time per frame (ms; median frame, else Σ stage medians)")
+            .y_desc("relative MSE against the reference (mean)")
+            .label_style((FONT, 15))
+            .axis_desc_style((FONT, 16))
+            .draw()?;
+        chart.draw_series(LineSeries::new(
+            front.iter().map(|&i| (points[i].1, points[i].2)),
+            BLACK.stroke_width(1),
+        ))?;
+        let mut entries = Vec::new();
+        for (k, (label, t, e)) in points.iter().enumerate() {
+            let color = stage_color(k);
+            let on_front = front.contains(&k);
+            let style = if on_front {
+                color.filled()
+            } else {
+                color.stroke_width(2)
+            };
+            chart.draw_series(std::iter::once(Circle::new((*t, *e), 6, style)))?;
+            let mark = if on_front { " (Pareto front)" } else { "" };
+            entries.push((format!("{label}{mark}"), color, Mark::Box));
+        }
+        draw_legend(&legend, "technique, setting", &entries)?;
+        root.present()?;
+        Ok(())
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use std::collections::BTreeMap;
 
     use super::*;
     use crate::results::{DeviceInfo, FrameRange, FrameResult, SCHEMA_VERSION};
+
+    /// The front keeps exactly the points nothing beats in both time and error.
+    #[test]
+    fn pareto_front_keeps_the_unbeaten_points() {
+        let p = |t: f64, e: f64| (String::new(), t, e);
+        let points = vec![
+            p(10.0, 0.5),
+            p(5.0, 0.9),
+            p(20.0, 0.1),
+            p(12.0, 0.6),
+            p(5.0, 1.0),
+        ];
+        // (12, 0.6) is beaten by (10, 0.5); (5, 1.0) by (5, 0.9).
+        assert_eq!(pareto_front(&points), vec![1, 0, 2]);
+    }
 
     /// Stats of 100 frames with the given median.
     fn stats(median: f64) -> Stats {

@@ -6,8 +6,8 @@
 //! Per technique: its preparation once ([`Harness::prepare`], timed as `prepare_ms`), the
 //! timing passes ([`Harness::run`]), the quality pass if asked ([`Harness::measure_quality`]),
 //! then its files in `out`: `{stem}.json` (written last, atomically), and unless `images` is off
-//! `{stem}.png`, `{stem}-indirect.exr`, `{stem}-direct.exr` (and with quality
-//! `{stem}-reference.png`, `{stem}-flip.png`).
+//! `{stem}.png`, `{stem}-indirect.exr`, `{stem}-direct.exr` (and with quality the images of
+//! [`QUALITY_IMAGES`]).
 
 use std::path::{Path, PathBuf};
 
@@ -19,6 +19,18 @@ use crate::runner::{Harness, PreparedTechnique, RunConfig, TimingMode};
 use crate::scene::Scene;
 use crate::technique::{Params, TechniqueInfo};
 use crate::{Error, Result};
+
+/// The quality pass's images, by file-name suffix after the run's stem, all of the last
+/// compared frame ([`crate::quality::QualityImages`]): the technique's composed image, the
+/// reference's, the FLIP error map, and the indirect light alone of the technique and of the
+/// reference at one shared exposure.
+pub const QUALITY_IMAGES: [&str; 5] = [
+    "-compared.png",
+    "-reference.png",
+    "-flip.png",
+    "-indirect.png",
+    "-reference-indirect.png",
+];
 
 /// One technique of a run.
 pub struct TechniqueRun {
@@ -147,11 +159,17 @@ fn execute_one(
             })?;
         result.quality = Some(summary);
         if spec.images {
-            let reference_png = out("-reference.png");
-            write_png(&reference_png, qimages.size, &qimages.reference_display)?;
-            let flip_png = out("-flip.png");
-            write_png(&flip_png, qimages.size, &qimages.flip_map)?;
-            extra_images = vec![file_name(&reference_png), file_name(&flip_png)];
+            for (suffix, rgba) in [
+                (QUALITY_IMAGES[0], &qimages.compared_display),
+                (QUALITY_IMAGES[1], &qimages.reference_display),
+                (QUALITY_IMAGES[2], &qimages.flip_map),
+                (QUALITY_IMAGES[3], &qimages.indirect_display),
+                (QUALITY_IMAGES[4], &qimages.reference_indirect_display),
+            ] {
+                let png = out(suffix);
+                write_png(&png, qimages.size, rgba)?;
+                extra_images.push(file_name(&png));
+            }
         }
     }
     if spec.images {

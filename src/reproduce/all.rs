@@ -287,6 +287,9 @@ impl Planned {
                 if !args.scenes.is_empty() {
                     command.push_str(&format!(" --scenes {}", args.scenes.join(",")));
                 }
+                if args.html {
+                    command.push_str(" --html");
+                }
                 Ok(Planned {
                     target,
                     out,
@@ -317,6 +320,9 @@ impl Planned {
                 }
                 if let Some(a) = &args.assets {
                     set_option(&mut argv, "--assets", &a.display().to_string());
+                }
+                if args.html && argv[0] != "reference" {
+                    argv.push("--html".into());
                 }
                 set_option(&mut argv, "--out", &out.display().to_string());
                 let job = Job::plan(&argv).map_err(|e| {
@@ -351,22 +357,43 @@ impl Planned {
         match &self.job {
             Some(job) => job.execute(gpu, bars),
             None => {
-                let tables = laine2007::reproduce(self.target.name, &self.args, gpu, bars)?;
+                let (tables, runs) = laine2007::reproduce(self.target.name, &self.args, gpu, bars)?;
                 let mut written = Vec::new();
-                for (table, stem) in tables {
-                    bars.table(&table);
-                    written.extend(report::write_tables(&table, &self.out, stem)?);
+                for (table, stem) in &tables {
+                    bars.table(table);
+                    written.extend(report::write_tables(table, &self.out, stem)?);
                 }
-                Ok(format!(
+                let mut done = format!(
                     "wrote {}",
                     written
                         .iter()
                         .map(|p| p.display().to_string())
                         .collect::<Vec<_>>()
                         .join(", ")
-                ))
+                );
+                if self.args.html {
+                    let page = self.out.join(format!("{}.html", self.target.name));
+                    let figures = written_figures(&self.out, self.target.name);
+                    crate::write_page(
+                        &page,
+                        self.target.description(),
+                        tables.into_iter().map(|(t, _)| t).collect(),
+                        figures,
+                        crate::with_folder(&laine2007::runs_folder(&self.args), runs),
+                    )?;
+                    done.push_str(&crate::page_line(&page));
+                }
+                Ok(done)
             }
         }
+    }
+}
+
+/// The SVG figures a paper target writes beside its tables (`{target}.svg`, where it has one).
+fn written_figures(out: &Path, target: &str) -> Vec<PathBuf> {
+    match target {
+        "laine-dispersion" => vec![out.join("laine-dispersion.svg")],
+        _ => Vec::new(),
     }
 }
 
@@ -790,11 +817,14 @@ impl Manifest {
         }
     }
 
-    /// Tables (`.md`, with `.csv` and `.tex` beside) and figures (`.svg`; the reference's
-    /// `.png` images) of a record.
+    /// Tables (`.md`, with `.csv` and `.tex` beside) and figures (`.svg`, `--html`'s pages, the
+    /// reference's `.png` images) of a record.
     fn outputs(r: &Record) -> (Vec<&str>, Vec<&str>, usize) {
-        let figure =
-            |f: &str| f.ends_with(".svg") || (r.name == "reference" && f.ends_with(".png"));
+        let figure = |f: &str| {
+            f.ends_with(".svg")
+                || f.ends_with(".html")
+                || (r.name == "reference" && f.ends_with(".png"))
+        };
         let tables: Vec<&str> = r
             .files
             .iter()

@@ -105,25 +105,35 @@ pub fn work(target: &str, args: &ReproduceArgs) -> (u64, u64) {
     }
 }
 
-/// Regenerates `target` (a `laine-*` target of [`super::all::TARGETS`]) on `gpu` (opened here if `None` and needed).
+/// Regenerates `target` (a `laine-*` target of [`super::all::TARGETS`]) on `gpu` (opened
+/// here if `None` and needed): its tables, and the runs behind them with their folder (none
+/// for the CPU-only targets).
 pub fn reproduce(
     target: &str,
     args: &ReproduceArgs,
     gpu: Option<&GpuContext>,
     bars: &Bars,
-) -> Result<Vec<Reproduction>> {
+) -> Result<(Vec<Reproduction>, Vec<RunResult>)> {
+    let runs = |pairs: &[Pair]| -> Vec<RunResult> {
+        pairs
+            .iter()
+            .flat_map(|p| [p.2.clone(), p.3.clone()])
+            .collect()
+    };
     Ok(match target {
-        "laine-table1" => vec![(table1(&run_pairs(args, gpu, bars)?)?, "laine-table1")],
-        "laine-table2" => vec![(table2(&run_pairs(args, gpu, bars)?)?, "laine-table2")],
-        "laine-tables" => {
+        "laine-table1" | "laine-table2" | "laine-tables" => {
             let pairs = run_pairs(args, gpu, bars)?;
-            vec![
-                (table1(&pairs)?, "laine-table1"),
-                (table2(&pairs)?, "laine-table2"),
-            ]
+            let mut tables = Vec::new();
+            if target != "laine-table2" {
+                tables.push((table1(&pairs)?, "laine-table1"));
+            }
+            if target != "laine-table1" {
+                tables.push((table2(&pairs)?, "laine-table2"));
+            }
+            (tables, runs(&pairs))
         }
-        "laine-management" => vec![(management(args)?, "laine-management")],
-        "laine-dispersion" => vec![(dispersion(args)?, "laine-dispersion")],
+        "laine-management" => (vec![(management(args)?, "laine-management")], Vec::new()),
+        "laine-dispersion" => (vec![(dispersion(args)?, "laine-dispersion")], Vec::new()),
         other => {
             return Err(Error::param(
                 "target",
@@ -131,6 +141,11 @@ pub fn reproduce(
             ))
         }
     })
+}
+
+/// The folder of the runs behind the tables.
+pub fn runs_folder(args: &ReproduceArgs) -> std::path::PathBuf {
+    out(args).join("runs")
 }
 
 /// The paper's published figures.

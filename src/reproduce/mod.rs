@@ -45,6 +45,10 @@ pub struct ReproduceArgs {
     /// Print the targets, their commands, folders and the time estimate; run nothing.
     #[arg(long)]
     pub list: bool,
+    /// Also write an HTML page per target (its tables, a paper's rows beside ours, and the
+    /// runs' images and plots where it has them).
+    #[arg(long)]
+    pub html: bool,
     /// Extra directory searched first for scene assets (glTF files).
     #[arg(long)]
     pub assets: Option<PathBuf>,
