@@ -31,13 +31,13 @@ run() { # run OUTPUT_DIR command... (OUTPUT_DIR is emptied first: no stale files
 # command"). `bash results/regenerate.sh laine` runs only the targets whose folder is under
 # results/laine (and `results/keller`, `results/clamp`, `results/reference` likewise).
 if [ -z "$only" ]; then
-  echo "== gibench reproduce all --quick"
-  "$g" reproduce all --quick --out results
+  echo "== gibench reproduce all --quick --html"
+  "$g" reproduce all --quick --html --out results
 elif [ "$only" != baseline ]; then
   targets=$("$g" reproduce all --quick --list 2>&1 | awk -v d="$only" '/^  [a-z]/ && ($3 == d || index($3, d "/") == 1) { print $1 }' | paste -sd, -)
   [ -n "$targets" ] || { echo "regenerate.sh: no target writes under results/$only" >&2; exit 1; }
-  echo "== gibench reproduce all --quick --only $targets"
-  "$g" reproduce all --quick --only "$targets" --out results
+  echo "== gibench reproduce all --quick --html --only $targets"
+  "$g" reproduce all --quick --html --only "$targets" --out results
 fi
 
 # Instruction counts of the CPU kernels under callgrind: the baseline CI's gate fails against.

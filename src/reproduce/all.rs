@@ -634,9 +634,9 @@ fn print_plan(
         ),
         None => eprintln!(
             "estimate: none — no earlier `reproduce all` is recorded in {} (the bar shows the work done instead)",
-            [root.to_path_buf(), PathBuf::from("results")]
+            Manifest::places(root)
                 .iter()
-                .map(|d| d.join(format!("{MANIFEST}.json")).display().to_string())
+                .map(|p| p.display().to_string())
                 .collect::<Vec<_>>()
                 .join(" or ")
         ),
@@ -760,17 +760,24 @@ struct Manifest {
 const MANIFEST: &str = "reproduce-all";
 
 impl Manifest {
+    /// Where an earlier manifest is looked for: `root`, then `results/`.
+    fn places(root: &Path) -> Vec<PathBuf> {
+        let mut places = vec![root.join(format!("{MANIFEST}.json"))];
+        let committed = Path::new("results").join(format!("{MANIFEST}.json"));
+        if places[0] != committed {
+            places.push(committed);
+        }
+        places
+    }
+
     /// The manifest in `root`, else in `results/`.
     fn previous(root: &Path) -> Option<Manifest> {
-        [root.to_path_buf(), PathBuf::from("results")]
-            .iter()
-            .map(|d| d.join(format!("{MANIFEST}.json")))
-            .find_map(|p| {
-                let text = gibench_harness::error::read_bounded(&p, 16 << 20).ok()?;
-                let mut m: Manifest = serde_json::from_slice(&text).ok()?;
-                m.source = p;
-                Some(m)
-            })
+        Self::places(root).into_iter().find_map(|p| {
+            let text = gibench_harness::error::read_bounded(&p, 16 << 20).ok()?;
+            let mut m: Manifest = serde_json::from_slice(&text).ok()?;
+            m.source = p;
+            Some(m)
+        })
     }
 
     /// Seconds for `target` doing `units` of work, from its recorded rate.
