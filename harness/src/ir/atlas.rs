@@ -179,6 +179,7 @@ impl ShadowAtlas {
             wgpu::TextureUsages::STORAGE_BINDING
                 | wgpu::TextureUsages::TEXTURE_BINDING
                 | wgpu::TextureUsages::COPY_DST
+                | wgpu::TextureUsages::COPY_SRC
         };
         let texture = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("vpl shadow atlas"),
@@ -260,6 +261,10 @@ impl ShadowAtlas {
         Ok(atlas)
     }
 
+    /// Slots per atlas row.
+    pub fn columns(&self) -> u32 {
+        self.columns
+    }
     pub fn texture(&self) -> &wgpu::Texture {
         &self.texture
     }

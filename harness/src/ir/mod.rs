@@ -27,6 +27,10 @@
 //! * [`interleave::Interleave`] — split, combine and the geometry-aware filter (Laine et al.
 //!   2007 §5).
 //! * [`accumulate::Accumulation`] — a store and an atlas through the interleaving.
+//! * [`splat::PointSplat`] — imperfect shadow maps' depth: each VPL's own subset of a point
+//!   pool splatted into its paraboloid map, one dispatch for all VPLs (Ritschel et al. 2008).
+//! * [`pullpush::PullPush`] — fills the splats' holes in every map at once and writes them
+//!   into a float atlas.
 //! * [`gather::VplGather`] — the common case wired: CPU list, rasterised static casters,
 //!   interleaved gathering, with the shared parameters and stage names.
 
@@ -34,5 +38,7 @@ pub mod accumulate;
 pub mod atlas;
 pub mod gather;
 pub mod interleave;
+pub mod pullpush;
 pub mod raster;
+pub mod splat;
 pub mod store;

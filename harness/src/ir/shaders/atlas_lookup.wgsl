@@ -20,6 +20,15 @@ fn vpl_tile_origin(slot: u32, tile_w: u32, tile_h: u32) -> vec2<i32> {
     return vec2<i32>(i32((slot % cols) * tile_w), i32((slot / cols) * tile_h));
 }
 
+// The texel of a `size`² paraboloid map that the unit direction `local` (in the map's frame, z
+// along the VPL's normal, z > 0) falls in: uv = local.xy / (1 + local.z) on [-1, 1]², row 0 at
+// the top. Shared by the lookup below and the point splats of imperfect shadow maps.
+fn paraboloid_texel(local: vec3<f32>, size: u32) -> vec2<i32> {
+    let uv = local.xy / (1.0 + local.z);
+    let st = vec2<i32>(floor(vec2<f32>(uv.x * 0.5 + 0.5, 0.5 - uv.y * 0.5) * f32(size)));
+    return clamp(st, vec2<i32>(0), vec2<i32>(i32(size) - 1));
+}
+
 // 1 if receiver `p` (unit normal `n`) is visible from VPL `v` according to its map, else 0.
 // The receiver is first moved off its surface by about two map texels (normal offset), so that
 // surfaces tilted away from the VPL do not shadow themselves.
@@ -37,9 +46,7 @@ fn vpl_visibility(v: GpuVpl, p_surface: vec3<f32>, n: vec3<f32>) -> f32 {
         if (local.z <= 0.0) {
             return 0.0;
         }
-        let uv = local.xy / (1.0 + local.z);
-        let st = vec2<i32>(floor(vec2<f32>(uv.x * 0.5 + 0.5, 0.5 - uv.y * 0.5) * f32(size)));
-        let t = clamp(st, vec2<i32>(0), vec2<i32>(i32(size) - 1));
+        let t = paraboloid_texel(local, size);
         let stored = textureLoad(vpl_atlas, vpl_tile_origin(slot, size, size) + t, 0).r;
         let receiver = 1.0 - len * (1.0 - bias) / far;
         return select(0.0, 1.0, receiver >= stored);

@@ -1,0 +1,26 @@
+// The last push: level 0 into the atlas. A texel where a point landed keeps its depth exactly;
+// a hole takes its filled parent's depth (level 1), or stays empty (0) where nothing was
+// within the levels pulled. Expects pullpush.wgsl's bindings.
+
+@group(0) @binding(3) var atlas_out: texture_storage_2d<r32float, write>;
+
+@compute @workgroup_size(64)
+fn store(@builtin(global_invocation_id) id: vec3<u32>) {
+    let size = pp.counts.y;
+    let slot = id.y;
+    if (id.x >= size * size || slot >= pp.counts.z) {
+        return;
+    }
+    let x = id.x % size;
+    let y = id.x / size;
+    var v = level0(slot, x, y, size);
+    if (v.y <= 0.0 && pp.offsets.y != 0xffffffffu) {
+        let parent = texel(pp.offsets.y, slot, x / 2u, y / 2u, size / 2u);
+        if (parent.y > 0.0) {
+            v = vec2<f32>(parent.x, 1.0);
+        }
+    }
+    let cols = pp.counts.w;
+    let origin = vec2<i32>(i32((slot % cols) * size), i32((slot / cols) * size));
+    textureStore(atlas_out, origin + vec2<i32>(i32(x), i32(y)), vec4<f32>(v.x, 0.0, 0.0, 1.0));
+}

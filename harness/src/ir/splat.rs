@@ -1,0 +1,210 @@
+//! **Point splat**: imperfect shadow maps' depth (Ritschel et al. 2008) — every VPL's own
+//! subset of a point pool splatted, one texel per point, into its paraboloid map.
+//!
+//! Reads: the point pool (world positions, `vec4<f32>` each, in random order so that any run
+//! of it is a uniform sample of the surfaces), the [`VplStore`], the [`ShadowAtlas`]'s
+//! parameters (map size, far distance, the lift of a map's centre off its VPL).
+//! Writes (owns): the imperfect depth buffer, one `u32` per texel of every slot's map
+//! (`slot · size² + y · size + x`), holding the bits of the nearest point's reversed depth
+//! (1 − d / far, as the atlas stores), 0 where no point landed. [`super::pullpush::PullPush`]
+//! fills its holes and writes the atlas.
+//!
+//! VPL slot s takes `points_per_vpl` consecutive points of the pool from a start that a hash
+//! of s picks, so each VPL has its own subset (the paper: 8k points per VPL). One dispatch for
+//! all VPLs: a thread per (point, slot), kept nearest-first by a storage-buffer `atomicMax` —
+//! no texture atomics, so it runs on Vulkan and GL alike. Paraboloid maps only (the paper's).
+
+use bytemuck::{Pod, Zeroable};
+
+use super::atlas::{MapKind, ShadowAtlas};
+use super::store::VplStore;
+use crate::gpu::GpuContext;
+use crate::passes::{params_entry, shader_module, PARAMS_USAGE};
+use crate::{Error, Result};
+
+/// GPU layout of `SplatParams` in `splat.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct ParamsData {
+    counts: [u32; 4],
+}
+
+/// The splat pass and the imperfect depth buffer it writes (see the module docs).
+pub struct PointSplat {
+    pipeline: wgpu::ComputePipeline,
+    group: wgpu::BindGroup,
+    depth: wgpu::Buffer,
+    /// Kept alive for the bind group.
+    _params: wgpu::Buffer,
+    per_vpl: u32,
+    slots: u32,
+    size: u32,
+}
+
+/// A storage-buffer layout entry, compute only.
+pub(crate) fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+/// Bytes of one buffer of `texels` 4-byte values, checked against the device's limits; the
+/// error names the parameters that set its size.
+pub(crate) fn texel_buffer_size(gpu: &GpuContext, texels: u64, what: &str) -> Result<u64> {
+    let bytes = texels * 4;
+    let limits = gpu.device.limits();
+    let max = limits
+        .max_storage_buffer_binding_size
+        .min(limits.max_buffer_size);
+    if bytes > max {
+        return Err(Error::param(
+            "vpl-map-size",
+            format!(
+                "{what} of {bytes} bytes exceeds this adapter's largest storage buffer ({max} bytes); use fewer VPLs or smaller maps"
+            ),
+        ));
+    }
+    Ok(bytes)
+}
+
+impl PointSplat {
+    /// The pass for `store`'s slots into `atlas`'s maps, each VPL splatting `points_per_vpl`
+    /// points of `points` (a storage buffer of `pool` `vec4<f32>` positions).
+    pub fn new(
+        gpu: &GpuContext,
+        store: &VplStore,
+        atlas: &ShadowAtlas,
+        points: &wgpu::Buffer,
+        pool: u32,
+        points_per_vpl: u32,
+    ) -> Result<PointSplat> {
+        if atlas.settings.kind != MapKind::Paraboloid {
+            return Err(Error::param(
+                "vpl-map",
+                "imperfect shadow maps are paraboloid maps (got cube)",
+            ));
+        }
+        if pool == 0 || points_per_vpl == 0 {
+            return Err(Error::param(
+                "points",
+                "at least one point per VPL and in the pool is needed",
+            ));
+        }
+        let device = &gpu.device;
+        let (slots, size) = (store.capacity(), atlas.settings.size);
+        let texels = slots as u64 * size as u64 * size as u64;
+        let bytes = texel_buffer_size(gpu, texels, "the imperfect depth buffer")?;
+        let depth = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("ism depth"),
+            size: bytes,
+            usage: wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_DST
+                | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let params = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("splat params"),
+            size: std::mem::size_of::<ParamsData>() as u64,
+            usage: PARAMS_USAGE,
+            mapped_at_creation: false,
+        });
+        gpu.queue.write_buffer(
+            &params,
+            0,
+            bytemuck::bytes_of(&ParamsData {
+                counts: [points_per_vpl, pool, 0, 0],
+            }),
+        );
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("splat"),
+            entries: &[
+                VplStore::layout_entry(0, false),
+                params_entry(1, wgpu::ShaderStages::COMPUTE),
+                storage_entry(2, true),
+                storage_entry(3, false),
+            ],
+        });
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("splat"),
+            layout: &layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: store.buffer().as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: params.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: points.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: depth.as_entire_binding(),
+                },
+            ],
+        });
+        let source = format!(
+            "{}\n{}\n{}",
+            VplStore::wgsl(0, 0, false),
+            ShadowAtlas::wgsl(1),
+            include_str!("shaders/splat.wgsl")
+        );
+        let module = shader_module(device, "ism splat", &source);
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("ism splat"),
+            bind_group_layouts: &[Some(&layout), Some(atlas.layout())],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("ism splat"),
+            layout: Some(&pipeline_layout),
+            module: &module,
+            entry_point: Some("splat"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        gpu.check_errors()?;
+        Ok(PointSplat {
+            pipeline,
+            group,
+            depth,
+            _params: params,
+            per_vpl: points_per_vpl,
+            slots,
+            size,
+        })
+    }
+
+    /// Records the splat: clears the depth buffer, then one dispatch for every slot.
+    pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, atlas: &ShadowAtlas) {
+        encoder.clear_buffer(&self.depth, 0, None);
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("ism splat"),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &self.group, &[]);
+        pass.set_bind_group(1, atlas.group(), &[]);
+        pass.dispatch_workgroups(self.per_vpl.div_ceil(64), self.slots, 1);
+    }
+
+    /// The imperfect depth buffer (see the module docs).
+    pub fn depth(&self) -> &wgpu::Buffer {
+        &self.depth
+    }
+
+    /// Slots and map edge of the depth buffer.
+    pub fn layout(&self) -> (u32, u32) {
+        (self.slots, self.size)
+    }
+}

@@ -1,0 +1,296 @@
+//! The imperfect-shadow-map kit parts (Ritschel et al. 2008) on the GPU, on every portable
+//! backend present: pull-push fills a synthetic hole pattern without changing any texel a
+//! point landed on and leaves regions beyond its reach empty; splatting a dense point set of a
+//! plane and pulling-pushing reproduces the plane's exact (classic) paraboloid depth map.
+
+mod support;
+
+use gibench_harness::glam::Vec3;
+use gibench_harness::gpu::{GpuContext, GpuOptions};
+use gibench_harness::ir::atlas::{AtlasFormat, AtlasSettings, MapKind, ShadowAtlas};
+use gibench_harness::ir::pullpush::PullPush;
+use gibench_harness::ir::splat::PointSplat;
+use gibench_harness::ir::store::VplStore;
+use gibench_harness::scene::{Mesh, SceneExtent};
+use gibench_harness::vpl::{frame_from_normal, Vpl};
+use gibench_harness::wgpu;
+
+fn backends() -> Vec<&'static str> {
+    let present = gibench_harness::gpu::available_backends();
+    assert!(!present.is_empty(), "no Vulkan or GL adapter");
+    if present.len() < 2 {
+        gibench_harness::gpu::say_uncaptured(&format!(
+            "ism_kit: only {present:?} present on this machine"
+        ));
+    }
+    present
+}
+
+fn gpu(backend: &str) -> GpuContext {
+    GpuContext::new(&GpuOptions {
+        backend: Some(backend.into()),
+        adapter: None,
+    })
+    .expect("a GPU adapter")
+}
+
+/// The plane z = 1, x and y in [-2, 2], as a mesh (for the scene extent the atlas's far
+/// distance and lift come from).
+fn plane() -> Mesh {
+    let mut mesh = Mesh::default();
+    support::quad(
+        &mut mesh,
+        [
+            Vec3::new(-2.0, -2.0, 1.0),
+            Vec3::new(2.0, -2.0, 1.0),
+            Vec3::new(2.0, 2.0, 1.0),
+            Vec3::new(-2.0, 2.0, 1.0),
+        ],
+        Vec3::NEG_Z,
+        0,
+    );
+    mesh
+}
+
+fn float_atlas(gpu: &GpuContext, extent: &SceneExtent, slots: u32, size: u32) -> ShadowAtlas {
+    ShadowAtlas::new(
+        gpu,
+        extent,
+        AtlasSettings {
+            kind: MapKind::Paraboloid,
+            format: AtlasFormat::Float32,
+            size,
+            capacity: slots,
+            bias: 0.0,
+        },
+    )
+    .unwrap()
+}
+
+fn points_buffer(gpu: &GpuContext, points: &[Vec3]) -> wgpu::Buffer {
+    let data: Vec<[f32; 4]> = points.iter().map(|p| p.extend(1.0).to_array()).collect();
+    let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("test points"),
+        size: (data.len() * 16) as u64,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    gpu.queue
+        .write_buffer(&buffer, 0, bytemuck::cast_slice(&data));
+    buffer
+}
+
+/// Slot `slot`'s map out of the atlas, row-major.
+fn read_map(gpu: &GpuContext, atlas: &ShadowAtlas, slot: u32) -> Vec<f32> {
+    let bytes = gibench_harness::image_io::read_texture(gpu, atlas.texture()).unwrap();
+    let width = atlas.texture().width() as usize;
+    let size = atlas.settings.size;
+    let ([ox, oy], _) = atlas.block(slot);
+    let mut out = Vec::new();
+    for y in 0..size {
+        for x in 0..size {
+            let i = ((oy + y) as usize * width + (ox + x) as usize) * 4;
+            out.push(f32::from_le_bytes(bytes[i..i + 4].try_into().unwrap()));
+        }
+    }
+    out
+}
+
+const SIZE: u32 = 32;
+
+/// The synthetic level 0 of slot 0: a depth ramp with scattered holes (one texel in five) and
+/// a 4×4 hole; `None` marks a hole.
+fn ramp(x: u32, y: u32) -> Option<f32> {
+    let hole = (x * 7 + y * 3) % 5 == 0 || ((12..16).contains(&x) && (20..24).contains(&y));
+    (!hole).then_some(0.3 + 0.01 * x as f32 + 0.005 * y as f32)
+}
+
+#[test]
+fn pull_push_fills_holes_and_never_changes_a_valid_texel() {
+    for backend in backends() {
+        let gpu = gpu(backend);
+        let extent = SceneExtent::of(&plane());
+        let atlas = float_atlas(&gpu, &extent, 2, SIZE);
+        let store = VplStore::new(&gpu, 2).unwrap();
+        let points = points_buffer(&gpu, &[Vec3::ZERO]);
+        let splat = PointSplat::new(&gpu, &store, &atlas, &points, 1, 1).unwrap();
+        // Level 0 written directly: slot 0 the ramp with holes; slot 1 empty but one texel.
+        let mut level0 = vec![0u32; 2 * (SIZE * SIZE) as usize];
+        for y in 0..SIZE {
+            for x in 0..SIZE {
+                if let Some(v) = ramp(x, y) {
+                    level0[(y * SIZE + x) as usize] = v.to_bits();
+                }
+            }
+        }
+        let lone = (5u32, 5u32, 0.42f32);
+        level0[(SIZE * SIZE + lone.1 * SIZE + lone.0) as usize] = lone.2.to_bits();
+        gpu.queue
+            .write_buffer(splat.depth(), 0, bytemuck::cast_slice(&level0));
+        let pp = PullPush::new(&gpu, &splat, &atlas, 3).unwrap();
+        assert_eq!(pp.levels(), 3);
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        pp.encode(&mut enc);
+        gpu.queue.submit([enc.finish()]);
+        let map = read_map(&gpu, &atlas, 0);
+        let (lo, hi) = (0.3f32, 0.3 + 0.01 * 31.0 + 0.005 * 31.0);
+        for y in 0..SIZE {
+            for x in 0..SIZE {
+                let got = map[(y * SIZE + x) as usize];
+                match ramp(x, y) {
+                    Some(v) => assert_eq!(
+                        got.to_bits(),
+                        v.to_bits(),
+                        "{backend}: valid texel ({x}, {y}) changed"
+                    ),
+                    None => {
+                        // Filled from nearby depths: within the ramp's range and near its value
+                        // here. The push takes the parent's mean, so a hole gets the mean of
+                        // the smallest aligned block around it that has points: the 4x4 hole,
+                        // its 8x8 block's, which the ramp (0.01 and 0.005 per texel) puts up to
+                        // 0.09 away at the block's far corner.
+                        let want = 0.3 + 0.01 * x as f32 + 0.005 * y as f32;
+                        assert!(
+                            got >= lo && got <= hi && (got - want).abs() < 0.1,
+                            "{backend}: hole ({x}, {y}) filled with {got}, the ramp is {want}"
+                        );
+                    }
+                }
+            }
+        }
+        // The lone texel fills its own 8x8 block (three levels up) and nothing beyond it.
+        let map = read_map(&gpu, &atlas, 1);
+        for y in 0..SIZE {
+            for x in 0..SIZE {
+                let got = map[(y * SIZE + x) as usize];
+                let within = x / 8 == lone.0 / 8 && y / 8 == lone.1 / 8;
+                let want = if within { lone.2 } else { 0.0 };
+                assert_eq!(got, want, "{backend}: slot 1 texel ({x}, {y})");
+            }
+        }
+    }
+}
+
+/// A VPL 1 unit below the plane's centre, facing it; the plane sampled every 0.01 units
+/// (160k points) and splatted into a 64² map, pulled-pushed two levels: where the exact map
+/// (a ray per texel) sees the plane two texels or more inside its edge, every texel of the
+/// imperfect map holds a depth between its neighbours' exact depths (the nearest point in the
+/// texel) and on average within half the depth change to its neighbours of its own; where the exact map sees no plane in the
+/// texel's 4x4 pull-push block or next to it, the imperfect map is empty.
+#[test]
+fn dense_splats_of_a_plane_reproduce_its_exact_map() {
+    const MAP: u32 = 64;
+    for backend in backends() {
+        let gpu = gpu(backend);
+        let extent = SceneExtent::of(&plane());
+        let atlas = float_atlas(&gpu, &extent, 1, MAP);
+        let store = VplStore::new(&gpu, 1).unwrap();
+        let vpl = Vpl {
+            position: Vec3::new(0.1, -0.05, 0.0),
+            normal: Vec3::Z,
+            flux: Vec3::ONE,
+            color: Vec3::ONE,
+            bounce: 1,
+            path: 0,
+            sample: Vec3::ZERO,
+        };
+        store.write(&gpu.queue, &[(0, vpl)]);
+        let n = 400;
+        let pts: Vec<Vec3> = (0..n * n)
+            .map(|i| {
+                let (x, y) = ((i % n) as f32 + 0.5, (i / n) as f32 + 0.5);
+                Vec3::new(-2.0 + 4.0 * x / n as f32, -2.0 + 4.0 * y / n as f32, 1.0)
+            })
+            .collect();
+        let points = points_buffer(&gpu, &pts);
+        let splat = PointSplat::new(
+            &gpu,
+            &store,
+            &atlas,
+            &points,
+            pts.len() as u32,
+            pts.len() as u32,
+        )
+        .unwrap();
+        let pp = PullPush::new(&gpu, &splat, &atlas, 2).unwrap();
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        splat.encode(&mut enc, &atlas);
+        pp.encode(&mut enc);
+        gpu.queue.submit([enc.finish()]);
+        let map = read_map(&gpu, &atlas, 0);
+        // The exact map: a ray through each texel's centre against the plane.
+        let (t, b) = frame_from_normal(vpl.normal);
+        let eye = vpl.position + vpl.normal * atlas.lift;
+        let exact = |x: i32, y: i32| -> Option<f32> {
+            if x < 0 || y < 0 || x >= MAP as i32 || y >= MAP as i32 {
+                return None;
+            }
+            let d = ShadowAtlas::paraboloid_texel_direction(MAP, x as u32, y as u32)?;
+            let dir = d.x * t + d.y * b + d.z * vpl.normal;
+            if dir.z <= 1e-6 {
+                return None;
+            }
+            let s = (1.0 - eye.z) / dir.z;
+            let p = eye + dir * s;
+            (p.x.abs() <= 2.0 && p.y.abs() <= 2.0).then(|| atlas.paraboloid_depth(s))
+        };
+        // The first texel of the aligned 4x4 block (two levels) that pull-push fills from.
+        let block = |v: i32| v - v.rem_euclid(4);
+        let (mut compared, mut empty, mut error, mut spread) = (0, 0, 0.0f64, 0.0f64);
+        for y in 0..MAP as i32 {
+            for x in 0..MAP as i32 {
+                let got = map[(y * MAP as i32 + x) as usize];
+                let around: Vec<Option<f32>> = (-2..=2)
+                    .flat_map(|dy| (-2..=2).map(move |dx| (dx, dy)))
+                    .map(|(dx, dy)| exact(x + dx, y + dy))
+                    .collect();
+                if around.iter().all(Option::is_some) {
+                    // The nearest point in the texel lies between the centre rays of its
+                    // neighbours (the plane's depth is monotonic across the map).
+                    let next: Vec<f32> = (-1..=1)
+                        .flat_map(|dy| (-1..=1).map(move |dx| (dx, dy)))
+                        .filter_map(|(dx, dy)| exact(x + dx, y + dy))
+                        .collect();
+                    let lo = next.iter().copied().fold(f32::MAX, f32::min) - 1e-4;
+                    let mut hi = next.iter().copied().fold(f32::MIN, f32::max) + 1e-4;
+                    // Next to the foot of the perpendicular (the map's centre, texel 32, 32)
+                    // the nearest point is nearer than every centre ray.
+                    if (x - 32).abs() <= 1 && (y - 32).abs() <= 1 {
+                        hi = hi.max(atlas.paraboloid_depth(1.0 - eye.z) + 1e-6);
+                    }
+                    let want = exact(x, y).unwrap();
+                    assert!(
+                        (lo..=hi).contains(&got),
+                        "{backend}: texel ({x}, {y}) holds {got}, the plane is at {want} here and {lo}..{hi} around"
+                    );
+                    error += (got - want).abs() as f64;
+                    spread += (next.iter().copied().fold(f32::MIN, f32::max)
+                        - next.iter().copied().fold(f32::MAX, f32::min))
+                        as f64
+                        / 2.0;
+                    compared += 1;
+                } else if (block(x) - 1..block(x) + 5)
+                    .all(|bx| (block(y) - 1..block(y) + 5).all(|by| exact(bx, by).is_none()))
+                    && ShadowAtlas::paraboloid_texel_direction(MAP, x as u32, y as u32).is_some()
+                {
+                    assert_eq!(
+                        got, 0.0,
+                        "{backend}: texel ({x}, {y}) sees no plane but holds {got}"
+                    );
+                    empty += 1;
+                }
+            }
+        }
+        assert!(
+            compared > 1000 && empty > 100,
+            "{backend}: {compared} compared, {empty} empty"
+        );
+        // On average a texel's depth is within half the depth change to its neighbours of its
+        // centre's depth.
+        let (mean, half) = (error / compared as f64, spread / compared as f64);
+        assert!(
+            mean < half,
+            "{backend}: mean depth error {mean}, half a texel's change {half}"
+        );
+    }
+}
