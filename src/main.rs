@@ -671,8 +671,18 @@ pub(crate) fn run_planned(
         &format!("Per-stage times on {name}"),
     )?;
     written.push(format!("{stem}.svg"));
-    if plan.quality.as_ref().is_some_and(|q| q.all) {
-        for metric in ["rmse", "flicker"] {
+    if plan.quality.is_some() {
+        // Per compared frame (every measured frame with --quality-all); flicker where a frame
+        // pair was compared.
+        let flicker = results.iter().any(|r| {
+            r.quality
+                .as_ref()
+                .is_some_and(|q| q.frames.iter().any(|f| f.temporal.is_some()))
+        });
+        for metric in ["rmse", "flicker"]
+            .into_iter()
+            .filter(|m| *m == "rmse" || flicker)
+        {
             let svg = args.out.join(format!("{name}-{metric}-per-frame.svg"));
             report::quality_over_frames_svg(
                 &results,
