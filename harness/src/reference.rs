@@ -228,22 +228,23 @@ fn mix64(mut z: u64) -> u64 {
     z ^ (z >> 31)
 }
 
-/// SplitMix64: one independent stream per (seed, stream index).
-struct Rng(u64);
+/// SplitMix64: one independent stream per (seed, stream index). Also the point pool's
+/// ([`crate::ir::points`]).
+pub(crate) struct Rng(u64);
 
 impl Rng {
     const GAMMA: u64 = 0x9e37_79b9_7f4a_7c15;
-    fn new(seed: u64, stream: u64) -> Rng {
+    pub(crate) fn new(seed: u64, stream: u64) -> Rng {
         Rng(mix64(
             mix64(seed ^ 0x5851_f42d_4c95_7f2d) ^ stream.wrapping_mul(Rng::GAMMA),
         ))
     }
-    fn next_u64(&mut self) -> u64 {
+    pub(crate) fn next_u64(&mut self) -> u64 {
         self.0 = self.0.wrapping_add(Rng::GAMMA);
         mix64(self.0)
     }
     /// Uniform in [0, 1).
-    fn next_f32(&mut self) -> f32 {
+    pub(crate) fn next_f32(&mut self) -> f32 {
         (self.next_u64() >> 40) as f32 * (1.0 / (1u64 << 24) as f32)
     }
     fn next_2d(&mut self) -> Vec2 {

@@ -27,6 +27,7 @@
 //! * [`interleave::Interleave`] — split, combine and the geometry-aware filter (Laine et al.
 //!   2007 §5).
 //! * [`accumulate::Accumulation`] — a store and an atlas through the interleaving.
+//! * [`points`] — the scene's surfaces as a shuffled pool of points, uniform by area.
 //! * [`splat::PointSplat`] — imperfect shadow maps' depth: each VPL's own subset of a point
 //!   pool splatted into its paraboloid map, one dispatch for all VPLs (Ritschel et al. 2008).
 //! * [`pullpush::PullPush`] — fills the splats' holes in every map at once and writes them
@@ -38,6 +39,7 @@ pub mod accumulate;
 pub mod atlas;
 pub mod gather;
 pub mod interleave;
+pub mod points;
 pub mod pullpush;
 pub mod raster;
 pub mod splat;
