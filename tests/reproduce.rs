@@ -114,6 +114,17 @@ fn gibench(args: &[&str], out: &std::path::Path) -> std::process::Output {
         .unwrap()
 }
 
+/// [`gibench`] run from `dir`, where no committed `results/reproduce-all.json` is found.
+fn gibench_in(dir: &std::path::Path, args: &[&str], out: &std::path::Path) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_gibench"))
+        .current_dir(dir)
+        .args(args)
+        .arg("--out")
+        .arg(out)
+        .output()
+        .unwrap()
+}
+
 /// `reproduce all --list` names every target with its folder and command and runs none.
 #[test]
 fn reproduce_all_lists_every_target_and_runs_nothing() {
@@ -174,7 +185,7 @@ fn reproduce_all_writes_lists_replaces_and_estimates() {
         "--frames",
         "2",
     ];
-    let first = gibench(&args, &out);
+    let first = gibench_in(tmp.path(), &args, &out);
     let stdout = String::from_utf8_lossy(&first.stdout);
     let stderr = String::from_utf8_lossy(&first.stderr);
     assert!(first.status.success(), "{stderr}");
@@ -196,7 +207,7 @@ fn reproduce_all_writes_lists_replaces_and_estimates() {
     assert!(targets.iter().all(|t| t["seconds"].as_f64().unwrap() > 0.0));
     std::fs::write(out.join("keller/tiles/stale.json"), "{}").unwrap();
     std::fs::write(out.join("laine/notes.txt"), "mine").unwrap();
-    let second = gibench(&args, &out);
+    let second = gibench_in(tmp.path(), &args, &out);
     let stderr = String::from_utf8_lossy(&second.stderr);
     assert!(second.status.success(), "{stderr}");
     assert!(

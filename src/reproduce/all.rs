@@ -904,7 +904,12 @@ impl Manifest {
                 out.push_str(&format!("\n    table  {t} (.csv, .tex beside)"));
             }
             for f in figures {
-                out.push_str(&format!("\n    figure {f}"));
+                let kind = if f.ends_with(".html") {
+                    "page  "
+                } else {
+                    "figure"
+                };
+                out.push_str(&format!("\n    {kind} {f}"));
             }
         }
         out.push_str(&format!(
