@@ -57,7 +57,7 @@ pub struct OutputSet {
 }
 
 /// `path` made absolute against the working directory and with `.` and `..` resolved lexically.
-fn absolute(path: &Path) -> PathBuf {
+pub(crate) fn absolute(path: &Path) -> PathBuf {
     let joined = if path.is_absolute() {
         path.to_path_buf()
     } else {

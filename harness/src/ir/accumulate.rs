@@ -24,7 +24,7 @@ use super::atlas::ShadowAtlas;
 use super::interleave::{Interleave, INTERLEAVE_WGSL};
 use super::store::VplStore;
 use crate::gpu::GpuContext;
-use crate::passes::{params_entry, shader_module, PARAMS_USAGE};
+use crate::passes::{compute_pipeline, params_entry, PARAMS_USAGE};
 use crate::Result;
 
 /// GPU layout of `AccumulateParams` in `accumulate.wgsl`.
@@ -125,24 +125,13 @@ impl Accumulation {
             ShadowAtlas::wgsl(2),
             include_str!("shaders/accumulate.wgsl")
         );
-        let module = shader_module(device, "vpl accumulate", &source);
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("vpl accumulate"),
-            bind_group_layouts: &[
-                Some(interleave.split_layout()),
-                Some(&layout),
-                Some(atlas.layout()),
-            ],
-            immediate_size: 0,
-        });
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("vpl accumulate"),
-            layout: Some(&pipeline_layout),
-            module: &module,
-            entry_point: Some("accumulate"),
-            compilation_options: Default::default(),
-            cache: None,
-        });
+        let pipeline = compute_pipeline(
+            device,
+            "vpl accumulate",
+            &source,
+            &[interleave.split_layout(), &layout, atlas.layout()],
+            "accumulate",
+        );
         gpu.check_errors()?;
         Ok(Accumulation {
             pipeline,

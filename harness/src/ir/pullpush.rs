@@ -20,9 +20,9 @@
 use bytemuck::{Pod, Zeroable};
 
 use super::atlas::{AtlasFormat, ShadowAtlas};
-use super::splat::{storage_entry, texel_buffer_size, PointSplat};
+use super::splat::{texel_buffer_size, PointSplat};
 use crate::gpu::GpuContext;
-use crate::passes::{params_entry, shader_module, PARAMS_USAGE};
+use crate::passes::{compute_pipeline, params_entry, storage_entry, PARAMS_USAGE};
 use crate::{Error, Result};
 
 /// GPU layout of `PullPushParams` in `pullpush.wgsl`.
@@ -111,20 +111,7 @@ impl PullPush {
         });
         let common = include_str!("shaders/pullpush.wgsl");
         let pipeline = |layout: &wgpu::BindGroupLayout, source: String, entry: &str| {
-            let module = shader_module(device, "pull-push", &source);
-            let pl = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some("pull-push"),
-                bind_group_layouts: &[Some(layout)],
-                immediate_size: 0,
-            });
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(entry),
-                layout: Some(&pl),
-                module: &module,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                cache: None,
-            })
+            compute_pipeline(device, entry, &source, &[layout], entry)
         };
         let pipelines = [
             pipeline(&layout, common.to_string(), "pull"),

@@ -19,7 +19,7 @@ use bytemuck::{Pod, Zeroable};
 use super::atlas::{MapKind, ShadowAtlas};
 use super::store::VplStore;
 use crate::gpu::GpuContext;
-use crate::passes::{params_entry, shader_module, PARAMS_USAGE};
+use crate::passes::{compute_pipeline, params_entry, storage_entry, PARAMS_USAGE};
 use crate::{Error, Result};
 
 /// GPU layout of `SplatParams` in `splat.wgsl`.
@@ -39,20 +39,6 @@ pub struct PointSplat {
     per_vpl: u32,
     slots: u32,
     size: u32,
-}
-
-/// A storage-buffer layout entry, compute only.
-pub(crate) fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
 }
 
 /// Bytes of one buffer of `texels` 4-byte values, checked against the device's limits; the
@@ -159,20 +145,13 @@ impl PointSplat {
             ShadowAtlas::wgsl(1),
             include_str!("shaders/splat.wgsl")
         );
-        let module = shader_module(device, "ism splat", &source);
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("ism splat"),
-            bind_group_layouts: &[Some(&layout), Some(atlas.layout())],
-            immediate_size: 0,
-        });
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("ism splat"),
-            layout: Some(&pipeline_layout),
-            module: &module,
-            entry_point: Some("splat"),
-            compilation_options: Default::default(),
-            cache: None,
-        });
+        let pipeline = compute_pipeline(
+            device,
+            "ism splat",
+            &source,
+            &[&layout, atlas.layout()],
+            "splat",
+        );
         gpu.check_errors()?;
         Ok(PointSplat {
             pipeline,
