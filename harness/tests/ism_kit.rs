@@ -294,3 +294,141 @@ fn dense_splats_of_a_plane_reproduce_its_exact_map() {
         );
     }
 }
+
+/// The bytes of `buffer` (COPY_SRC).
+fn read_buffer(gpu: &GpuContext, buffer: &wgpu::Buffer) -> Vec<u8> {
+    let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("test readback"),
+        size: buffer.size(),
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let mut enc = gpu.device.create_command_encoder(&Default::default());
+    enc.copy_buffer_to_buffer(buffer, 0, &staging, 0, buffer.size());
+    gpu.queue.submit([enc.finish()]);
+    let slice = staging.slice(..);
+    slice.map_async(wgpu::MapMode::Read, |_| {});
+    gpu.flush().unwrap();
+    let bytes = slice.get_mapped_range().unwrap().to_vec();
+    staging.unmap();
+    bytes
+}
+
+fn luminance(c: Vec3) -> f32 {
+    c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
+}
+
+/// VPLs sampled from a synthetic reflective shadow map (64x64 texels: a reddish and a bluish
+/// half of varying brightness, one texel in seven empty, one in eleven black): every VPL sits
+/// on a lit texel with its normal, has luminance total / N, the store's header holds the
+/// texels' total flux, and the VPLs' summed flux is within 2 % of the texels' per channel.
+#[test]
+fn sampled_vpls_carry_the_flux_the_map_saw() {
+    use gibench_harness::ir::vpl_sample::{RsmTexels, VplSampler};
+    const SIDE: u32 = 64;
+    const N: u32 = 256;
+    let texels = SIDE * SIDE;
+    let mut position = Vec::new();
+    let mut normal = Vec::new();
+    let mut flux = Vec::new();
+    for t in 0..texels {
+        let (x, y) = (t % SIDE, t / SIDE);
+        let valid = t % 7 != 0;
+        position.push(Vec3::new(x as f32, y as f32, 0.5).extend(valid as u32 as f32));
+        normal.push(
+            Vec3::new(0.1 * (x % 3) as f32, 0.2, 1.0)
+                .normalize()
+                .extend(0.0),
+        );
+        let c = if t % 11 == 0 {
+            Vec3::ZERO
+        } else if x < SIDE / 2 {
+            Vec3::new(0.8, 0.2, 0.1) * (1.0 + (t % 5) as f32)
+        } else {
+            Vec3::new(0.1, 0.3, 0.9) * (1.0 + (t % 3) as f32)
+        };
+        flux.push(c.extend(0.0));
+    }
+    let total: Vec3 = (0..texels as usize)
+        .filter(|&t| position[t].w > 0.0)
+        .map(|t| flux[t].truncate())
+        .sum();
+    let total_lum = luminance(total);
+    for backend in backends() {
+        let gpu = gpu(backend);
+        let upload = |data: &[gibench_harness::glam::Vec4]| {
+            let raw: Vec<[f32; 4]> = data.iter().map(|v| v.to_array()).collect();
+            let b = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("test rsm"),
+                size: (raw.len() * 16) as u64,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            gpu.queue.write_buffer(&b, 0, bytemuck::cast_slice(&raw));
+            b
+        };
+        let (pb, nb, fb) = (upload(&position), upload(&normal), upload(&flux));
+        let store = VplStore::new(&gpu, N).unwrap();
+        let sampler = VplSampler::new(
+            &gpu,
+            &store,
+            &RsmTexels {
+                position: &pb,
+                normal: &nb,
+                flux: &fb,
+                texels,
+            },
+            N,
+        )
+        .unwrap();
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        sampler.encode(&mut enc);
+        gpu.queue.submit([enc.finish()]);
+        let bytes = read_buffer(&gpu, store.buffer());
+        let words: Vec<u32> = bytemuck::cast_slice(&bytes[..bytes.len() / 4 * 4]).to_vec();
+        assert_eq!(words[0], N, "{backend}: slots in use");
+        let header = Vec3::new(
+            f32::from_bits(words[1]),
+            f32::from_bits(words[2]),
+            f32::from_bits(words[3]),
+        );
+        assert!(
+            (header - total).abs().max_element() < 1e-3 * total.max_element(),
+            "{backend}: header flux {header}, the texels' {total}"
+        );
+        let floats: &[f32] = bytemuck::cast_slice(&bytes[16..16 + N as usize * 80]);
+        let mut sum = Vec3::ZERO;
+        for i in 0..N as usize {
+            let v = &floats[i * 20..i * 20 + 20];
+            let (p, n, f, tg) = (
+                Vec3::new(v[0], v[1], v[2]),
+                Vec3::new(v[4], v[5], v[6]),
+                Vec3::new(v[8], v[9], v[10]),
+                Vec3::new(v[12], v[13], v[14]),
+            );
+            assert_eq!(v[3], i as f32, "{backend}: VPL {i}'s slot");
+            let t = (p.y as u32 * SIDE + p.x as u32) as usize;
+            assert!(
+                position[t].w > 0.0 && flux[t].truncate() != Vec3::ZERO,
+                "{backend}: VPL {i} on an empty or black texel {t}"
+            );
+            assert!(
+                (n - normal[t].truncate()).length() < 1e-5,
+                "{backend}: VPL {i}'s normal"
+            );
+            assert!(tg.dot(n).abs() < 1e-5 && (tg.length() - 1.0).abs() < 1e-5);
+            let lum = luminance(f);
+            assert!(
+                (lum - total_lum / N as f32).abs() < 1e-3 * total_lum / N as f32,
+                "{backend}: VPL {i}'s luminance {lum}, want {}",
+                total_lum / N as f32
+            );
+            sum += f;
+        }
+        let rel = ((sum - total) / total).abs();
+        assert!(
+            rel.max_element() < 0.02,
+            "{backend}: VPL flux {sum}, texels' {total}"
+        );
+    }
+}

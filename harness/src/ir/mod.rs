@@ -27,6 +27,8 @@
 //! * [`interleave::Interleave`] — split, combine and the geometry-aware filter (Laine et al.
 //!   2007 §5).
 //! * [`accumulate::Accumulation`] — a store and an atlas through the interleaving.
+//! * [`vpl_sample::VplSampler`] — VPLs importance-sampled by brightness from reflective
+//!   shadow-map texels into the store, on the GPU.
 //! * [`points`] — the scene's surfaces as a shuffled pool of points, uniform by area.
 //! * [`splat::PointSplat`] — imperfect shadow maps' depth: each VPL's own subset of a point
 //!   pool splatted into its paraboloid map, one dispatch for all VPLs (Ritschel et al. 2008).
@@ -44,3 +46,4 @@ pub mod pullpush;
 pub mod raster;
 pub mod splat;
 pub mod store;
+pub mod vpl_sample;

@@ -83,7 +83,9 @@ impl VplStore {
         let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("vpl store"),
             size,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            usage: wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_DST
+                | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
         Ok(VplStore { buffer, capacity })
