@@ -227,3 +227,34 @@ fn reproduce_page_has_the_papers_rows() {
     let v = verdict(&browser, &page);
     assert_eq!(v, "ok 0");
 }
+
+/// `reproduce all --html`'s index page (`reproduce-all.html`) shows the figures of the targets
+/// it ran and loads clean — from the repository root too, where the committed
+/// `results/reproduce-all.json` gives estimates but its targets' files are not in the output
+/// folder (so none of them may be listed there).
+#[test]
+fn reproduce_all_index_page_loads_clean() {
+    let Some(browser) = chromium() else { return };
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("all");
+    gibench(&[
+        "reproduce",
+        "all",
+        "--quick",
+        "--only",
+        "laine-dispersion",
+        "--html",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let page = out.join("reproduce-all.html");
+    let html = std::fs::read_to_string(&page).unwrap();
+    assert!(html.contains("src=\"laine/laine-dispersion.svg\""));
+    assert!(html.contains("href=\"laine/laine-dispersion.html\""));
+    assert!(
+        !html.contains("keller/"),
+        "a target that did not run is listed"
+    );
+    assert_clean(&browser, &page);
+}

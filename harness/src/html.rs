@@ -378,6 +378,78 @@ impl Page {
     }
 }
 
+/// One entry of an index page: a target, what it shows, and its files (relative to the page).
+pub struct IndexEntry {
+    pub name: String,
+    pub what: String,
+    /// How long it took, as shown.
+    pub time: String,
+    pub files: Vec<String>,
+}
+
+/// An index page over several outputs (`gibench reproduce all --html`): per entry its
+/// description, links to its pages and tables, and its SVG figures shown inline (as images).
+pub fn write_index(path: &Path, title: &str, command: &str, entries: &[IndexEntry]) -> Result<()> {
+    let mut body = format!(
+        "<h1>{}</h1>\n<dl class=\"provenance\"><dt>command</dt><dd><code>{}</code></dd><dt>gibench</dt><dd>{}</dd></dl>\n",
+        esc(title),
+        esc(command),
+        env!("CARGO_PKG_VERSION")
+    );
+    for e in entries {
+        let link = |f: &String| format!("<a href=\"{}\">{}</a>", esc(&url_of(f)), esc(f));
+        let pages: Vec<String> = e
+            .files
+            .iter()
+            .filter(|f| f.ends_with(".html"))
+            .map(link)
+            .collect();
+        let tables: Vec<String> = e
+            .files
+            .iter()
+            .filter(|f| f.ends_with(".md"))
+            .map(link)
+            .collect();
+        let _ = writeln!(
+            body,
+            "<h2 id=\"{}\">{}</h2>\n<p>{} <span class=\"note\">({})</span></p>",
+            esc(&e.name),
+            esc(&e.name),
+            esc(&e.what),
+            esc(&e.time)
+        );
+        if !pages.is_empty() {
+            let _ = writeln!(body, "<p>page: {}</p>", pages.join(", "));
+        }
+        if !tables.is_empty() {
+            let _ = writeln!(body, "<p>tables: {}</p>", tables.join(", "));
+        }
+        for f in e.files.iter().filter(|f| f.ends_with(".svg")) {
+            let _ = writeln!(
+                body,
+                "<figure><img class=\"plot\" src=\"{}\" alt=\"{}\"></figure>",
+                esc(&url_of(f)),
+                esc(f)
+            );
+        }
+    }
+    let html = format!(
+        "<!DOCTYPE html>\n<html lang=\"en\" data-selfcheck=\"pending\">\n<head>\n<meta charset=\"utf-8\">\n\
+         <title>{}</title>\n<style>{STYLE}</style>\n<script>{CHECK_SCRIPT}</script>\n</head>\n<body>\n{body}</body>\n</html>\n",
+        esc(title)
+    );
+    crate::error::write_atomic(path, html.as_bytes())
+}
+
+/// A relative path (with `/` separators) as a URL, each segment percent-encoded.
+fn url_of(relative: &str) -> String {
+    relative
+        .split('/')
+        .map(|seg| relative_url(Path::new("/"), &Path::new("/").join(seg)))
+        .collect::<Vec<_>>()
+        .join("/")
+}
+
 const STYLE: &str = "body{font-family:sans-serif;margin:1.5em;max-width:1400px;color:#222}\
 table{border-collapse:collapse;margin:.5em 0;font-size:14px}th,td{border:1px solid #ccc;padding:3px 7px;text-align:right}\
 th{background:#eee;cursor:pointer;user-select:none}td:first-child,th:first-child{text-align:left}\

@@ -8,7 +8,8 @@
 //! folder under `--out` is replaced (files its target did not write are removed), so the folder
 //! never mixes the files of two runs of a target. It then lists every table and figure it
 //! wrote and records them in `reproduce-all.json` / `.md` (per target: the command, the work,
-//! the estimate and the time taken).
+//! the estimate and the time taken) and `reproduce-all.html` (one page with every target's
+//! figures and links to its tables and pages).
 //!
 //! **The estimate** scales the time each target took in the last `reproduce all` recorded in
 //! the output folder (or in the committed `results/`) by the work it does now (frames ×
@@ -579,9 +580,14 @@ pub fn reproduce(args: &ReproduceArgs) -> Result<()> {
         seconds,
         estimate,
         records,
-        previous.as_ref(),
+        // Entries are carried over only from this folder's own manifest: one found elsewhere
+        // (the committed results/) only gives estimates; its files are not here.
+        previous
+            .as_ref()
+            .filter(|p| p.source == root.join(format!("{MANIFEST}.json"))),
     );
     manifest.write(&root)?;
+    manifest.write_index(&root)?;
     set.publish()?;
     println!("{}", manifest.listing(&root));
     Ok(())
@@ -886,6 +892,33 @@ impl Manifest {
         gibench_harness::error::write_atomic(&root.join(format!("{MANIFEST}.md")), md.as_bytes())
     }
 
+    /// `reproduce-all.html`: every target with its pages, tables and figures.
+    fn write_index(&self, root: &Path) -> Result<()> {
+        let entries: Vec<gibench_harness::html::IndexEntry> = self
+            .targets
+            .iter()
+            .map(|r| gibench_harness::html::IndexEntry {
+                name: r.name.clone(),
+                what: r.what.clone(),
+                time: match (r.seconds, &r.carried_from) {
+                    (_, Some(c)) => format!("from the run of git {c}"),
+                    (Some(s), None) => duration(s),
+                    (None, None) => "?".into(),
+                },
+                files: r.files.clone(),
+            })
+            .collect();
+        gibench_harness::html::write_index(
+            &root.join(format!("{MANIFEST}.html")),
+            &format!(
+                "gibench reproduce all ({} sizes) on {}",
+                self.mode, self.adapter
+            ),
+            &std::env::args().collect::<Vec<_>>().join(" "),
+            &entries,
+        )
+    }
+
     /// Every table and figure, per target, for the terminal.
     fn listing(&self, root: &Path) -> String {
         let mut out = format!(
@@ -914,6 +947,9 @@ impl Manifest {
         }
         out.push_str(&format!(
             "\n  and {MANIFEST}.json / {MANIFEST}.md: every target's command, time and files"
+        ));
+        out.push_str(&format!(
+            "\n  and {MANIFEST}.html: every target's pages, tables and figures on one page"
         ));
         out
     }
