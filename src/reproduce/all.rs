@@ -495,7 +495,7 @@ pub fn reproduce(args: &ReproduceArgs) -> Result<()> {
         .map(|g| format!("{} ({})", g.info.adapter, g.info.backend))
         .unwrap_or_else(|| "CPU only".into());
     let previous = Manifest::previous(&root);
-    let estimates: Vec<Option<f64>> = planned
+    let measured: Vec<Option<(f64, String)>> = planned
         .iter()
         .map(|p| {
             previous
@@ -503,10 +503,21 @@ pub fn reproduce(args: &ReproduceArgs) -> Result<()> {
                 .and_then(|m| m.estimate(p.target.name, p.work.units))
         })
         .collect();
+    let estimates: Vec<Option<f64>> = measured.iter().map(|m| m.as_ref().map(|e| e.0)).collect();
+    // The adapters the estimates were measured on (a CPU-only target's on any).
+    let mut sources: Vec<&str> = measured
+        .iter()
+        .zip(&planned)
+        .filter(|(_, p)| p.needs_gpu())
+        .filter_map(|(m, _)| m.as_ref().map(|e| e.1.as_str()))
+        .collect();
+    sources.sort();
+    sources.dedup();
     print_plan(
         &planned,
         &estimates,
         previous.as_ref(),
+        &sources,
         mode,
         &adapter,
         &root,
@@ -568,6 +579,11 @@ pub fn reproduce(args: &ReproduceArgs) -> Result<()> {
                 .map(|f| f.to_string_lossy().into_owned())
                 .collect(),
             carried_from: None,
+            adapter: if p.needs_gpu() {
+                adapter.clone()
+            } else {
+                "CPU only".into()
+            },
         });
     }
     overall.finish();
@@ -603,10 +619,12 @@ fn duration(seconds: f64) -> String {
     }
 }
 
+#[allow(clippy::too_many_arguments)]
 fn print_plan(
     planned: &[Planned],
     estimates: &[Option<f64>],
     previous: Option<&Manifest>,
+    sources: &[&str],
     mode: &str,
     adapter: &str,
     root: &Path,
@@ -629,14 +647,13 @@ fn print_plan(
     let unknown = estimates.iter().filter(|e| e.is_none()).count();
     match previous {
         Some(m) => eprintln!(
-            "estimate: {}{} — the times of the {} run recorded in {} (git {}, {}), scaled by the work each target does now{}",
+            "estimate: {}{} — the times of the {} run recorded in {} (on {}), scaled by the work each target does now{}",
             duration(known),
             if unknown > 0 { format!(" + {unknown} targets never timed") } else { String::new() },
             m.mode,
             m.source.display(),
-            m.git_commit,
-            m.adapter,
-            if m.adapter != adapter { "; a different adapter, so only a rough guide" } else { "" }
+            if sources.is_empty() { "the CPU".to_string() } else { sources.join("; ") },
+            if sources.iter().any(|s| *s != adapter) { "; a different adapter, so only a rough guide" } else { "" }
         ),
         None => eprintln!(
             "estimate: none — no earlier `reproduce all` is recorded in {} (the bar shows the work done instead)",
@@ -746,6 +763,9 @@ struct Record {
     files: Vec<String>,
     /// Not run this time: the entry (and its files) are from this earlier commit's run.
     carried_from: Option<String>,
+    /// The adapter the target ran on ("CPU only" for targets that need none).
+    #[serde(default)]
+    adapter: String,
 }
 
 /// `reproduce-all.json`: what the last `reproduce all` into a folder ran and wrote.
@@ -786,11 +806,17 @@ impl Manifest {
         })
     }
 
-    /// Seconds for `target` doing `units` of work, from its recorded rate.
-    fn estimate(&self, target: &str, units: u64) -> Option<f64> {
+    /// Seconds for `target` doing `units` of work, from its recorded rate, and the adapter
+    /// that rate was measured on.
+    fn estimate(&self, target: &str, units: u64) -> Option<(f64, String)> {
         let r = self.targets.iter().find(|r| r.name == target)?;
         let s = r.seconds?;
-        (r.units > 0).then(|| s * units as f64 / r.units as f64)
+        let adapter = if r.adapter.is_empty() {
+            self.adapter.clone()
+        } else {
+            r.adapter.clone()
+        };
+        (r.units > 0).then(|| (s * units as f64 / r.units as f64, adapter))
     }
 
     fn new(
@@ -809,6 +835,9 @@ impl Manifest {
                     let mut r = r.clone();
                     r.carried_from
                         .get_or_insert_with(|| prev.git_commit.clone());
+                    if r.adapter.is_empty() {
+                        r.adapter = prev.adapter.clone();
+                    }
                     targets.push(r);
                 }
             }
@@ -857,8 +886,9 @@ impl Manifest {
         let json = serde_json::to_vec_pretty(self).map_err(|e| Error::Invalid(e.to_string()))?;
         gibench_harness::error::write_atomic(&root.join(format!("{MANIFEST}.json")), &json)?;
         let mut md = format!(
-            "# gibench reproduce all ({} sizes)\n\nOn {} (driver {}), git {}, {} CPU threads: {} ({}).\n\n\
-             | target | what | command | time (estimate) | tables | figures | files |\n|---|---|---|---|---|---|---|\n",
+            "# gibench reproduce all ({} sizes)\n\nLast run: on {} (driver {}), git {}, {} CPU threads: {} ({}). \
+             Targets it did not run keep the entry of the run that made their files (\"from git …\").\n\n\
+             | target | what | command | ran on | time (estimate) | tables | figures | files |\n|---|---|---|---|---|---|---|---|\n",
             self.mode,
             self.adapter,
             self.driver,
@@ -881,10 +911,11 @@ impl Manifest {
                 (None, None) => "?".into(),
             };
             md.push_str(&format!(
-                "| {} | {} | `{}` | {time} | {} | {} | {files} |\n",
+                "| {} | {} | `{}` | {} | {time} | {} | {} | {files} |\n",
                 r.name,
                 r.what,
                 r.command,
+                r.adapter,
                 tables.join("<br>"),
                 figures.join("<br>"),
             ));
