@@ -27,6 +27,8 @@
 //! * [`interleave::Interleave`] — split, combine and the geometry-aware filter (Laine et al.
 //!   2007 §5).
 //! * [`accumulate::Accumulation`] — a store and an atlas through the interleaving.
+//! * [`rsm::ReflectiveShadowMap`] — the scene seen from the primary light: positions, normals
+//!   and reflected flux per texel, for the VPL sampler.
 //! * [`vpl_sample::VplSampler`] — VPLs importance-sampled by brightness from reflective
 //!   shadow-map texels into the store, on the GPU.
 //! * [`points`] — the scene's surfaces as a shuffled pool of points, uniform by area.
@@ -44,6 +46,7 @@ pub mod interleave;
 pub mod points;
 pub mod pullpush;
 pub mod raster;
+pub mod rsm;
 pub mod splat;
 pub mod store;
 pub mod vpl_sample;

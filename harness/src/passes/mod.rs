@@ -18,7 +18,9 @@ mod scene_gpu;
 
 pub use compose::Compose;
 pub use direct::{needed_cube_faces, DirectLight, CUBE_FACES, DIRECT_LIGHT_WGSL};
-pub use gbuffer::{scene_pipeline, GBuffer, GBufferTexels, DEPTH_FORMAT};
+pub use gbuffer::{
+    scene_pipeline, GBuffer, GBufferTexels, ALBEDO_FORMAT, DEPTH_FORMAT, NORMAL_FORMAT,
+};
 pub use scene_gpu::{
     cube_face_matrix, sun_view_matrix, DrawSet, FrameUniforms, GpuScene, Vertex, View, ViewSet,
     CAMERA_SLOT, MAX_MATERIALS,
