@@ -3,11 +3,12 @@
 
 use gibench_harness::technique::TechniqueInfo;
 
-static ALL: [TechniqueInfo; 4] = [
+static ALL: [TechniqueInfo; 5] = [
     gibench_direct::INFO,
     gibench_keller::FULL,
     gibench_keller::INCREMENTAL,
     gibench_laine::INFO,
+    gibench_ism::INFO,
 ];
 
 /// All registered techniques.

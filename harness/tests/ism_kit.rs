@@ -67,8 +67,20 @@ fn float_atlas(gpu: &GpuContext, extent: &SceneExtent, slots: u32, size: u32) ->
     .unwrap()
 }
 
-fn points_buffer(gpu: &GpuContext, points: &[Vec3]) -> wgpu::Buffer {
-    let data: Vec<[f32; 4]> = points.iter().map(|p| p.extend(1.0).to_array()).collect();
+/// The points (all of object 0, the static mesh) and the objects' transforms (identity).
+fn points_buffer(gpu: &GpuContext, points: &[Vec3]) -> (wgpu::Buffer, wgpu::Buffer) {
+    let objects = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("test objects"),
+        size: 64,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    gpu.queue.write_buffer(
+        &objects,
+        0,
+        bytemuck::cast_slice(&gibench_harness::glam::Mat4::IDENTITY.to_cols_array()),
+    );
+    let data: Vec<[f32; 4]> = points.iter().map(|p| p.extend(0.0).to_array()).collect();
     let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("test points"),
         size: (data.len() * 16) as u64,
@@ -77,7 +89,7 @@ fn points_buffer(gpu: &GpuContext, points: &[Vec3]) -> wgpu::Buffer {
     });
     gpu.queue
         .write_buffer(&buffer, 0, bytemuck::cast_slice(&data));
-    buffer
+    (buffer, objects)
 }
 
 /// Slot `slot`'s map out of the atlas, row-major.
@@ -112,8 +124,8 @@ fn pull_push_fills_holes_and_never_changes_a_valid_texel() {
         let extent = SceneExtent::of(&plane());
         let atlas = float_atlas(&gpu, &extent, 2, SIZE);
         let store = VplStore::new(&gpu, 2).unwrap();
-        let points = points_buffer(&gpu, &[Vec3::ZERO]);
-        let splat = PointSplat::new(&gpu, &store, &atlas, &points, 1, 1).unwrap();
+        let (points, objects) = points_buffer(&gpu, &[Vec3::ZERO]);
+        let splat = PointSplat::new(&gpu, &store, &atlas, &points, &objects, 1, 1).unwrap();
         // Level 0 written directly: slot 0 the ramp with holes; slot 1 empty but one texel.
         let mut level0 = vec![0u32; 2 * (SIZE * SIZE) as usize];
         for y in 0..SIZE {
@@ -202,12 +214,13 @@ fn dense_splats_of_a_plane_reproduce_its_exact_map() {
                 Vec3::new(-2.0 + 4.0 * x / n as f32, -2.0 + 4.0 * y / n as f32, 1.0)
             })
             .collect();
-        let points = points_buffer(&gpu, &pts);
+        let (points, objects) = points_buffer(&gpu, &pts);
         let splat = PointSplat::new(
             &gpu,
             &store,
             &atlas,
             &points,
+            &objects,
             pts.len() as u32,
             pts.len() as u32,
         )

@@ -98,17 +98,20 @@ pub struct VplGather {
     pub interleave: Interleave,
     pub store: VplStore,
     pub atlas: ShadowAtlas,
-    pub raster: AtlasRasteriser,
+    /// `None` when another pass writes the atlas (imperfect shadow maps).
+    pub raster: Option<AtlasRasteriser>,
     pub accumulation: Accumulation,
 }
 
 impl VplGather {
-    /// Builds the gather for at most `capacity` VPLs with `settings`, rasterising `draw_set`.
+    /// Builds the gather for at most `capacity` VPLs with `settings`, rasterising `draw_set`
+    /// into the atlas (`None`: another pass writes it; [`VplGather::render_maps`] is then an
+    /// error).
     pub fn new(
         settings: &GatherParams,
         ctx: &PrepareContext,
         capacity: u32,
-        draw_set: DrawSet,
+        draw_set: Option<DrawSet>,
     ) -> Result<VplGather> {
         let gpu = ctx.gpu;
         let output = crate::passes::indirect_target(&gpu.device, ctx.resolution, true);
@@ -135,7 +138,9 @@ impl VplGather {
                 bias: scene_settings.shadow_bias,
             },
         )?;
-        let raster = AtlasRasteriser::new(gpu, &atlas, ctx.uniforms, draw_set)?;
+        let raster = draw_set
+            .map(|set| AtlasRasteriser::new(gpu, &atlas, ctx.uniforms, set))
+            .transpose()?;
         let accumulation = Accumulation::new(
             gpu,
             &interleave,
@@ -167,9 +172,11 @@ impl VplGather {
         clear: AtlasClear,
     ) -> Result<()> {
         let (gpu, scene, uniforms) = (ctx.gpu, ctx.gpu_scene, ctx.uniforms);
+        let raster = self.raster.as_ref().ok_or_else(|| {
+            crate::Error::Invalid("this gather's atlas is written by another pass".into())
+        })?;
         let n = ctx.profiler.gpu_stage(gpu, STAGE_VPL_SHADOW_MAPS, |enc| {
-            self.raster
-                .render(gpu, enc, &self.atlas, scene, uniforms, vpls, clear)
+            raster.render(gpu, enc, &self.atlas, scene, uniforms, vpls, clear)
         })?;
         ctx.profiler.count("shadow-maps", n as f64);
         Ok(())

@@ -1,9 +1,11 @@
 //! **Point splat**: imperfect shadow maps' depth (Ritschel et al. 2008) — every VPL's own
 //! subset of a point pool splatted, one texel per point, into its paraboloid map.
 //!
-//! Reads: the point pool (world positions, `vec4<f32>` each, in random order so that any run
-//! of it is a uniform sample of the surfaces), the [`VplStore`], the [`ShadowAtlas`]'s
-//! parameters (map size, far distance, the lift of a map's centre off its VPL).
+//! Reads: the point pool (`vec4<f32>` each: position in its object's space, w = the object's
+//! index; in random order so that any run of it is a uniform sample of the surfaces), the
+//! objects' transforms (`mat4x4<f32>` each: 0 the static mesh, k + 1 mover k, written each
+//! frame by the technique), the [`VplStore`], the [`ShadowAtlas`]'s parameters (map size, far
+//! distance, the lift of a map's centre off its VPL).
 //! Writes (owns): the imperfect depth buffer, one `u32` per texel of every slot's map
 //! (`slot · size² + y · size + x`), holding the bits of the nearest point's reversed depth
 //! (1 − d / far, as the atlas stores), 0 where no point landed. [`super::pullpush::PullPush`]
@@ -62,12 +64,14 @@ pub(crate) fn texel_buffer_size(gpu: &GpuContext, texels: u64, what: &str) -> Re
 
 impl PointSplat {
     /// The pass for `store`'s slots into `atlas`'s maps, each VPL splatting `points_per_vpl`
-    /// points of `points` (a storage buffer of `pool` `vec4<f32>` positions).
+    /// points of `points` (a storage buffer of `pool` `vec4<f32>`: position, object index)
+    /// moved by `objects` (a storage buffer of `mat4x4<f32>`, one per object).
     pub fn new(
         gpu: &GpuContext,
         store: &VplStore,
         atlas: &ShadowAtlas,
         points: &wgpu::Buffer,
+        objects: &wgpu::Buffer,
         pool: u32,
         points_per_vpl: u32,
     ) -> Result<PointSplat> {
@@ -115,6 +119,7 @@ impl PointSplat {
                 params_entry(1, wgpu::ShaderStages::COMPUTE),
                 storage_entry(2, true),
                 storage_entry(3, false),
+                storage_entry(4, true),
             ],
         });
         let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -136,6 +141,10 @@ impl PointSplat {
                 wgpu::BindGroupEntry {
                     binding: 3,
                     resource: depth.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: objects.as_entire_binding(),
                 },
             ],
         });

@@ -173,7 +173,7 @@ fn create_full(
     let p = KellerParams::from_params(params)?;
     // More bounces can overshoot the count by a path's worth of VPLs.
     let capacity = p.vpls + p.bounces;
-    let gather = VplGather::new(&p.gather, ctx, capacity, DrawSet::StaticCasters)?;
+    let gather = VplGather::new(&p.gather, ctx, capacity, Some(DrawSet::StaticCasters))?;
     Ok(Box::new(KellerFull {
         gather,
         vpls: p.vpls,
@@ -314,7 +314,7 @@ fn create_incremental(
         &p.gather,
         ctx,
         ring.paths() * p.bounces,
-        DrawSet::StaticCasters,
+        Some(DrawSet::StaticCasters),
     )?;
     Ok(Box::new(KellerIncremental {
         gather,

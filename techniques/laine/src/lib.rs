@@ -168,7 +168,7 @@ pub struct Laine {
 
 fn create(params: &Params, ctx: &PrepareContext, _: &Prepared) -> Result<Box<dyn Technique>> {
     let p = LaineParams::from_params(params)?;
-    let gather = VplGather::new(&p.gather, ctx, p.max_lights, DrawSet::StaticCasters)?;
+    let gather = VplGather::new(&p.gather, ctx, p.max_lights, Some(DrawSet::StaticCasters))?;
     let manager = Manager::new(p.max_lights, p.recalc_min, p.recalc_max);
     Ok(Box::new(Laine { gather, manager }))
 }

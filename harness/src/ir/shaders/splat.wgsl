@@ -11,6 +11,8 @@ struct SplatParams {
 @group(0) @binding(1) var<storage, read> splat_params: SplatParams;
 @group(0) @binding(2) var<storage, read> points: array<vec4<f32>>;
 @group(0) @binding(3) var<storage, read_write> ism_depth: array<atomic<u32>>;
+// Object -> world per object: 0 the static mesh (identity), k + 1 mover k.
+@group(0) @binding(4) var<storage, read> objects: array<mat4x4<f32>>;
 
 // Where VPL `slot`'s subset starts in the pool: a multiplicative hash, so neighbouring slots
 // take unrelated runs of the (shuffled) pool.
@@ -31,7 +33,8 @@ fn splat(@builtin(global_invocation_id) id: vec3<u32>) {
     if (max(v.flux.x, max(v.flux.y, v.flux.z)) <= 0.0) {
         return;
     }
-    let p = points[(subset_start(slot, pool) + j) % pool].xyz;
+    let point = points[(subset_start(slot, pool) + j) % pool];
+    let p = (objects[u32(point.w)] * vec4<f32>(point.xyz, 1.0)).xyz;
     let eye = v.position.xyz + v.normal.xyz * atlas_params.distances.w;
     let d = p - eye;
     let len = length(d);

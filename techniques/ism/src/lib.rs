@@ -1,0 +1,270 @@
+//! **`ism`**: imperfect shadow maps (Ritschel et al. 2008, as the Kautz course slides present
+//! them), every frame and all on the GPU — no CPU readback inside a frame:
+//!
+//! 1. **RSM** ([`ReflectiveShadowMap`]): the scene from the primary light (cube faces around a
+//!    spot, omni or area light; the sun's orthographic map): position, normal and the flux each
+//!    texel's patch reflects.
+//! 2. **VPL sampling** ([`VplSampler`]): `vpls` VPLs importance-sampled by brightness, each
+//!    with luminance total / N, together the flux the map saw.
+//! 3. **Point splat** ([`PointSplat`]): each VPL's own run of `points-per-vpl` points of the
+//!    pool (the surfaces sampled uniformly by area once, in [`prepare`]; movers' points moved
+//!    by their transforms every frame) splatted into its paraboloid map, one dispatch.
+//! 4. **Pull-push** ([`PullPush`]): holes filled in every map at once, `pull-push-levels`
+//!    levels.
+//! 5. **Gathering**: the kit's interleaved accumulation and geometry-aware filter over the
+//!    float atlas ([`VplGather`] without a rasteriser). Direct light comes from the harness.
+//!
+//! `vpls` means what it means for every VPL technique: the VPLs lighting the frame.
+//!
+//! Deviations (README): points are splatted with a storage-buffer atomic, one texel each; the
+//! push takes the nearest parent; the strata of the VPL sampling are jittered once (fixed per
+//! VPL index); an area light's map is taken from its centre.
+//!
+//! Needs: compute shaders, storage buffers with atomics (GL ES 3.1 / Vulkan), no optional
+//! features.
+
+use gibench_harness::glam::Mat4;
+use gibench_harness::ir::atlas::{AtlasFormat, MapKind};
+use gibench_harness::ir::gather::{GatherParams, VplGather, GATHER_PARAMS};
+use gibench_harness::ir::points::{self, PoolPoint};
+use gibench_harness::ir::pullpush::PullPush;
+use gibench_harness::ir::rsm::ReflectiveShadowMap;
+use gibench_harness::ir::splat::PointSplat;
+use gibench_harness::ir::vpl_sample::{RsmTexels, VplSampler};
+use gibench_harness::quality::IndirectComponent;
+use gibench_harness::technique::{
+    Conformance, FrameContext, ParamKind, ParamSpec, Params, PrepareContext, Prepared, Technique,
+    TechniqueInfo,
+};
+use gibench_harness::{wgpu, Error, Result};
+
+/// Stage: rendering the reflective shadow map and exporting its texels.
+pub const STAGE_RSM: &str = "rsm";
+/// Stage: sampling the VPLs from the map.
+pub const STAGE_VPL_SAMPLING: &str = "vpl-sampling";
+/// Stage: splatting every VPL's points into its imperfect map.
+pub const STAGE_POINT_SPLAT: &str = "point-splat";
+/// Stage: pull-push over all maps, into the atlas.
+pub const STAGE_PULL_PUSH: &str = "pull-push";
+
+const OWN_PARAMS: &[ParamSpec] = &[
+    ParamSpec {
+        name: "vpls",
+        kind: ParamKind::Int { min: 1, max: 4096 },
+        default: "64",
+        doc: "VPLs lighting each frame, importance-sampled from the reflective shadow map (the slides: 1024)",
+    },
+    ParamSpec {
+        name: "points-per-vpl",
+        kind: ParamKind::Int { min: 1, max: 1 << 20 },
+        default: "1024",
+        doc: "points splatted into each VPL's imperfect map (the slides: 8k)",
+    },
+    ParamSpec {
+        name: "point-pool",
+        kind: ParamKind::Int { min: 1, max: 1 << 24 },
+        default: "65536",
+        doc: "points sampled on the surfaces once; each VPL takes its own run of them",
+    },
+    ParamSpec {
+        name: "rsm-size",
+        kind: ParamKind::Int { min: 8, max: 2048 },
+        default: "64",
+        doc: "edge of each face of the reflective shadow map, texels",
+    },
+    ParamSpec {
+        name: "pull-push-levels",
+        kind: ParamKind::Int { min: 0, max: 12 },
+        default: "3",
+        doc: "pyramid levels of the pull-push: holes up to 2^levels texels wide are filled (0: none)",
+    },
+];
+
+/// The kit's gather parameters that apply to imperfect maps: tiles, map size, clamp (the maps
+/// are always paraboloid, in a float atlas).
+const GATHER: &[ParamSpec] = &[GATHER_PARAMS[0], GATHER_PARAMS[2], GATHER_PARAMS[4]];
+
+/// `ism` registry entry.
+pub const INFO: TechniqueInfo = TechniqueInfo {
+    name: "ism",
+    description:
+        "Ritschel et al. 2008 imperfect shadow maps: RSM-sampled VPLs, point splats, pull-push",
+    params: &[OWN_PARAMS, GATHER],
+    required_features: wgpu::Features::empty(),
+    required_limits: wgpu::Limits::downlevel_defaults,
+    reference: IndirectComponent::OneBounce,
+    // On the Cornell boxes against the one-bounce reference (64 VPLs, 1024 points each, 4x4
+    // tiles, 3 pull-push levels): measured relative L1 0.34–0.69 and mean ratio 0.93–0.94 on
+    // the spot, area and omni boxes, 1.14 on the sun box, where light leaks through holes the
+    // pull-push leaves open (the bias there falls from +29 % without pull-push to +12 % at 3
+    // levels and +8 % at 6; more points per VPL do not change it) — the imperfection the paper
+    // trades for speed, measured rather than hidden.
+    conformance: Conformance {
+        max_relative_l1: 0.8,
+        mean_ratio: (0.88, 1.2),
+    },
+    prepare,
+    create,
+};
+
+/// The parameters, read once.
+#[derive(Clone, Copy, Debug)]
+pub struct IsmParams {
+    pub vpls: u32,
+    pub points_per_vpl: u32,
+    pub pool: u32,
+    pub rsm_size: u32,
+    pub levels: u32,
+    pub gather: GatherParams,
+}
+
+impl IsmParams {
+    pub fn from_params(params: &Params) -> Result<IsmParams> {
+        let p = IsmParams {
+            vpls: params.int("vpls") as u32,
+            points_per_vpl: params.int("points-per-vpl") as u32,
+            pool: params.int("point-pool") as u32,
+            rsm_size: params.int("rsm-size") as u32,
+            levels: params.int("pull-push-levels") as u32,
+            gather: GatherParams {
+                tiles: params.tiles("tiles"),
+                map: MapKind::Paraboloid,
+                map_size: params.int("vpl-map-size") as u32,
+                format: AtlasFormat::Float32,
+                clamp: params.float("clamp") as f32,
+            },
+        };
+        if p.points_per_vpl > p.pool {
+            return Err(Error::param(
+                "points-per-vpl",
+                format!(
+                    "{} points per VPL from a pool of {} (point-pool): a VPL cannot take more points than the pool has",
+                    p.points_per_vpl, p.pool
+                ),
+            ));
+        }
+        Ok(p)
+    }
+}
+
+/// The point pool, sampled once per scene.
+struct IsmPrepared {
+    pool: Vec<PoolPoint>,
+}
+
+fn prepare(params: &Params, ctx: &PrepareContext) -> Result<Prepared> {
+    let p = IsmParams::from_params(params)?;
+    Ok(Box::new(IsmPrepared {
+        pool: points::sample_scene(ctx.scene, p.pool, ctx.seed)?,
+    }))
+}
+
+/// `ism`.
+pub struct Ism {
+    gather: VplGather,
+    rsm: ReflectiveShadowMap,
+    sampler: VplSampler,
+    splat: PointSplat,
+    pullpush: PullPush,
+    /// Object → world per object (0: the static mesh), written every frame.
+    objects: wgpu::Buffer,
+    _points: wgpu::Buffer,
+    vpls: u32,
+}
+
+fn create(
+    params: &Params,
+    ctx: &PrepareContext,
+    prepared: &Prepared,
+) -> Result<Box<dyn Technique>> {
+    let p = IsmParams::from_params(params)?;
+    let pool = &prepared
+        .downcast_ref::<IsmPrepared>()
+        .ok_or_else(|| Error::Invalid("ism: built without its preparation".into()))?
+        .pool;
+    let gpu = ctx.gpu;
+    let device = &gpu.device;
+    let gather = VplGather::new(&p.gather, ctx, p.vpls, None)?;
+    let rsm = ReflectiveShadowMap::new(gpu, ctx.gpu_scene, ctx.uniforms, p.rsm_size)?;
+    let [position, normal, flux] = rsm.buffers();
+    let sampler = VplSampler::new(
+        gpu,
+        &gather.store,
+        &RsmTexels {
+            position,
+            normal,
+            flux,
+            texels: rsm.texels(),
+        },
+        p.vpls,
+    )?;
+    let data: Vec<[f32; 4]> = pool
+        .iter()
+        .map(|q| q.position.extend(q.object as f32).to_array())
+        .collect();
+    let points = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("ism point pool"),
+        size: (data.len().max(1) * 16) as u64,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    gpu.queue
+        .write_buffer(&points, 0, bytemuck::cast_slice(&data));
+    let objects = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("ism objects"),
+        size: 64 * (1 + ctx.scene.movers.len() as u64),
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let splat = PointSplat::new(
+        gpu,
+        &gather.store,
+        &gather.atlas,
+        &points,
+        &objects,
+        pool.len() as u32,
+        p.points_per_vpl,
+    )?;
+    let pullpush = PullPush::new(gpu, &splat, &gather.atlas, p.levels)?;
+    Ok(Box::new(Ism {
+        gather,
+        rsm,
+        sampler,
+        splat,
+        pullpush,
+        objects,
+        _points: points,
+        vpls: p.vpls,
+    }))
+}
+
+impl Technique for Ism {
+    fn render(&mut self, ctx: &mut FrameContext) -> Result<()> {
+        let gpu = ctx.gpu;
+        let (scene, uniforms) = (ctx.gpu_scene, ctx.uniforms);
+        let directional = ctx.frame.light.is_directional();
+        let transforms: Vec<[f32; 16]> = std::iter::once(Mat4::IDENTITY)
+            .chain(ctx.frame.movers.iter().copied())
+            .map(|m| m.to_cols_array())
+            .collect();
+        gpu.queue
+            .write_buffer(&self.objects, 0, bytemuck::cast_slice(&transforms));
+        ctx.profiler.gpu_stage(gpu, STAGE_RSM, |enc| {
+            self.rsm.encode(gpu, enc, scene, uniforms, directional)
+        })?;
+        ctx.profiler
+            .gpu_stage(gpu, STAGE_VPL_SAMPLING, |enc| self.sampler.encode(enc))?;
+        let atlas = &self.gather.atlas;
+        ctx.profiler
+            .gpu_stage(gpu, STAGE_POINT_SPLAT, |enc| self.splat.encode(enc, atlas))?;
+        ctx.profiler
+            .gpu_stage(gpu, STAGE_PULL_PUSH, |enc| self.pullpush.encode(enc))?;
+        ctx.profiler.count("vpls", self.vpls as f64);
+        ctx.profiler.count("shadow-maps", self.vpls as f64);
+        self.gather.gather_store(ctx)
+    }
+
+    fn output(&self) -> &wgpu::TextureView {
+        self.gather.output()
+    }
+}
