@@ -163,6 +163,10 @@ fn reproduce_all_lists_every_target_and_runs_nothing() {
         "laine-quality",
         "laine-sibenik-vpls",
         "laine-sibenik-1024",
+        "ism-points",
+        "ism-map-size",
+        "ism-vpls",
+        "ism-tiles",
     ] {
         assert!(
             stderr.lines().any(|l| l.trim_start().starts_with(target)),

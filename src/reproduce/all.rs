@@ -199,6 +199,42 @@ pub const TARGETS: &[Target] = &[
             paper: "run --scene sibenik --technique laine,keller-full --param vpls=1024 --param vpl-map-size=256 --resolution 1024x768 --shadow-size 1024 --frames 200 --warmup 20 --no-images",
         },
     },
+    Target {
+        name: "ism-points",
+        dir: "ism/points",
+        what: "ism against the points splatted per VPL (the slides' first tunable): time and error",
+        kind: Kind::Command {
+            quick: "sweep --technique ism --sweep points-per-vpl=1024,2048,4096,8192,16384 --param vpls=256 --quality --frames 8 --warmup 3 --timing stages",
+            paper: "sweep --scene sponza --technique ism --sweep points-per-vpl=1024,2048,4096,8192,16384 --param vpls=1024 --param vpl-map-size=256 --param point-pool=1048576 --quality --frames 8 --warmup 3 --timing stages",
+        },
+    },
+    Target {
+        name: "ism-map-size",
+        dir: "ism/map-size",
+        what: "ism against the imperfect map size (the slides' second tunable): time and error",
+        kind: Kind::Command {
+            quick: "sweep --technique ism --sweep vpl-map-size=64,128,256 --param vpls=256 --param points-per-vpl=8192 --quality --frames 8 --warmup 3 --timing stages",
+            paper: "sweep --scene sponza --technique ism --sweep vpl-map-size=64,128,256 --param vpls=1024 --param points-per-vpl=8192 --param point-pool=1048576 --quality --frames 8 --warmup 3 --timing stages",
+        },
+    },
+    Target {
+        name: "ism-vpls",
+        dir: "ism/vpls",
+        what: "ism against the VPL count: time and error",
+        kind: Kind::Command {
+            quick: "sweep --technique ism --sweep vpls=256,512,1024 --quality --frames 8 --warmup 3 --timing stages",
+            paper: "sweep --scene sponza --technique ism --sweep vpls=256,512,1024 --param vpl-map-size=256 --param points-per-vpl=8192 --param point-pool=1048576 --quality --frames 8 --warmup 3 --timing stages",
+        },
+    },
+    Target {
+        name: "ism-tiles",
+        dir: "ism/tiles",
+        what: "ism against the tile count at 1024 VPLs (16 of 1024 per pixel at 8x8)",
+        kind: Kind::Command {
+            quick: "sweep --technique ism --sweep tiles=4x4,8x8,16x16 --param vpls=1024 --quality --frames 8 --warmup 3 --timing stages",
+            paper: "sweep --scene sponza --technique ism --sweep tiles=4x4,8x8,16x16 --param vpls=1024 --param vpl-map-size=256 --param points-per-vpl=8192 --param point-pool=1048576 --quality --frames 8 --warmup 3 --timing stages",
+        },
+    },
 ];
 
 impl Target {
