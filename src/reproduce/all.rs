@@ -679,9 +679,17 @@ fn print_plan(
             p.command
         );
     }
-    let known: f64 = estimates.iter().flatten().sum();
+    let known: f64 = estimates.iter().flatten().sum::<f64>().max(0.0);
     let unknown = estimates.iter().filter(|e| e.is_none()).count();
     match previous {
+        Some(_) if unknown == estimates.len() => eprintln!(
+            "estimate: none — the run recorded in {} timed none of these targets",
+            Manifest::places(root)
+                .iter()
+                .map(|p| p.display().to_string())
+                .collect::<Vec<_>>()
+                .join(" or ")
+        ),
         Some(m) => eprintln!(
             "estimate: {}{} — the times of the {} run recorded in {} (on {}), scaled by the work each target does now{}",
             duration(known),
