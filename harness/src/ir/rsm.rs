@@ -19,9 +19,9 @@
 use super::splat::texel_buffer_size;
 use crate::gpu::GpuContext;
 use crate::passes::{
-    compute_pipeline, params_entry, render_target, scene_pipeline, storage_entry, texture_entry,
-    uniform_entry, DrawSet, FrameUniforms, GpuScene, ALBEDO_FORMAT, DEPTH_FORMAT, NORMAL_FORMAT,
-    PARAMS_USAGE,
+    begin_gbuffer_pass, compute_pipeline, draw_light_faces, params_entry, render_target,
+    scene_pipeline, storage_entry, texture_entry, uniform_entry, FrameUniforms, GpuScene,
+    ALBEDO_FORMAT, DEPTH_FORMAT, NORMAL_FORMAT, PARAMS_USAGE,
 };
 use crate::Result;
 
@@ -203,53 +203,16 @@ impl ReflectiveShadowMap {
             0,
             bytemuck::bytes_of(&[self.size, faces, 0, 0]),
         );
-        let clear = wgpu::Operations {
-            load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-            store: wgpu::StoreOp::Store,
-        };
         {
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("rsm"),
-                color_attachments: &[
-                    Some(wgpu::RenderPassColorAttachment {
-                        view: &self.normal_view,
-                        depth_slice: None,
-                        resolve_target: None,
-                        ops: clear,
-                    }),
-                    Some(wgpu::RenderPassColorAttachment {
-                        view: &self.albedo_view,
-                        depth_slice: None,
-                        resolve_target: None,
-                        ops: clear,
-                    }),
-                ],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &self.depth_view,
-                    depth_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(0.0),
-                        store: wgpu::StoreOp::Store,
-                    }),
-                    stencil_ops: None,
-                }),
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
+            let mut pass = begin_gbuffer_pass(
+                encoder,
+                "rsm",
+                &self.normal_view,
+                &self.albedo_view,
+                &self.depth_view,
+            );
             pass.set_pipeline(&self.pipeline);
-            pass.set_bind_group(2, &scene.material_group, &[]);
-            let s = self.size;
-            for f in 0..faces {
-                let (x, y) = ((f % 3) * s, (f / 3) * s);
-                pass.set_viewport(x as f32, y as f32, s as f32, s as f32, 0.0, 1.0);
-                pass.set_scissor_rect(x, y, s, s);
-                pass.set_bind_group(
-                    0,
-                    uniforms.views.group(),
-                    &[uniforms.views.offset(1 + f as usize)],
-                );
-                scene.draw(&mut pass, uniforms, 1, DrawSet::StaticAndMovers);
-            }
+            draw_light_faces(&mut pass, scene, uniforms, self.size, 0..faces as usize);
         }
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("rsm export"),

@@ -72,6 +72,30 @@ pub struct DirectLight {
     pub irradiance_view: wgpu::TextureView,
 }
 
+/// Draws the scene (static meshes and movers) into faces `faces` of a 3x2 atlas of
+/// `size`² faces, each with the light's view for that face (view slots 1..=6; the sun's one
+/// map is face 0), with the pass's pipeline already set. Returns the faces drawn. The direct
+/// shadow map and the reflective shadow map share it.
+pub fn draw_light_faces(
+    pass: &mut wgpu::RenderPass,
+    scene: &GpuScene,
+    uniforms: &FrameUniforms,
+    size: u32,
+    faces: impl Iterator<Item = usize>,
+) -> u32 {
+    pass.set_bind_group(2, &scene.material_group, &[]);
+    let mut rendered = 0;
+    for f in faces {
+        let (x, y) = ((f as u32 % 3) * size, (f as u32 / 3) * size);
+        pass.set_viewport(x as f32, y as f32, size as f32, size as f32, 0.0, 1.0);
+        pass.set_scissor_rect(x, y, size, size);
+        pass.set_bind_group(0, uniforms.views.group(), &[uniforms.views.offset(1 + f)]);
+        scene.draw(pass, uniforms, 1, super::DrawSet::StaticAndMovers);
+        rendered += 1;
+    }
+    rendered
+}
+
 impl DirectLight {
     pub fn new(
         gpu: &GpuContext,
@@ -197,18 +221,13 @@ impl DirectLight {
             multiview_mask: None,
         });
         pass.set_pipeline(&self.depth_pipeline);
-        pass.set_bind_group(2, &scene.material_group, &[]);
-        let s = self.face_size;
-        let mut rendered = 0;
-        for f in (0..6).filter(|f| needed[*f]) {
-            let (x, y) = ((f as u32 % 3) * s, (f as u32 / 3) * s);
-            pass.set_viewport(x as f32, y as f32, s as f32, s as f32, 0.0, 1.0);
-            pass.set_scissor_rect(x, y, s, s);
-            pass.set_bind_group(0, uniforms.views.group(), &[uniforms.views.offset(1 + f)]);
-            scene.draw(&mut pass, uniforms, 1, super::DrawSet::StaticAndMovers);
-            rendered += 1;
-        }
-        rendered
+        draw_light_faces(
+            &mut pass,
+            scene,
+            uniforms,
+            self.face_size,
+            (0..6).filter(|f| needed[*f]),
+        )
     }
 
     /// Records the direct-lighting pass.

@@ -115,6 +115,44 @@ pub fn scene_pipeline(
     })
 }
 
+/// Begins a render pass into G-buffer-shaped targets (normal, albedo, reversed-Z depth), all
+/// cleared: the camera's G-buffer and the reflective shadow map's faces share it.
+pub fn begin_gbuffer_pass<'e>(
+    encoder: &'e mut wgpu::CommandEncoder,
+    label: &str,
+    normal: &wgpu::TextureView,
+    albedo: &wgpu::TextureView,
+    depth: &wgpu::TextureView,
+) -> wgpu::RenderPass<'e> {
+    let clear = wgpu::Operations {
+        load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+        store: wgpu::StoreOp::Store,
+    };
+    let color = |view| {
+        Some(wgpu::RenderPassColorAttachment {
+            view,
+            depth_slice: None,
+            resolve_target: None,
+            ops: clear,
+        })
+    };
+    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some(label),
+        color_attachments: &[color(normal), color(albedo)],
+        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+            view: depth,
+            depth_ops: Some(wgpu::Operations {
+                load: wgpu::LoadOp::Clear(0.0),
+                store: wgpu::StoreOp::Store,
+            }),
+            stencil_ops: None,
+        }),
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    })
+}
+
 impl GBuffer {
     pub fn new(gpu: &GpuContext, scene: &GpuScene, uniforms: &FrameUniforms) -> GBuffer {
         let device = &gpu.device;
@@ -223,38 +261,13 @@ impl GBuffer {
         scene: &GpuScene,
         uniforms: &FrameUniforms,
     ) {
-        let clear = wgpu::Operations {
-            load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-            store: wgpu::StoreOp::Store,
-        };
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("gbuffer"),
-            color_attachments: &[
-                Some(wgpu::RenderPassColorAttachment {
-                    view: &self.normal_view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: clear,
-                }),
-                Some(wgpu::RenderPassColorAttachment {
-                    view: &self.albedo_view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: clear,
-                }),
-            ],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &self.depth_view,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(0.0),
-                    store: wgpu::StoreOp::Store,
-                }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let mut pass = begin_gbuffer_pass(
+            encoder,
+            "gbuffer",
+            &self.normal_view,
+            &self.albedo_view,
+            &self.depth_view,
+        );
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(
             0,

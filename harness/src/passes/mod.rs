@@ -17,9 +17,10 @@ mod gbuffer;
 mod scene_gpu;
 
 pub use compose::Compose;
-pub use direct::{needed_cube_faces, DirectLight, CUBE_FACES, DIRECT_LIGHT_WGSL};
+pub use direct::{draw_light_faces, needed_cube_faces, DirectLight, CUBE_FACES, DIRECT_LIGHT_WGSL};
 pub use gbuffer::{
-    scene_pipeline, GBuffer, GBufferTexels, ALBEDO_FORMAT, DEPTH_FORMAT, NORMAL_FORMAT,
+    begin_gbuffer_pass, scene_pipeline, GBuffer, GBufferTexels, ALBEDO_FORMAT, DEPTH_FORMAT,
+    NORMAL_FORMAT,
 };
 pub use scene_gpu::{
     cube_face_matrix, sun_view_matrix, DrawSet, FrameUniforms, GpuScene, Vertex, View, ViewSet,
