@@ -166,8 +166,10 @@ pub struct Ism {
     sampler: VplSampler,
     splat: PointSplat,
     pullpush: PullPush,
-    /// Object → world per object (0: the static mesh), written every frame.
+    /// Object → world per object (0: the static mesh, the identity; k + 1: mover k, written
+    /// every frame from `mover_transforms`, kept to reuse its allocation).
     objects: wgpu::Buffer,
+    mover_transforms: Vec<[f32; 16]>,
     _points: wgpu::Buffer,
     vpls: u32,
 }
@@ -216,6 +218,11 @@ fn create(
         usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
         mapped_at_creation: false,
     });
+    gpu.queue.write_buffer(
+        &objects,
+        0,
+        bytemuck::cast_slice(&Mat4::IDENTITY.to_cols_array()),
+    );
     let splat = PointSplat::new(
         gpu,
         &gather.store,
@@ -233,6 +240,7 @@ fn create(
         splat,
         pullpush,
         objects,
+        mover_transforms: Vec::with_capacity(ctx.scene.movers.len()),
         _points: points,
         vpls: p.vpls,
     }))
@@ -243,12 +251,17 @@ impl Technique for Ism {
         let gpu = ctx.gpu;
         let (scene, uniforms) = (ctx.gpu_scene, ctx.uniforms);
         let directional = ctx.frame.light.is_directional();
-        let transforms: Vec<[f32; 16]> = std::iter::once(Mat4::IDENTITY)
-            .chain(ctx.frame.movers.iter().copied())
-            .map(|m| m.to_cols_array())
-            .collect();
-        gpu.queue
-            .write_buffer(&self.objects, 0, bytemuck::cast_slice(&transforms));
+        // Object 0 (the static mesh) stays the identity written at creation; only movers move.
+        if !ctx.frame.movers.is_empty() {
+            self.mover_transforms.clear();
+            self.mover_transforms
+                .extend(ctx.frame.movers.iter().map(|m| m.to_cols_array()));
+            gpu.queue.write_buffer(
+                &self.objects,
+                64,
+                bytemuck::cast_slice(&self.mover_transforms),
+            );
+        }
         ctx.profiler.gpu_stage(gpu, STAGE_RSM, |enc| {
             self.rsm.encode(gpu, enc, scene, uniforms, directional)
         })?;
