@@ -1,8 +1,9 @@
 //! `gibench compare` on real runs: three repeats of `direct` each for BASE, SAME (the same
-//! build) and SLOW (the same build with `compose` slowed by 3 ms through the test hook
-//! `GIBENCH_TEST_SLOW_STAGE`), run alternating. SAME against BASE is "unchanged" for every
-//! stage; SLOW against BASE is "slower" for `compose` and for nothing else. Two repeats are
-//! refused.
+//! build) and SLOW (the same build with 3 ms added to `compose`'s recorded times through the
+//! test hook `GIBENCH_TEST_SLOW_STAGE`, which leaves the other stages' execution untouched),
+//! run alternating. SAME against BASE is "unchanged" for every stage; SLOW against BASE is
+//! "slower" for `compose` and for nothing else, and SLOW's results carry the hook's warning.
+//! Two repeats are refused.
 
 use std::path::Path;
 use std::process::Command;
@@ -91,6 +92,19 @@ fn compare_finds_the_slowed_stage_and_only_it() {
         };
         assert_eq!(verdict, want, "{stage}");
     }
+    let warned = |side: &str| {
+        let f = std::fs::read_dir(dir.join(side).join("r0"))
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .find(|p| p.extension().is_some_and(|e| e == "json"))
+            .unwrap();
+        let v: serde_json::Value = serde_json::from_slice(&std::fs::read(&f).unwrap()).unwrap();
+        v["warnings"].as_array().is_some_and(|w| {
+            w.iter()
+                .any(|w| w.as_str().unwrap().contains("GIBENCH_TEST_SLOW_STAGE"))
+        })
+    };
+    assert!(warned("slow") && !warned("base"));
     std::fs::remove_dir_all(dir.join("same/r2")).unwrap();
     let (ok, _, stderr) = compare(dir, "base", "same");
     assert!(

@@ -45,9 +45,13 @@ struct StageSeries {
     cpu: Vec<f64>,
 }
 
-/// A deliberate slowdown for testing `gibench compare`: `GIBENCH_TEST_SLOW_STAGE=NAME:MS` makes
-/// the stage NAME busy-wait MS milliseconds on the CPU inside its timed span. Read once per
-/// profiler; never set in benchmark runs.
+/// A deliberate slowdown for testing `gibench compare`: `GIBENCH_TEST_SLOW_STAGE=NAME:MS` adds
+/// MS milliseconds to the stage NAME. In stages mode the milliseconds are added to the stage's
+/// recorded wall time and nothing waits, so the other stages run exactly as without the hook (a
+/// real busy-wait between two flushed stages let lavapipe's worker threads fall asleep and made
+/// the *next* stage slower too); in frame mode the stage busy-waits on the CPU, since only a
+/// real delay reaches the frame time. Read once per profiler; a run with it set says so in its
+/// results' warnings ([`Profiler::test_hook_warning`]); never set in benchmark runs.
 fn slow_stage_hook() -> Option<(String, f64)> {
     let v = std::env::var("GIBENCH_TEST_SLOW_STAGE").ok()?;
     let (name, ms) = v.split_once(':')?;
@@ -204,8 +208,7 @@ impl Profiler {
                 }
                 gpu.queue.submit([enc.finish()]);
                 gpu.flush()?;
-                self.slow_down(name);
-                let ms = t0.elapsed().as_secs_f64() * 1e3;
+                let ms = t0.elapsed().as_secs_f64() * 1e3 + self.added_ms(name);
                 self.record_wall(idx, ms);
                 Ok(r)
             }
@@ -218,8 +221,10 @@ impl Profiler {
         let c0 = crate::calibrate::thread_cpu_ms();
         let t0 = Instant::now();
         let r = work();
-        self.slow_down(name);
-        let ms = t0.elapsed().as_secs_f64() * 1e3;
+        if self.mode == ProfileMode::Frame {
+            self.slow_down(name);
+        }
+        let ms = t0.elapsed().as_secs_f64() * 1e3 + self.added_ms(name);
         if let (Some(c0), Some(c1), true) = (c0, crate::calibrate::thread_cpu_ms(), self.recording)
         {
             self.series[idx].cpu.push(c1 - c0);
@@ -228,7 +233,24 @@ impl Profiler {
         r
     }
 
-    /// The [`slow_stage_hook`], if it names this stage.
+    /// The [`slow_stage_hook`]'s milliseconds added to this stage's recorded time (stages mode).
+    fn added_ms(&self, name: &str) -> f64 {
+        match &self.slow {
+            Some((stage, ms)) if self.mode == ProfileMode::Stages && stage == name => *ms,
+            _ => 0.0,
+        }
+    }
+
+    /// A warning for the results when the [`slow_stage_hook`] is set.
+    pub fn test_hook_warning(&self) -> Option<String> {
+        self.slow.as_ref().map(|(stage, ms)| {
+            format!(
+                "GIBENCH_TEST_SLOW_STAGE was set: stage {stage} was slowed by {ms} ms on purpose (a test hook); these timings are not a benchmark"
+            )
+        })
+    }
+
+    /// The [`slow_stage_hook`] in frame mode: a real busy-wait, if it names this stage.
     fn slow_down(&self, name: &str) {
         if let Some((stage, ms)) = &self.slow {
             if stage == name {

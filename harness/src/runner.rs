@@ -392,6 +392,7 @@ impl<'a> Harness<'a> {
         let mut frame_result = None;
         let mut first_frame_ms = None;
         let mut images = None;
+        let mut hook_warning = None;
         for &mode in config.timing.passes() {
             let (mut technique, compose) = self.build(info, params, config, prepared)?;
             let mut profiler = Profiler::new(self.gpu, mode);
@@ -408,6 +409,7 @@ impl<'a> Harness<'a> {
                 progress();
             }
             profiler.finish(self.gpu)?;
+            hook_warning = profiler.test_hook_warning();
             match mode {
                 ProfileMode::Stages => {
                     stages = profiler.stage_results();
@@ -479,6 +481,7 @@ impl<'a> Harness<'a> {
         let images = images.expect("at least one timing pass");
         let mut result = result;
         result.warnings = images.saturation_warnings();
+        result.warnings.extend(hook_warning);
         Ok((result, images))
     }
 
