@@ -3,12 +3,13 @@
 
 use gibench_harness::technique::TechniqueInfo;
 
-static ALL: [TechniqueInfo; 5] = [
+static ALL: [TechniqueInfo; 6] = [
     gibench_direct::INFO,
     gibench_keller::FULL,
     gibench_keller::INCREMENTAL,
     gibench_laine::INFO,
     gibench_ism::INFO,
+    gibench_ism::INFO_CLASSIC,
 ];
 
 /// All registered techniques.

@@ -104,6 +104,98 @@ fn laine_management_records_spot_and_omni_at_256_and_1024() {
     assert_eq!(v["frames"].as_u64(), Some(4));
 }
 
+#[test]
+fn ism_breakdown_has_the_stages_the_published_figures_and_the_ratios() {
+    let tmp = tempfile::tempdir().unwrap();
+    reproduce("ism-breakdown", tmp.path());
+    let md = std::fs::read_to_string(tmp.path().join("ism-breakdown.md")).unwrap();
+    for col in [
+        "RSM",
+        "VPL sampling",
+        "VPL maps",
+        "point splat",
+        "pull-push",
+        "gathering",
+        "filter",
+        "FPS",
+        "maps ÷ ISM maps",
+        "FPS ism ÷ FPS",
+    ] {
+        assert!(md.contains(col), "the breakdown lacks '{col}'");
+    }
+    // The published figures, from results/papers/ism2008.json, labelled with their sources.
+    assert!(md.contains("| Ritschel et al. 2008, course slides (NVIDIA GeForce 8800 GTX, 2008) | ISM | Christo's Sponza (70k) | not stated | 1024 | 256² | 8192 |"), "{md}");
+    assert!(
+        md.contains("| 440–660 |")
+            && md.contains("| 10–15 |")
+            && md.contains("| ~10 |")
+            && md.contains("| > 11 |"),
+        "{md}"
+    );
+    assert!(
+        md.contains("| Linke, master's thesis (GTX 980 at base clock) |")
+            && md.contains("| 0.39 + 0.85 |")
+            && md.contains("| 2.70 |"),
+        "{md}"
+    );
+    // Our three rows at equal terms, their maps counted, and the ratios computed from the
+    // rows' own columns.
+    let rows = technique_rows(&tmp.path().join("ism-breakdown.csv"));
+    let num = |t: &str, c: &str| -> f64 { rows[t][c].parse().unwrap_or(f64::NAN) };
+    for t in ["ism", "ism-classic", "keller-full"] {
+        assert_eq!(rows[t]["VPLs (mean / min)"], "256.0 / 256", "{t}");
+        let r: serde_json::Value = serde_json::from_slice(
+            &std::fs::read(tmp.path().join(format!("runs/cornell-{t}-256x192.json"))).unwrap(),
+        )
+        .unwrap();
+        assert_eq!(
+            r["counters"]["shadow-maps"]["mean"].as_f64(),
+            Some(256.0),
+            "{t}"
+        );
+    }
+    let ism_maps = num("ism", "VPL maps");
+    // (The CSV rounds milliseconds to 4 decimals, ratios to 2, FPS to 1.)
+    assert!((num("ism", "point splat") + num("ism", "pull-push") - ism_maps).abs() <= 2e-4);
+    for t in ["ism-classic", "keller-full"] {
+        let ratio = num(t, "VPL maps") / ism_maps;
+        assert!(
+            (num(t, "maps ÷ ISM maps") - ratio).abs() <= 0.006,
+            "{t}: {ratio}"
+        );
+        let fps = num("ism", "FPS") / num(t, "FPS");
+        let spread = fps * (0.05 / num("ism", "FPS") + 0.05 / num(t, "FPS")) + 0.006;
+        assert!(
+            (num(t, "FPS ism ÷ FPS") - fps).abs() <= spread,
+            "{t}: {fps}"
+        );
+    }
+    assert!(rows["ism"]["maps ÷ ISM maps"].is_empty());
+    for f in ["ism-breakdown.csv", "ism-breakdown.tex"] {
+        assert!(tmp.path().join(f).is_file(), "{f}");
+    }
+}
+
+/// The `gibench` rows of a table's CSV by their `technique` column, as column name → text.
+fn technique_rows(
+    csv: &std::path::Path,
+) -> std::collections::HashMap<String, std::collections::HashMap<String, String>> {
+    let text = std::fs::read_to_string(csv).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    lines
+        .filter(|l| l.starts_with("gibench,"))
+        .map(|l| {
+            let row: std::collections::HashMap<String, String> = header
+                .iter()
+                .zip(l.split(','))
+                .map(|(h, v)| (h.to_string(), v.to_string()))
+                .collect();
+            (row["technique"].clone(), row)
+        })
+        .collect()
+}
+
 /// The first `gibench` row of a table's CSV, as column name → number.
 fn gibench_row(csv: &std::path::Path) -> std::collections::HashMap<String, f64> {
     let text = std::fs::read_to_string(csv).unwrap();

@@ -25,13 +25,13 @@ use gibench_harness::output::OutputSet;
 use gibench_harness::report;
 use gibench_harness::{Error, Result};
 
-use super::{laine2007, out_dir, ReproduceArgs};
+use super::{ism2008, laine2007, out_dir, PaperModule, ReproduceArgs};
 use crate::{Bars, Job};
 
 /// How a target is produced.
 pub enum Kind {
     /// A typed reproduction of a paper module (it reads `--quick` and `--frames` itself).
-    Paper,
+    Paper(&'static PaperModule),
     /// A gibench command: its arguments (without `--out`) at quick and at paper sizes.
     Command {
         quick: &'static str,
@@ -131,19 +131,19 @@ pub const TARGETS: &[Target] = &[
         name: "laine-tables",
         dir: "laine",
         what: "",
-        kind: Kind::Paper,
+        kind: Kind::Paper(&laine2007::MODULE),
     },
     Target {
         name: "laine-management",
         dir: "laine",
         what: "",
-        kind: Kind::Paper,
+        kind: Kind::Paper(&laine2007::MODULE),
     },
     Target {
         name: "laine-dispersion",
         dir: "laine",
         what: "",
-        kind: Kind::Paper,
+        kind: Kind::Paper(&laine2007::MODULE),
     },
     Target {
         name: "laine-tiles",
@@ -235,13 +235,28 @@ pub const TARGETS: &[Target] = &[
             paper: "sweep --scene sponza --technique ism --sweep tiles=4x4,8x8,16x16 --param vpls=1024 --param vpl-map-size=256 --param points-per-vpl=8192 --param point-pool=1048576 --quality --frames 8 --warmup 3 --timing stages",
         },
     },
+    Target {
+        name: "ism-quality",
+        dir: "ism/quality",
+        what: "per-frame error and flicker of ism, ism-classic (the same VPLs, classic maps) and keller-full at equal VPL counts, the light and a mover moving",
+        kind: Kind::Command {
+            quick: "run --technique ism,ism-classic,keller-full --param vpls=256 --param ism.points-per-vpl=8192 --quality --quality-all --frames 60 --warmup 0 --timing stages --spp 64",
+            paper: "run --technique ism,ism-classic,keller-full --param vpls=256 --param ism.points-per-vpl=8192 --quality --quality-all --frames 60 --warmup 0 --timing stages --spp 64",
+        },
+    },
+    Target {
+        name: "ism-breakdown",
+        dir: "ism/breakdown",
+        what: "",
+        kind: Kind::Paper(&ism2008::MODULE),
+    },
 ];
 
 impl Target {
     /// What it regenerates, one line.
     pub fn description(&self) -> String {
         match self.kind {
-            Kind::Paper => laine2007::describe(self.name).to_string(),
+            Kind::Paper(m) => (m.describe)(self.name).to_string(),
             Kind::Command { quick, paper } if quick == paper => {
                 format!("{} {SAME_SIZES}", self.what)
             }
@@ -275,13 +290,13 @@ const EXTRA: &[Target] = &[
         name: "laine-table1",
         dir: "laine",
         what: "",
-        kind: Kind::Paper,
+        kind: Kind::Paper(&laine2007::MODULE),
     },
     Target {
         name: "laine-table2",
         dir: "laine",
         what: "",
-        kind: Kind::Paper,
+        kind: Kind::Paper(&laine2007::MODULE),
     },
 ];
 
@@ -310,9 +325,9 @@ impl Planned {
         let mut targs = args.clone();
         targs.out = Some(out.clone());
         match target.kind {
-            Kind::Paper => {
-                laine2007::check(target.name, &targs)?;
-                let (frames, units) = laine2007::work(target.name, &targs);
+            Kind::Paper(m) => {
+                (m.check)(target.name, &targs)?;
+                let (frames, units) = (m.work)(target.name, &targs);
                 let mut command = format!(
                     "gibench reproduce {}{mode} --out {}",
                     target.name,
@@ -341,7 +356,7 @@ impl Planned {
                     return Err(Error::param(
                         "scenes",
                         format!(
-                            "applies to the Laine targets only; '{}' runs the scene its command names",
+                            "applies to the paper targets only; '{}' runs the scene its command names",
                             target.name
                         ),
                     ));
@@ -383,18 +398,23 @@ impl Planned {
     }
 
     fn needs_gpu(&self) -> bool {
-        match &self.job {
-            Some(job) => job.needs_gpu(),
-            None => !matches!(self.target.name, "laine-management" | "laine-dispersion"),
+        match (&self.job, &self.target.kind) {
+            (Some(job), _) => job.needs_gpu(),
+            (None, Kind::Paper(m)) => (m.needs_gpu)(self.target.name),
+            (None, Kind::Command { .. }) => true,
         }
     }
 
     /// Runs the target; returns a line saying what it wrote.
     fn run(&self, gpu: Option<&GpuContext>, bars: &Bars) -> Result<String> {
-        match &self.job {
-            Some(job) => job.execute(gpu, bars),
-            None => {
-                let (tables, runs) = laine2007::reproduce(self.target.name, &self.args, gpu, bars)?;
+        match (&self.job, &self.target.kind) {
+            (Some(job), _) => job.execute(gpu, bars),
+            (None, Kind::Command { .. }) => Err(Error::Invalid(format!(
+                "target '{}' was not planned",
+                self.target.name
+            ))),
+            (None, Kind::Paper(m)) => {
+                let (tables, runs) = (m.reproduce)(self.target.name, &self.args, gpu, bars)?;
                 let mut written = Vec::new();
                 for (table, stem) in &tables {
                     bars.table(table);
@@ -410,27 +430,19 @@ impl Planned {
                 );
                 if self.args.html {
                     let page = self.out.join(format!("{}.html", self.target.name));
-                    let figures = written_figures(&self.out, self.target.name);
+                    let figures = (m.figures)(&self.out, self.target.name);
                     crate::write_page(
                         &page,
                         self.target.description(),
                         tables.into_iter().map(|(t, _)| t).collect(),
                         figures,
-                        crate::with_folder(&laine2007::runs_folder(&self.args), runs),
+                        crate::with_folder(&(m.runs_folder)(&self.args), runs),
                     )?;
                     done.push_str(&crate::page_line(&page));
                 }
                 Ok(done)
             }
         }
-    }
-}
-
-/// The SVG figures a paper target writes beside its tables (`{target}.svg`, where it has one).
-fn written_figures(out: &Path, target: &str) -> Vec<PathBuf> {
-    match target {
-        "laine-dispersion" => vec![out.join("laine-dispersion.svg")],
-        _ => Vec::new(),
     }
 }
 
@@ -567,8 +579,10 @@ pub fn reproduce(args: &ReproduceArgs) -> Result<()> {
         if matches!(p.target.kind, Kind::Command { .. }) {
             set.replace(Path::new(p.target.dir))?;
         }
-        for sub in laine2007::owned_folders(p.target.name) {
-            set.replace(&Path::new(p.target.dir).join(sub))?;
+        if let Kind::Paper(m) = p.target.kind {
+            for sub in (m.owned_folders)(p.target.name) {
+                set.replace(&Path::new(p.target.dir).join(sub))?;
+            }
         }
     }
     // The bar advances in estimated milliseconds (work units where there is no estimate).

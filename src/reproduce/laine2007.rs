@@ -26,9 +26,24 @@ use gibench_harness::session::{RunSpec, TechniqueRun};
 use gibench_harness::technique::TechniqueInfo;
 use gibench_harness::{Error, Result};
 
-use super::{device_note, load_scene, paper_cells, ReproduceArgs, Reproduction};
+use super::{device_note, load_scene, paper_cells, PaperModule, ReproduceArgs, Reproduction};
 use crate::Bars;
 use gibench_harness::gpu::GpuContext;
+
+/// The module's entry for `reproduce all`.
+pub const MODULE: PaperModule = PaperModule {
+    describe,
+    owned_folders,
+    check,
+    work,
+    needs_gpu: |target| !matches!(target, "laine-management" | "laine-dispersion"),
+    reproduce,
+    runs_folder,
+    figures: |out, target| match target {
+        "laine-dispersion" => vec![out.join("laine-dispersion.svg")],
+        _ => Vec::new(),
+    },
+};
 
 /// What each target regenerates (for `gibench reproduce all --list` and its manifest).
 pub fn describe(target: &str) -> &'static str {

@@ -3,11 +3,14 @@
 //! `results/papers/<paper>.json` and printed beside ours, each labelled with its source.
 //!
 //! * [`laine2007`]: Laine et al. 2007, Tables 1 and 2, VPL management, dispersion.
+//! * [`ism2008`]: the imperfect-shadow-map breakdown of the Kautz course slides (Ritschel et
+//!   al. 2008), ISM against classic maps on the same VPLs.
 //! * [`all`]: every paper table, figure and sweep (`gibench reproduce all`), and the sweeps
 //!   that are gibench commands (Keller's and Laine's tile, VPL and clamp sweeps, the lag and
 //!   quality runs, the reference) as targets of their own.
 
 pub mod all;
+pub mod ism2008;
 pub mod laine2007;
 
 use std::path::PathBuf;
@@ -24,12 +27,12 @@ use gibench_harness::{Error, Result};
 pub struct ReproduceArgs {
     /// What to regenerate: `all` (every target below), or one target: laine-table1,
     /// laine-table2, laine-tables (both from one set of runs), laine-management,
-    /// laine-dispersion, or a sweep or run target (`gibench reproduce all --list` lists them).
+    /// laine-dispersion, ism-breakdown, or a sweep or run target (`gibench reproduce all --list` lists them).
     pub target: String,
     /// Small sizes for machines without a GPU (each target says which).
     #[arg(long)]
     pub quick: bool,
-    /// Scenes (default: the paper's; Laine targets only).
+    /// Scenes (default: the paper's; paper targets only: Laine's and ism-breakdown, which takes the first).
     #[arg(long, value_delimiter = ',')]
     pub scenes: Vec<String>,
     /// Output directory (default: results/<the target's folder>; for `all`, results, with
@@ -65,6 +68,31 @@ pub struct ReproduceArgs {
 
 /// A table and the file stem it is written under.
 pub type Reproduction = (Table, &'static str);
+
+/// A paper target's tables and the runs behind them.
+pub type Reproduced = Result<(Vec<Reproduction>, Vec<RunResult>)>;
+
+/// What a paper module offers `reproduce all` for its targets (each function takes the
+/// target's name).
+pub struct PaperModule {
+    /// What the target regenerates, one line.
+    pub describe: fn(&str) -> &'static str,
+    /// Subfolders of its output folder the target owns entirely (replaced by `all`).
+    pub owned_folders: fn(&str) -> &'static [&'static str],
+    /// Checks everything that can be checked before any work.
+    pub check: fn(&str, &ReproduceArgs) -> Result<()>,
+    /// (frames rendered or stepped, work units) for the time estimate.
+    pub work: fn(&str, &ReproduceArgs) -> (u64, u64),
+    /// Whether the target needs an adapter (CPU-only targets do not).
+    pub needs_gpu: fn(&str) -> bool,
+    /// Regenerates the target on `gpu` (opened by the module if `None`): its tables and the
+    /// runs behind them.
+    pub reproduce: fn(&str, &ReproduceArgs, Option<&GpuContext>, &crate::Bars) -> Reproduced,
+    /// The folder of the runs behind the tables.
+    pub runs_folder: fn(&ReproduceArgs) -> PathBuf,
+    /// The figures (SVG) the target writes beside its tables into the output folder.
+    pub figures: fn(&std::path::Path, &str) -> Vec<PathBuf>,
+}
 
 /// A paper's published figures (`results/papers/{name}.json`, embedded at build time).
 pub fn paper(name: &str, text: &str) -> Result<serde_json::Value> {

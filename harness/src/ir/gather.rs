@@ -12,7 +12,7 @@
 use super::accumulate::{Accumulation, IrradianceClamp};
 use super::atlas::{AtlasFormat, AtlasSettings, MapKind, ShadowAtlas};
 use super::interleave::{FilterSettings, Interleave};
-use super::raster::{AtlasClear, AtlasRasteriser};
+use super::raster::{AtlasClear, AtlasRasteriser, StoreViews};
 use super::store::VplStore;
 use crate::passes::DrawSet;
 use crate::technique::{FrameContext, ParamKind, ParamSpec, Params, PrepareContext};
@@ -172,11 +172,34 @@ impl VplGather {
         clear: AtlasClear,
     ) -> Result<()> {
         let (gpu, scene, uniforms) = (ctx.gpu, ctx.gpu_scene, ctx.uniforms);
-        let raster = self.raster.as_ref().ok_or_else(|| {
-            crate::Error::Invalid("this gather's atlas is written by another pass".into())
-        })?;
+        let raster = self.rasteriser()?;
         let n = ctx.profiler.gpu_stage(gpu, STAGE_VPL_SHADOW_MAPS, |enc| {
             raster.render(gpu, enc, &self.atlas, scene, uniforms, vpls, clear)
+        })?;
+        ctx.profiler.count("shadow-maps", n as f64);
+        Ok(())
+    }
+
+    /// The rasteriser, or an error when another pass writes the atlas.
+    fn rasteriser(&self) -> Result<&AtlasRasteriser> {
+        self.raster.as_ref().ok_or_else(|| {
+            crate::Error::Invalid("this gather's atlas is written by another pass".into())
+        })
+    }
+
+    /// Records the maps of the store's slots `0..count`, written by a GPU pass earlier in the
+    /// frame, as the `vpl-shadow-maps` stage (their views written from the store inside it) and
+    /// counts them as `shadow-maps`.
+    pub fn render_store_maps(
+        &self,
+        ctx: &mut FrameContext,
+        views: &StoreViews,
+        count: u32,
+    ) -> Result<()> {
+        let (gpu, scene, uniforms) = (ctx.gpu, ctx.gpu_scene, ctx.uniforms);
+        let raster = self.rasteriser()?;
+        let n = ctx.profiler.gpu_stage(gpu, STAGE_VPL_SHADOW_MAPS, |enc| {
+            raster.render_store(enc, &self.atlas, scene, uniforms, views, count)
         })?;
         ctx.profiler.count("shadow-maps", n as f64);
         Ok(())

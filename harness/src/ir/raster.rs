@@ -1,7 +1,8 @@
 //! **Atlas rasteriser**: renders chosen slots of a depth [`ShadowAtlas`] from a chosen
 //! [`DrawSet`] by triangle rasterisation.
 //!
-//! Reads: the VPLs of the slots to render, the scene's meshes ([`GpuScene`]) and object
+//! Reads: the VPLs of the slots to render (a CPU list, or a [`VplStore`] a GPU pass wrote), the
+//! scene's meshes ([`GpuScene`]) and object
 //! transforms ([`FrameUniforms`]).
 //! Writes: its own per-slot view uniforms (uploaded inside the call, so their cost is part of
 //! the caller's `vpl-shadow-maps` stage) and those slots' blocks of the atlas. With
@@ -11,14 +12,20 @@
 //!
 //! Paraboloid maps are rendered with the VPL's frame in the vertex shader (Brabec et al. 2002)
 //! and back-hemisphere fragments discarded; cube maps with one 90° view per face.
+//!
+//! VPLs a GPU pass wrote into a [`VplStore`] (imperfect shadow maps' RSM-sampled VPLs) are
+//! rendered with [`StoreViews`]: a compute pass writes each slot's paraboloid view from the store
+//! into the same view uniforms, inside the same stage, with no readback.
 
 use bytemuck::{Pod, Zeroable};
 use glam::Mat4;
 
 use super::atlas::{MapKind, ShadowAtlas};
+use super::store::VplStore;
 use crate::gpu::GpuContext;
 use crate::passes::{
-    cube_face_matrix, shader_module, uniform_entry, DrawSet, FrameUniforms, GpuScene, Vertex,
+    compute_pipeline, cube_face_matrix, shader_module, storage_entry, uniform_entry, DrawSet,
+    FrameUniforms, GpuScene, Vertex,
 };
 use crate::vpl::{frame_from_normal, Vpl};
 use crate::{Error, Result};
@@ -52,6 +59,9 @@ pub struct AtlasRasteriser {
     draw_set: DrawSet,
     capacity: u32,
     view_buffer: wgpu::Buffer,
+    /// The view uniforms' CPU copy (allocated once): rendered slots are written into it and
+    /// uploaded in one write covering them.
+    mirror: std::cell::RefCell<Vec<u8>>,
     view_group: wgpu::BindGroup,
     map_pipeline: wgpu::RenderPipeline,
     clear_pipeline: wgpu::RenderPipeline,
@@ -78,7 +88,10 @@ impl AtlasRasteriser {
         let view_buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("vpl views"),
             size: settings.capacity as u64 * faces * VIEW_STRIDE,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            // STORAGE: written by [`StoreViews`] for GPU-written VPLs.
+            usage: wgpu::BufferUsages::UNIFORM
+                | wgpu::BufferUsages::COPY_DST
+                | wgpu::BufferUsages::STORAGE,
             mapped_at_creation: false,
         });
         let view_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -170,6 +183,7 @@ impl AtlasRasteriser {
             kind: settings.kind,
             draw_set,
             capacity: settings.capacity,
+            mirror: std::cell::RefCell::new(vec![0; view_buffer.size() as usize]),
             view_buffer,
             view_group,
             map_pipeline,
@@ -177,12 +191,13 @@ impl AtlasRasteriser {
         })
     }
 
-    /// Uploads the view(s) of `vpl` for `slot`.
-    fn write_view(&self, queue: &wgpu::Queue, atlas: &ShadowAtlas, slot: u32, vpl: &Vpl) {
+    /// Writes the view(s) of `vpl` for `slot` into the CPU copy `mirror`.
+    fn write_view(&self, mirror: &mut [u8], atlas: &ShadowAtlas, slot: u32, vpl: &Vpl) {
         let (t, b) = frame_from_normal(vpl.normal);
         let eye = vpl.position + vpl.normal * atlas.lift;
         let faces = self.kind.faces() as usize;
-        let mut bytes = vec![0u8; faces * VIEW_STRIDE as usize];
+        let start = slot as usize * faces * VIEW_STRIDE as usize;
+        let bytes = &mut mirror[start..start + faces * VIEW_STRIDE as usize];
         for f in 0..faces {
             let view_proj = match self.kind {
                 MapKind::Cube => cube_face_matrix(eye, f, atlas.near),
@@ -198,11 +213,6 @@ impl AtlasRasteriser {
             let o = f * VIEW_STRIDE as usize;
             bytes[o..o + std::mem::size_of::<ViewData>()].copy_from_slice(bytemuck::bytes_of(&d));
         }
-        queue.write_buffer(
-            &self.view_buffer,
-            slot as u64 * faces as u64 * VIEW_STRIDE,
-            &bytes,
-        );
     }
 
     /// Uploads the views of `vpls` (slot, VPL) and records their maps into `atlas` after the
@@ -220,9 +230,63 @@ impl AtlasRasteriser {
         clear: AtlasClear,
     ) -> u32 {
         let vpls: Vec<&(u32, Vpl)> = vpls.iter().filter(|(s, _)| *s < self.capacity).collect();
+        // One upload covering every slot rendered (per-slot writes cost about 1 ms each on
+        // lavapipe: 8x the maps themselves at 256 VPLs).
+        let mut mirror = self.mirror.borrow_mut();
         for (slot, vpl) in &vpls {
-            self.write_view(&gpu.queue, atlas, *slot, vpl);
+            self.write_view(&mut mirror, atlas, *slot, vpl);
         }
+        if let (Some(lo), Some(hi)) = (
+            vpls.iter().map(|(s, _)| *s).min(),
+            vpls.iter().map(|(s, _)| *s).max(),
+        ) {
+            let slot_bytes = self.kind.faces() as usize * VIEW_STRIDE as usize;
+            let range = lo as usize * slot_bytes..(hi as usize + 1) * slot_bytes;
+            gpu.queue
+                .write_buffer(&self.view_buffer, range.start as u64, &mirror[range]);
+        }
+        let slots: Vec<u32> = vpls.iter().map(|(slot, _)| *slot).collect();
+        self.draw(encoder, atlas, scene, uniforms, &slots, clear);
+        slots.len() as u32
+    }
+
+    /// Records the maps of slots `0..count` of the store `views` reads (clamped to the
+    /// capacity) into `atlas`, clearing it whole: first the compute pass that writes their views
+    /// from the store, then the maps. Returns the number of maps rendered.
+    pub fn render_store(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        atlas: &ShadowAtlas,
+        scene: &GpuScene,
+        uniforms: &FrameUniforms,
+        views: &StoreViews,
+        count: u32,
+    ) -> u32 {
+        let count = count.min(self.capacity);
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("vpl views from the store"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&views.pipeline);
+            pass.set_bind_group(0, &views.group, &[]);
+            pass.dispatch_workgroups(count.div_ceil(64), 1, 1);
+        }
+        let slots: Vec<u32> = (0..count).collect();
+        self.draw(encoder, atlas, scene, uniforms, &slots, AtlasClear::Whole);
+        count
+    }
+
+    /// Records the maps of `slots`, whose views are in place, after the clear `clear` asks for.
+    fn draw(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        atlas: &ShadowAtlas,
+        scene: &GpuScene,
+        uniforms: &FrameUniforms,
+        slots: &[u32],
+        clear: AtlasClear,
+    ) {
         let load = match clear {
             AtlasClear::Whole => wgpu::LoadOp::Clear(0.0),
             AtlasClear::RenderedSlots => wgpu::LoadOp::Load,
@@ -244,8 +308,7 @@ impl AtlasRasteriser {
         });
         let s = atlas.settings.size;
         let faces = self.kind.faces();
-        for (slot, _) in &vpls {
-            let slot = *slot;
+        for &slot in slots {
             if clear == AtlasClear::RenderedSlots {
                 let ([x, y], [w, h]) = atlas.block(slot);
                 pass.set_viewport(x as f32, y as f32, w as f32, h as f32, 0.0, 1.0);
@@ -263,6 +326,64 @@ impl AtlasRasteriser {
                 scene.draw(&mut pass, uniforms, 1, self.draw_set);
             }
         }
-        vpls.len() as u32
     }
+
+    /// The compute pass that writes the views of the VPLs in `store` for
+    /// [`AtlasRasteriser::render_store`] (paraboloid maps only: a cube map's six views would
+    /// need the face matrices on the GPU, which nothing uses yet).
+    pub fn store_views(
+        &self,
+        gpu: &GpuContext,
+        atlas: &ShadowAtlas,
+        store: &VplStore,
+    ) -> Result<StoreViews> {
+        if self.kind != MapKind::Paraboloid {
+            return Err(Error::param(
+                "vpl-map",
+                "maps of VPLs written on the GPU are paraboloid only",
+            ));
+        }
+        let device = &gpu.device;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("vpl views from the store"),
+            entries: &[VplStore::layout_entry(0, false), storage_entry(1, false)],
+        });
+        let source = format!(
+            "const LIFT: f32 = {:.9e};\nconst FAR: f32 = {:.9e};\n{}\n{}",
+            atlas.lift,
+            atlas.far,
+            VplStore::wgsl(0, 0, false),
+            include_str!("shaders/store_views.wgsl")
+        );
+        let pipeline = compute_pipeline(
+            device,
+            "vpl views from the store",
+            &source,
+            &[&layout],
+            "write_views",
+        );
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("vpl views from the store"),
+            layout: &layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: store.buffer().as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: self.view_buffer.as_entire_binding(),
+                },
+            ],
+        });
+        gpu.check_errors()?;
+        Ok(StoreViews { pipeline, group })
+    }
+}
+
+/// The pass writing paraboloid views of GPU-written VPLs into an [`AtlasRasteriser`]'s view
+/// uniforms ([`AtlasRasteriser::store_views`]).
+pub struct StoreViews {
+    pipeline: wgpu::ComputePipeline,
+    group: wgpu::BindGroup,
 }

@@ -278,10 +278,12 @@ impl GpuScene {
         set: DrawSet,
     ) {
         let statics = match set {
-            DrawSet::StaticCasters => self.shadow_mesh.as_ref().unwrap_or(&self.static_mesh),
+            DrawSet::StaticCasters | DrawSet::CastersAndMovers => {
+                self.shadow_mesh.as_ref().unwrap_or(&self.static_mesh)
+            }
             DrawSet::Static | DrawSet::StaticAndMovers => &self.static_mesh,
         };
-        let movers = if set == DrawSet::StaticAndMovers {
+        let movers = if matches!(set, DrawSet::StaticAndMovers | DrawSet::CastersAndMovers) {
             &self.movers[..]
         } else {
             &[]
@@ -310,6 +312,9 @@ pub enum DrawSet {
     Static,
     /// The static mesh and every mover (the camera view, the direct light's shadow map).
     StaticAndMovers,
+    /// The shadow-caster copy and every mover: VPL maps rendered anew every frame with the
+    /// movers in them (`ism-classic`).
+    CastersAndMovers,
 }
 
 /// A view for drawing the scene: the `View` uniform of `common.wgsl`.

@@ -16,6 +16,14 @@
 //!
 //! `vpls` means what it means for every VPL technique: the VPLs lighting the frame.
 //!
+//! **`ism-classic`** is the slides' comparison: the same RSM and the same sampled VPLs (the
+//! sampling depends only on the map and the VPL index), with classic maps instead of steps 3–4
+//! — every triangle of the scene's shadow-caster copy (tessellated where the scene has one, as
+//! paraboloid maps need: `keller-full` and `laine` draw the same) and of the movers rasterised
+//! into each VPL's paraboloid map
+//! (the kit's [`AtlasRasteriser`](gibench_harness::ir::raster::AtlasRasteriser), views written
+//! from the GPU store), 32-bit depth, as the `vpl-shadow-maps` stage.
+//!
 //! Deviations (README): points are splatted with a storage-buffer atomic, one texel each; the
 //! push takes the nearest parent; the strata of the VPL sampling are jittered once (fixed per
 //! VPL index); an area light's map is taken from its centre.
@@ -28,9 +36,11 @@ use gibench_harness::ir::atlas::{AtlasFormat, MapKind};
 use gibench_harness::ir::gather::{GatherParams, VplGather, GATHER_PARAMS};
 use gibench_harness::ir::points::{self, PoolPoint};
 use gibench_harness::ir::pullpush::PullPush;
+use gibench_harness::ir::raster::StoreViews;
 use gibench_harness::ir::rsm::ReflectiveShadowMap;
 use gibench_harness::ir::splat::PointSplat;
 use gibench_harness::ir::vpl_sample::{RsmTexels, VplSampler};
+use gibench_harness::passes::DrawSet;
 use gibench_harness::quality::IndirectComponent;
 use gibench_harness::technique::{
     Conformance, FrameContext, ParamKind, ParamSpec, Params, PrepareContext, Prepared, Technique,
@@ -84,6 +94,27 @@ const OWN_PARAMS: &[ParamSpec] = &[
 /// are always paraboloid, in a float atlas).
 const GATHER: &[ParamSpec] = &[GATHER_PARAMS[0], GATHER_PARAMS[2], GATHER_PARAMS[4]];
 
+/// The parameters `ism-classic` shares with `ism` (no points, no pull-push).
+const CLASSIC_PARAMS: &[ParamSpec] = &[OWN_PARAMS[0], OWN_PARAMS[3]];
+
+/// `ism-classic` registry entry.
+pub const INFO_CLASSIC: TechniqueInfo = TechniqueInfo {
+    name: "ism-classic",
+    description:
+        "ism's RSM-sampled VPLs with classic triangle-rasterised maps (the slides' comparison)",
+    params: &[CLASSIC_PARAMS, GATHER],
+    required_features: wgpu::Features::empty(),
+    required_limits: wgpu::Limits::downlevel_defaults,
+    reference: IndirectComponent::OneBounce,
+    // The same bound as `ism`: the VPLs are the same; only the maps differ.
+    conformance: Conformance {
+        max_relative_l1: 0.8,
+        mean_ratio: (0.88, 1.2),
+    },
+    prepare: prepare_classic,
+    create: create_classic,
+};
+
 /// `ism` registry entry.
 pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "ism",
@@ -119,6 +150,7 @@ pub struct IsmParams {
 }
 
 impl IsmParams {
+    /// `ism`'s parameters.
     pub fn from_params(params: &Params) -> Result<IsmParams> {
         let p = IsmParams {
             vpls: params.int("vpls") as u32,
@@ -126,13 +158,7 @@ impl IsmParams {
             pool: params.int("point-pool") as u32,
             rsm_size: params.int("rsm-size") as u32,
             levels: params.int("pull-push-levels") as u32,
-            gather: GatherParams {
-                tiles: params.tiles("tiles"),
-                map: MapKind::Paraboloid,
-                map_size: params.int("vpl-map-size") as u32,
-                format: AtlasFormat::Float32,
-                clamp: params.float("clamp") as f32,
-            },
+            gather: Self::gather(params, AtlasFormat::Float32),
         };
         if p.points_per_vpl > p.pool {
             return Err(Error::param(
@@ -144,6 +170,29 @@ impl IsmParams {
             ));
         }
         Ok(p)
+    }
+
+    /// `ism-classic`'s parameters (no points, no pull-push: those fields are 0).
+    pub fn classic_from_params(params: &Params) -> IsmParams {
+        IsmParams {
+            vpls: params.int("vpls") as u32,
+            points_per_vpl: 0,
+            pool: 0,
+            rsm_size: params.int("rsm-size") as u32,
+            levels: 0,
+            gather: Self::gather(params, AtlasFormat::Depth32),
+        }
+    }
+
+    /// The gather over paraboloid maps in `format`.
+    fn gather(params: &Params, format: AtlasFormat) -> GatherParams {
+        GatherParams {
+            tiles: params.tiles("tiles"),
+            map: MapKind::Paraboloid,
+            map_size: params.int("vpl-map-size") as u32,
+            format,
+            clamp: params.float("clamp") as f32,
+        }
     }
 }
 
@@ -159,19 +208,72 @@ fn prepare(params: &Params, ctx: &PrepareContext) -> Result<Prepared> {
     }))
 }
 
-/// `ism`.
+/// `ism-classic` prepares nothing.
+fn prepare_classic(_: &Params, _: &PrepareContext) -> Result<Prepared> {
+    Ok(Box::new(()))
+}
+
+/// How the VPLs' maps are made.
+enum Maps {
+    /// Imperfect: points splatted, then pull-push.
+    Imperfect(Box<ImperfectMaps>),
+    /// Classic: the triangles rasterised, views written from the store.
+    Classic(StoreViews),
+}
+
+/// `ism`'s map making.
+struct ImperfectMaps {
+    splat: PointSplat,
+    pullpush: PullPush,
+    /// Object → world per object (0: the static mesh, the identity; k + 1: mover k,
+    /// written every frame from `mover_transforms`, kept to reuse its allocation).
+    objects: wgpu::Buffer,
+    mover_transforms: Vec<[f32; 16]>,
+    _points: wgpu::Buffer,
+}
+
+/// `ism` and `ism-classic`.
 pub struct Ism {
     gather: VplGather,
     rsm: ReflectiveShadowMap,
     sampler: VplSampler,
-    splat: PointSplat,
-    pullpush: PullPush,
-    /// Object → world per object (0: the static mesh, the identity; k + 1: mover k, written
-    /// every frame from `mover_transforms`, kept to reuse its allocation).
-    objects: wgpu::Buffer,
-    mover_transforms: Vec<[f32; 16]>,
-    _points: wgpu::Buffer,
+    maps: Maps,
     vpls: u32,
+}
+
+impl Ism {
+    /// The parts both variants share: the gather (rasterising `draw_set` if given), the RSM
+    /// and the VPL sampler.
+    fn new(
+        p: &IsmParams,
+        ctx: &PrepareContext,
+        draw_set: Option<DrawSet>,
+        maps: impl FnOnce(&VplGather) -> Result<Maps>,
+    ) -> Result<Ism> {
+        let gpu = ctx.gpu;
+        let gather = VplGather::new(&p.gather, ctx, p.vpls, draw_set)?;
+        let rsm = ReflectiveShadowMap::new(gpu, ctx.gpu_scene, ctx.uniforms, p.rsm_size)?;
+        let [position, normal, flux] = rsm.buffers();
+        let sampler = VplSampler::new(
+            gpu,
+            &gather.store,
+            &RsmTexels {
+                position,
+                normal,
+                flux,
+                texels: rsm.texels(),
+            },
+            p.vpls,
+        )?;
+        let maps = maps(&gather)?;
+        Ok(Ism {
+            gather,
+            rsm,
+            sampler,
+            maps,
+            vpls: p.vpls,
+        })
+    }
 }
 
 fn create(
@@ -186,64 +288,69 @@ fn create(
         .pool;
     let gpu = ctx.gpu;
     let device = &gpu.device;
-    let gather = VplGather::new(&p.gather, ctx, p.vpls, None)?;
-    let rsm = ReflectiveShadowMap::new(gpu, ctx.gpu_scene, ctx.uniforms, p.rsm_size)?;
-    let [position, normal, flux] = rsm.buffers();
-    let sampler = VplSampler::new(
-        gpu,
-        &gather.store,
-        &RsmTexels {
-            position,
-            normal,
-            flux,
-            texels: rsm.texels(),
-        },
-        p.vpls,
-    )?;
-    let data: Vec<[f32; 4]> = pool
-        .iter()
-        .map(|q| q.position.extend(q.object as f32).to_array())
-        .collect();
-    let points = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("ism point pool"),
-        size: (data.len().max(1) * 16) as u64,
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    gpu.queue
-        .write_buffer(&points, 0, bytemuck::cast_slice(&data));
-    let objects = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("ism objects"),
-        size: 64 * (1 + ctx.scene.movers.len() as u64),
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    gpu.queue.write_buffer(
-        &objects,
-        0,
-        bytemuck::cast_slice(&Mat4::IDENTITY.to_cols_array()),
-    );
-    let splat = PointSplat::new(
-        gpu,
-        &gather.store,
-        &gather.atlas,
-        &points,
-        &objects,
-        pool.len() as u32,
-        p.points_per_vpl,
-    )?;
-    let pullpush = PullPush::new(gpu, &splat, &gather.atlas, p.levels)?;
-    Ok(Box::new(Ism {
-        gather,
-        rsm,
-        sampler,
-        splat,
-        pullpush,
-        objects,
-        mover_transforms: Vec::with_capacity(ctx.scene.movers.len()),
-        _points: points,
-        vpls: p.vpls,
-    }))
+    let ism = Ism::new(&p, ctx, None, |gather| {
+        let data: Vec<[f32; 4]> = pool
+            .iter()
+            .map(|q| q.position.extend(q.object as f32).to_array())
+            .collect();
+        let points = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("ism point pool"),
+            size: (data.len().max(1) * 16) as u64,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        gpu.queue
+            .write_buffer(&points, 0, bytemuck::cast_slice(&data));
+        let objects = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("ism objects"),
+            size: 64 * (1 + ctx.scene.movers.len() as u64),
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        gpu.queue.write_buffer(
+            &objects,
+            0,
+            bytemuck::cast_slice(&Mat4::IDENTITY.to_cols_array()),
+        );
+        let splat = PointSplat::new(
+            gpu,
+            &gather.store,
+            &gather.atlas,
+            &points,
+            &objects,
+            pool.len() as u32,
+            p.points_per_vpl,
+        )?;
+        let pullpush = PullPush::new(gpu, &splat, &gather.atlas, p.levels)?;
+        Ok(Maps::Imperfect(Box::new(ImperfectMaps {
+            splat,
+            pullpush,
+            objects,
+            mover_transforms: Vec::with_capacity(ctx.scene.movers.len()),
+            _points: points,
+        })))
+    })?;
+    Ok(Box::new(ism))
+}
+
+fn create_classic(
+    params: &Params,
+    ctx: &PrepareContext,
+    _: &Prepared,
+) -> Result<Box<dyn Technique>> {
+    let p = IsmParams::classic_from_params(params);
+    let ism = Ism::new(&p, ctx, Some(DrawSet::CastersAndMovers), |gather| {
+        let raster = gather
+            .raster
+            .as_ref()
+            .ok_or_else(|| Error::Invalid("ism-classic: built without a rasteriser".into()))?;
+        Ok(Maps::Classic(raster.store_views(
+            ctx.gpu,
+            &gather.atlas,
+            &gather.store,
+        )?))
+    })?;
+    Ok(Box::new(ism))
 }
 
 impl Technique for Ism {
@@ -251,29 +358,38 @@ impl Technique for Ism {
         let gpu = ctx.gpu;
         let (scene, uniforms) = (ctx.gpu_scene, ctx.uniforms);
         let directional = ctx.frame.light.is_directional();
-        // Object 0 (the static mesh) stays the identity written at creation; only movers move.
-        if !ctx.frame.movers.is_empty() {
-            self.mover_transforms.clear();
-            self.mover_transforms
-                .extend(ctx.frame.movers.iter().map(|m| m.to_cols_array()));
-            gpu.queue.write_buffer(
-                &self.objects,
-                64,
-                bytemuck::cast_slice(&self.mover_transforms),
-            );
-        }
         ctx.profiler.gpu_stage(gpu, STAGE_RSM, |enc| {
             self.rsm.encode(gpu, enc, scene, uniforms, directional)
         })?;
         ctx.profiler
             .gpu_stage(gpu, STAGE_VPL_SAMPLING, |enc| self.sampler.encode(enc))?;
-        let atlas = &self.gather.atlas;
-        ctx.profiler
-            .gpu_stage(gpu, STAGE_POINT_SPLAT, |enc| self.splat.encode(enc, atlas))?;
-        ctx.profiler
-            .gpu_stage(gpu, STAGE_PULL_PUSH, |enc| self.pullpush.encode(enc))?;
+        match &mut self.maps {
+            Maps::Imperfect(m) => {
+                let ImperfectMaps {
+                    splat,
+                    pullpush,
+                    objects,
+                    mover_transforms,
+                    ..
+                } = &mut **m;
+                // Object 0 (the static mesh) stays the identity written at creation; only
+                // movers move.
+                if !ctx.frame.movers.is_empty() {
+                    mover_transforms.clear();
+                    mover_transforms.extend(ctx.frame.movers.iter().map(|m| m.to_cols_array()));
+                    gpu.queue
+                        .write_buffer(objects, 64, bytemuck::cast_slice(mover_transforms));
+                }
+                let atlas = &self.gather.atlas;
+                ctx.profiler
+                    .gpu_stage(gpu, STAGE_POINT_SPLAT, |enc| splat.encode(enc, atlas))?;
+                ctx.profiler
+                    .gpu_stage(gpu, STAGE_PULL_PUSH, |enc| pullpush.encode(enc))?;
+                ctx.profiler.count("shadow-maps", self.vpls as f64);
+            }
+            Maps::Classic(views) => self.gather.render_store_maps(ctx, views, self.vpls)?,
+        }
         ctx.profiler.count("vpls", self.vpls as f64);
-        ctx.profiler.count("shadow-maps", self.vpls as f64);
         self.gather.gather_store(ctx)
     }
 
