@@ -238,10 +238,10 @@ pub const TARGETS: &[Target] = &[
     Target {
         name: "ism-quality",
         dir: "ism/quality",
-        what: "per-frame error and flicker of ism, ism-classic (the same VPLs, classic maps) and keller-full at equal VPL counts, the light and a mover moving",
+        what: "per-frame error and flicker of ism, ism-classic (the same VPLs, classic maps) and keller-full at equal VPL counts in the Cornell box with an animated mover, the light and the mover moving",
         kind: Kind::Command {
-            quick: "run --technique ism,ism-classic,keller-full --param vpls=256 --param ism.points-per-vpl=8192 --quality --quality-all --frames 60 --warmup 0 --timing stages --spp 64",
-            paper: "run --technique ism,ism-classic,keller-full --param vpls=256 --param ism.points-per-vpl=8192 --quality --quality-all --frames 60 --warmup 0 --timing stages --spp 64",
+            quick: "run --scene cornell-bunny --technique ism,ism-classic,keller-full --param vpls=256 --param ism.points-per-vpl=8192 --quality --quality-all --frames 60 --warmup 0 --timing stages --spp 64",
+            paper: "run --scene cornell-bunny --technique ism,ism-classic,keller-full --param vpls=256 --param ism.points-per-vpl=8192 --quality --quality-all --frames 60 --warmup 0 --timing stages --spp 64",
         },
     },
     Target {
