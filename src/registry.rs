@@ -3,13 +3,14 @@
 
 use gibench_harness::technique::TechniqueInfo;
 
-static ALL: [TechniqueInfo; 6] = [
+static ALL: [TechniqueInfo; 7] = [
     gibench_direct::INFO,
     gibench_keller::FULL,
     gibench_keller::INCREMENTAL,
     gibench_laine::INFO,
     gibench_ism::INFO,
     gibench_ism::INFO_CLASSIC,
+    gibench_gaitatzes::INFO,
 ];
 
 /// All registered techniques.

@@ -176,6 +176,62 @@ fn ism_breakdown_has_the_stages_the_published_figures_and_the_ratios() {
     }
 }
 
+#[test]
+fn gaitatzes_table1_has_the_papers_rows_and_the_scaling_figure() {
+    let tmp = tempfile::tempdir().unwrap();
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_gibench"))
+        .args([
+            "reproduce",
+            "gaitatzes-table1",
+            "--quick",
+            "--scenes",
+            "gaitatzes-test",
+            "--frames",
+            "2",
+            "--out",
+        ])
+        .arg(tmp.path())
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let md = std::fs::read_to_string(tmp.path().join("gaitatzes-table1.md")).unwrap();
+    for col in [
+        "triangles",
+        "grid",
+        "iterations",
+        "voxelization",
+        "propagation",
+        "total (frame)",
+    ] {
+        assert!(md.contains(col), "the table lacks '{col}'");
+    }
+    // The paper's row for the test scene, from results/papers/gaitatzes2010.json, and ours at
+    // the paper's grid and iteration count with the scene's triangle count.
+    assert!(
+        md.contains("| Gaitatzes et al. 2010, Table 1 (NVIDIA GeForce GTX 285, 2010) | test scene | 48 | 32³ | 11 | 10.00 | 12.00 | – | 22.00 |"),
+        "{md}"
+    );
+    assert!(
+        md.contains("| gibench | gaitatzes-test | 48 | 32³ | 11 |"),
+        "{md}"
+    );
+    let r: serde_json::Value = serde_json::from_slice(
+        &std::fs::read(
+            tmp.path()
+                .join("runs/gaitatzes-test-gaitatzes-256x192.json"),
+        )
+        .unwrap(),
+    )
+    .unwrap();
+    assert_eq!(r["counters"]["iterations"]["mean"].as_f64(), Some(11.0));
+    assert_eq!(r["counters"]["grid"]["mean"].as_f64(), Some(32.0));
+    let svg = std::fs::read_to_string(tmp.path().join("gaitatzes-scaling.svg")).unwrap();
+    assert!(svg.contains("<svg") && svg.contains("propagation per iteration"));
+    for f in ["gaitatzes-table1.csv", "gaitatzes-table1.tex"] {
+        assert!(tmp.path().join(f).is_file(), "{f}");
+    }
+}
+
 /// The `gibench` rows of a table's CSV by their `technique` column, as column name → text.
 fn technique_rows(
     csv: &std::path::Path,

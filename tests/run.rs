@@ -149,8 +149,9 @@ fn quality_columns_and_results() {
     assert!(q.rmse.mean > 0.0 && q.flip_mean.mean > 0.0);
     assert!(tmp.path().join("cornell-direct-reference.png").is_file());
     assert!(tmp.path().join("cornell-direct-flip.png").is_file());
-    // The references were cached.
-    assert_eq!(std::fs::read_dir(&cache).unwrap().count(), 2);
+    // The references were cached: frames 4 and 5, one-bounce (the VPL techniques) and
+    // multi-bounce (`gaitatzes`).
+    assert_eq!(std::fs::read_dir(&cache).unwrap().count(), 4);
 }
 
 /// README: two seeds of the reference at the default spp agree to a relative MSE below 0.02.

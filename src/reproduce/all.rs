@@ -25,7 +25,7 @@ use gibench_harness::output::OutputSet;
 use gibench_harness::report;
 use gibench_harness::{Error, Result};
 
-use super::{ism2008, laine2007, out_dir, PaperModule, ReproduceArgs};
+use super::{gaitatzes2010, ism2008, laine2007, out_dir, PaperModule, ReproduceArgs};
 use crate::{Bars, Job};
 
 /// How a target is produced.
@@ -249,6 +249,36 @@ pub const TARGETS: &[Target] = &[
         dir: "ism/breakdown",
         what: "",
         kind: Kind::Paper(&ism2008::MODULE),
+    },
+    Target {
+        name: "gaitatzes-table1",
+        dir: "gaitatzes/table1",
+        what: "",
+        kind: Kind::Paper(&gaitatzes2010::MODULE),
+    },
+    Target {
+        name: "gaitatzes-quality",
+        dir: "gaitatzes/quality",
+        what: "",
+        kind: Kind::Paper(&gaitatzes2010::MODULE),
+    },
+    Target {
+        name: "gaitatzes-grid",
+        dir: "gaitatzes/grid",
+        what: "gaitatzes against the grid size on the room (64 iterations)",
+        kind: Kind::Command {
+            quick: "sweep --scene gaitatzes-room --technique gaitatzes --sweep grid=16,24,32,48,64 --param iterations=64 --quality --quality-reference multi-bounce --frames 4 --warmup 3 --timing stages",
+            paper: "sweep --scene gaitatzes-room --technique gaitatzes --sweep grid=16,24,32,48,64 --param iterations=64 --quality --quality-reference multi-bounce --resolution 512x512 --frames 100 --warmup 10 --timing stages",
+        },
+    },
+    Target {
+        name: "gaitatzes-iterations",
+        dir: "gaitatzes/iterations",
+        what: "gaitatzes against the propagation iterations on the room (32³)",
+        kind: Kind::Command {
+            quick: "sweep --scene gaitatzes-room --technique gaitatzes --sweep iterations=4,8,16,32,64,96 --quality --quality-reference multi-bounce --frames 4 --warmup 3 --timing stages",
+            paper: "sweep --scene gaitatzes-room --technique gaitatzes --sweep iterations=4,8,16,32,64,96 --quality --quality-reference multi-bounce --resolution 512x512 --frames 100 --warmup 10 --timing stages",
+        },
     },
 ];
 

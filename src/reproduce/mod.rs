@@ -3,6 +3,8 @@
 //! `results/papers/<paper>.json` and printed beside ours, each labelled with its source.
 //!
 //! * [`laine2007`]: Laine et al. 2007, Tables 1 and 2, VPL management, dispersion.
+//! * [`gaitatzes2010`]: Gaitatzes et al. 2010, Table 1 and the Figure 6 comparison with plain
+//!   light propagation volumes.
 //! * [`ism2008`]: the imperfect-shadow-map breakdown of the Kautz course slides (Ritschel et
 //!   al. 2008), ISM against classic maps on the same VPLs.
 //! * [`all`]: every paper table, figure and sweep (`gibench reproduce all`), and the sweeps
@@ -10,6 +12,7 @@
 //!   quality runs, the reference) as targets of their own.
 
 pub mod all;
+pub mod gaitatzes2010;
 pub mod ism2008;
 pub mod laine2007;
 
@@ -27,12 +30,12 @@ use gibench_harness::{Error, Result};
 pub struct ReproduceArgs {
     /// What to regenerate: `all` (every target below), or one target: laine-table1,
     /// laine-table2, laine-tables (both from one set of runs), laine-management,
-    /// laine-dispersion, ism-breakdown, or a sweep or run target (`gibench reproduce all --list` lists them).
+    /// laine-dispersion, ism-breakdown, gaitatzes-table1, gaitatzes-quality, or a sweep or run target (`gibench reproduce all --list` lists them).
     pub target: String,
     /// Small sizes for machines without a GPU (each target says which).
     #[arg(long)]
     pub quick: bool,
-    /// Scenes (default: the paper's; paper targets only: Laine's and ism-breakdown, which takes the first).
+    /// Scenes (default: the paper's; paper targets only: Laine's, ism-breakdown and gaitatzes-*).
     #[arg(long, value_delimiter = ',')]
     pub scenes: Vec<String>,
     /// Output directory (default: results/<the target's folder>; for `all`, results, with

@@ -8,10 +8,19 @@ use serde::{Deserialize, Serialize};
 
 use crate::{Error, Result};
 
-/// The only name `generated` mesh sources accept.
+/// Name of the generated Cornell box ([`crate::scene::cornell`]).
 pub const GENERATED_CORNELL_BOX: &str = "cornell-box";
 /// Name of the generated maze of Laine et al. 2007's MAZE scene ([`crate::scene::maze`]).
 pub const GENERATED_MAZE: &str = "maze";
+/// Every generated mesh name: the Cornell box, the maze, and the scenes of Gaitatzes et al.
+/// 2010 ([`crate::scene::gaitatzes`]).
+pub const GENERATED_MESHES: &[&str] = &[
+    GENERATED_CORNELL_BOX,
+    GENERATED_MAZE,
+    "gaitatzes-test",
+    "gaitatzes-room",
+    "gaitatzes-arena",
+];
 
 /// Where a mesh comes from: exactly one of `file` (a glTF binary on the asset search path) or
 /// `generated` (a scene built in code, e.g. `"cornell-box"`).
@@ -223,6 +232,22 @@ const BUILTINS: &[(&str, &str)] = &[
         include_str!("../../../scenes/sibenik-omni.json"),
     ),
     ("sponza", include_str!("../../../scenes/sponza.json")),
+    (
+        "sponza-sun",
+        include_str!("../../../scenes/sponza-sun.json"),
+    ),
+    (
+        "gaitatzes-test",
+        include_str!("../../../scenes/gaitatzes-test.json"),
+    ),
+    (
+        "gaitatzes-room",
+        include_str!("../../../scenes/gaitatzes-room.json"),
+    ),
+    (
+        "gaitatzes-arena",
+        include_str!("../../../scenes/gaitatzes-arena.json"),
+    ),
     ("maze", include_str!("../../../scenes/maze.json")),
     (
         "conference",
@@ -511,11 +536,14 @@ fn validate_mesh_source(p: &Path, field: &str, src: &MeshSource) -> Result<()> {
             }
         }
         (None, Some(name)) => {
-            if name != GENERATED_CORNELL_BOX && name != GENERATED_MAZE {
+            if !GENERATED_MESHES.contains(&name.as_str()) {
                 return Err(invalid(
                     p,
                     &format!("{field}.generated"),
-                    format!("unknown generated mesh '{name}'; expected '{GENERATED_CORNELL_BOX}' or '{GENERATED_MAZE}'"),
+                    format!(
+                        "unknown generated mesh '{name}'; expected one of: {}",
+                        GENERATED_MESHES.join(", ")
+                    ),
                 ));
             }
         }

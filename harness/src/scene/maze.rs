@@ -39,7 +39,7 @@ fn materials() -> Vec<Material> {
 
 /// A quad (corners counter-clockwise seen from the side `normal` points to), split into an
 /// nu×nv grid when `cell` is given.
-fn quad(mesh: &mut Mesh, c: [Vec3; 4], normal: Vec3, material: u32, cell: Option<f32>) {
+pub(crate) fn quad(mesh: &mut Mesh, c: [Vec3; 4], normal: Vec3, material: u32, cell: Option<f32>) {
     let (nu, nv) = match cell {
         Some(s) => (
             (((c[1] - c[0]).length() / s).round() as usize).max(1),

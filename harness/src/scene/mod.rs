@@ -11,6 +11,7 @@
 
 pub mod cornell;
 pub mod descriptor;
+pub mod gaitatzes;
 pub mod gltf_load;
 pub mod maze;
 
@@ -334,6 +335,24 @@ struct BuiltMesh {
     lights: Vec<PunctualLight>,
 }
 
+/// The mesh and materials of the generated mesh `name` (one of
+/// [`descriptor::GENERATED_MESHES`]), split into cells of about `tessellate` where given.
+fn generate(name: &str, tessellate: Option<f32>) -> Result<(Mesh, Vec<Material>)> {
+    Ok(match name {
+        GENERATED_CORNELL_BOX => cornell::cornell_box(tessellate),
+        GENERATED_MAZE => maze::maze(tessellate),
+        "gaitatzes-test" => gaitatzes::test_scene(tessellate),
+        "gaitatzes-room" => gaitatzes::room(tessellate),
+        "gaitatzes-arena" => gaitatzes::arena(tessellate),
+        _ => {
+            return Err(crate::Error::Invalid(format!(
+                "unknown generated mesh '{name}'; expected one of: {}",
+                descriptor::GENERATED_MESHES.join(", ")
+            )))
+        }
+    })
+}
+
 /// Builds `src`; `field` names it in errors (`mesh`, `shadow_mesh`, `statics[0].mesh`, ...).
 fn build_mesh(src: &MeshSource, assets: &AssetPaths, field: &str) -> Result<BuiltMesh> {
     match (&src.file, &src.generated) {
@@ -363,8 +382,8 @@ fn build_mesh(src: &MeshSource, assets: &AssetPaths, field: &str) -> Result<Buil
                 lights: g.lights,
             })
         }
-        (None, Some(name)) if name == GENERATED_MAZE => {
-            let (mesh, materials) = maze::maze(src.tessellate);
+        (None, Some(name)) => {
+            let (mesh, materials) = generate(name, src.tessellate)?;
             Ok(BuiltMesh {
                 mesh,
                 materials,
@@ -372,18 +391,6 @@ fn build_mesh(src: &MeshSource, assets: &AssetPaths, field: &str) -> Result<Buil
                 lights: Vec::new(),
             })
         }
-        (None, Some(name)) if name == GENERATED_CORNELL_BOX => {
-            let (mesh, materials) = cornell::cornell_box(src.tessellate);
-            Ok(BuiltMesh {
-                mesh,
-                materials,
-                textures: Vec::new(),
-                lights: Vec::new(),
-            })
-        }
-        (None, Some(name)) => Err(crate::Error::Invalid(format!(
-            "unknown generated mesh '{name}'; expected '{GENERATED_CORNELL_BOX}' or '{GENERATED_MAZE}'"
-        ))),
         (None, None) => Err(crate::Error::Invalid(
             "a mesh source needs a `file` or a `generated` name".into(),
         )),

@@ -1,0 +1,30 @@
+// The grid shared by the combine, propagation and reconstruction passes. Expects the constants
+// N (cells per axis), COLS (slice tiles per atlas row), ORIGIN (vec3: the grid's min corner),
+// CELL (cell edge), MODE (0: occluded propagation with reflections, Gaitatzes et al. 2010;
+// 1: plain light propagation volume, Kaplanyan 2009), STORED_ALBEDO (0: the paper's constant
+// 0.5 for secondary bounces, 1: the voxel's albedo) prepended, then sh::wgsl().
+
+struct Voxel {
+    // xyz: average unit normal of its surfaces (the side it emits and reflects on); w: 1 if
+    // occupied, else 0
+    normal: vec4<f32>,
+    // rgb: average albedo
+    albedo: vec4<f32>,
+    // rgb: direct radiosity (the largest of the three axes' averages)
+    radiosity: vec4<f32>,
+};
+
+// Second-order SH per colour channel.
+struct Sh3 {
+    r: vec4<f32>,
+    g: vec4<f32>,
+    b: vec4<f32>,
+};
+
+fn cell_index(c: vec3<i32>) -> u32 {
+    return u32(c.x) + N * (u32(c.y) + N * u32(c.z));
+}
+
+fn in_grid(c: vec3<i32>) -> bool {
+    return all(c >= vec3<i32>(0)) && all(c < vec3<i32>(i32(N)));
+}

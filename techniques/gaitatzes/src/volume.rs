@@ -1,0 +1,574 @@
+//! The voxel grid and its passes: voxelization with injection, propagation, reconstruction.
+//!
+//! * [`Grid`] — the cubic grid around the scene and the WGSL constants every pass shares.
+//! * [`Volumes`] — Reads: nothing. Writes (owns): the voxel buffer (normal and occupancy,
+//!   albedo, direct radiosity per cell), two propagation buffers and the accumulation buffer
+//!   (second-order SH per colour channel per cell).
+//! * [`Voxelizer`] — Reads: the scene (static mesh and movers), materials and textures, the
+//!   direct light (its shadow map). Writes: three per-axis slice atlases (its own), then the
+//!   voxel buffer, the first propagation buffer (the injected direct radiosity) and the
+//!   accumulation (cleared; plain LPV: the injected light).
+//! * [`Propagation`] — Reads: the voxel buffer. Writes: the propagation buffers (ping-pong) and
+//!   the accumulation.
+//! * [`Reconstruction`] — Reads: the G-buffer, the voxel buffer, the accumulation. Writes: the
+//!   technique's indirect-irradiance output.
+
+use gibench_harness::glam::{Mat4, Vec3, Vec4};
+use gibench_harness::gpu::GpuContext;
+use gibench_harness::passes::{
+    compute_pipeline, shader_module, storage_entry, texture_entry, uniform_entry, DirectLight,
+    DrawSet, FrameUniforms, GBuffer, GpuScene, Vertex, HDR_FORMAT,
+};
+use gibench_harness::scene::SceneExtent;
+use gibench_harness::{wgpu, Error, Result};
+
+use crate::sh;
+
+/// How radiance moves through the grid.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Mode {
+    /// Gaitatzes et al. 2010: through void cells only, reflected at occupied ones (secondary
+    /// bounces), accumulated where it arrives at occupied cells.
+    Occluded,
+    /// Plain light propagation volume (Kaplanyan 2009): through every cell, no reflection,
+    /// accumulated everywhere.
+    Lpv,
+}
+
+/// The grid (see the module docs).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Grid {
+    /// Cells per axis.
+    pub n: u32,
+    /// The min corner.
+    pub origin: Vec3,
+    /// Cell edge.
+    pub cell: f32,
+    pub mode: Mode,
+    /// Secondary bounces with the voxel's albedo instead of the paper's constant 0.5.
+    pub stored_albedo: bool,
+}
+
+/// Bytes of one cell of the voxel buffer (`Voxel`) and of an SH buffer (`Sh3`).
+pub const CELL_BYTES: u64 = 48;
+
+impl Grid {
+    /// A cubic grid of `n`³ cells around `extent`: its largest side plus half a cell on each
+    /// side, so that walls on the bounding box fall inside cells, not on their boundaries.
+    pub fn around(extent: &SceneExtent, n: u32, mode: Mode, stored_albedo: bool) -> Grid {
+        let side = (extent.max - extent.min).max_element().max(1e-6) * n as f32 / (n as f32 - 1.0);
+        Grid {
+            n,
+            origin: extent.centre - Vec3::splat(side / 2.0),
+            cell: side / n as f32,
+            mode,
+            stored_albedo,
+        }
+    }
+
+    /// Cells in the grid.
+    pub fn cells(&self) -> u64 {
+        (self.n as u64).pow(3)
+    }
+
+    /// Slice tiles per row of a voxelization atlas.
+    pub fn cols(&self) -> u32 {
+        (self.n as f32).sqrt().ceil() as u32
+    }
+
+    /// The atlas of one axis: `cols` × `rows` tiles of `n`² texels.
+    pub fn atlas_size(&self) -> [u32; 2] {
+        let cols = self.cols();
+        [cols * self.n, self.n.div_ceil(cols) * self.n]
+    }
+
+    /// The grid's constants, the SH convention ([`sh::wgsl`]) and `grid.wgsl`.
+    pub fn wgsl(&self) -> String {
+        format!(
+            "const N: u32 = {}u;\nconst COLS: u32 = {}u;\nconst ORIGIN: vec3<f32> = vec3<f32>({:.9e}, {:.9e}, {:.9e});\n\
+             const CELL: f32 = {:.9e};\nconst MODE: u32 = {}u;\nconst STORED_ALBEDO: u32 = {}u;\n{}\n{}",
+            self.n,
+            self.cols(),
+            self.origin.x,
+            self.origin.y,
+            self.origin.z,
+            self.cell,
+            (self.mode == Mode::Lpv) as u32,
+            self.stored_albedo as u32,
+            sh::wgsl(),
+            include_str!("shaders/grid.wgsl")
+        )
+    }
+
+    /// World → clip of slice `s` along `axis` (0 x, 1 y, 2 z): x and y over the slice's tile
+    /// (the other two axes, in the order the combine pass reads), z the position along the axis
+    /// in cells minus `s`, so that clipping to [0, 1] keeps the slice.
+    pub fn slice_matrix(&self, axis: usize, s: u32) -> Mat4 {
+        let (iu, iv, iw) = [(1, 2, 0), (2, 0, 1), (0, 1, 2)][axis];
+        let scale = 2.0 / (self.n as f32 * self.cell);
+        let unit = |i: usize| Vec3::AXES[i];
+        let row_x = (unit(iu) * scale).extend(-self.origin[iu] * scale - 1.0);
+        let row_y = (-unit(iv) * scale).extend(self.origin[iv] * scale + 1.0);
+        let row_z = (unit(iw) / self.cell).extend(-self.origin[iw] / self.cell - s as f32);
+        Mat4::from_cols(row_x, row_y, row_z, Vec4::W).transpose()
+    }
+
+    /// Checks the grid's buffers and atlases against the adapter's limits.
+    pub fn check_limits(&self, gpu: &GpuContext) -> Result<()> {
+        let limits = gpu.device.limits();
+        let bytes = self.cells() * CELL_BYTES;
+        let max = limits
+            .max_storage_buffer_binding_size
+            .min(limits.max_buffer_size);
+        if bytes > max {
+            return Err(Error::param(
+                "grid",
+                format!(
+                    "a {0}³ grid needs {bytes}-byte buffers; this adapter allows {max} bytes",
+                    self.n
+                ),
+            ));
+        }
+        let [w, h] = self.atlas_size();
+        if w.max(h) > limits.max_texture_dimension_2d {
+            return Err(Error::param(
+                "grid",
+                format!(
+                    "a {0}³ grid's slice atlas is {w}x{h}; this adapter allows {1}",
+                    self.n, limits.max_texture_dimension_2d
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// The grid's buffers (see the module docs). All are STORAGE, COPY_SRC and COPY_DST (tests
+/// read and write them).
+pub struct Volumes {
+    pub voxels: wgpu::Buffer,
+    pub propagation: [wgpu::Buffer; 2],
+    pub accumulation: wgpu::Buffer,
+}
+
+impl Volumes {
+    pub fn new(gpu: &GpuContext, grid: &Grid) -> Result<Volumes> {
+        grid.check_limits(gpu)?;
+        let buffer = |label: &str| {
+            gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: grid.cells() * CELL_BYTES,
+                usage: wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_SRC
+                    | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        };
+        Ok(Volumes {
+            voxels: buffer("voxels"),
+            propagation: [buffer("propagation a"), buffer("propagation b")],
+            accumulation: buffer("accumulation"),
+        })
+    }
+}
+
+fn entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
+    wgpu::BindGroupEntry {
+        binding,
+        resource: buffer.as_entire_binding(),
+    }
+}
+
+/// Uniform slots of the slice matrices are this far apart.
+const SLICE_STRIDE: u64 = 256;
+
+/// Voxelization, combine and injection (see the module docs).
+pub struct Voxelizer {
+    n: u32,
+    cols: u32,
+    /// Per axis: radiosity, normal, albedo targets (views).
+    targets: Vec<[wgpu::TextureView; 3]>,
+    slice_group: wgpu::BindGroup,
+    pipeline: wgpu::RenderPipeline,
+    combine: wgpu::ComputePipeline,
+    combine_group: wgpu::BindGroup,
+    _slices: wgpu::Buffer,
+    _textures: Vec<wgpu::Texture>,
+}
+
+/// Format of the voxelization atlases (blendable and renderable on Vulkan and GL).
+const ATLAS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+
+impl Voxelizer {
+    pub fn new(
+        gpu: &GpuContext,
+        grid: &Grid,
+        scene: &GpuScene,
+        uniforms: &FrameUniforms,
+        direct: &DirectLight,
+        volumes: &Volumes,
+    ) -> Result<Voxelizer> {
+        let device = &gpu.device;
+        let [w, h] = grid.atlas_size();
+        let mut textures = Vec::new();
+        let mut targets = Vec::new();
+        for axis in ["x", "y", "z"] {
+            let make = |what: &str| {
+                device.create_texture(&wgpu::TextureDescriptor {
+                    label: Some(&format!("voxel atlas {axis} {what}")),
+                    size: wgpu::Extent3d {
+                        width: w,
+                        height: h,
+                        depth_or_array_layers: 1,
+                    },
+                    mip_level_count: 1,
+                    sample_count: 1,
+                    dimension: wgpu::TextureDimension::D2,
+                    format: ATLAS_FORMAT,
+                    usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                        | wgpu::TextureUsages::TEXTURE_BINDING,
+                    view_formats: &[],
+                })
+            };
+            let t = [make("radiosity"), make("normal"), make("albedo")];
+            targets.push(t.each_ref().map(|t| t.create_view(&Default::default())));
+            textures.extend(t);
+        }
+        // One world → clip matrix per (axis, slice), written once.
+        let slices = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("voxel slices"),
+            size: 3 * grid.n as u64 * SLICE_STRIDE,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut bytes = vec![0u8; slices.size() as usize];
+        for axis in 0..3 {
+            for s in 0..grid.n {
+                let m = grid.slice_matrix(axis, s).to_cols_array();
+                let o = (axis as u64 * grid.n as u64 + s as u64) * SLICE_STRIDE;
+                bytes[o as usize..o as usize + 64].copy_from_slice(bytemuck::cast_slice(&m));
+            }
+        }
+        gpu.queue.write_buffer(&slices, 0, &bytes);
+        let slice_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("voxel slice"),
+            entries: &[uniform_entry(0, wgpu::ShaderStages::VERTEX, true)],
+        });
+        let slice_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("voxel slice"),
+            layout: &slice_layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer: &slices,
+                    offset: 0,
+                    size: wgpu::BufferSize::new(64),
+                }),
+            }],
+        });
+        let source = format!(
+            "{}\n{}",
+            DirectLight::wgsl(3),
+            include_str!("shaders/voxelize.wgsl")
+        );
+        let module = shader_module(device, "voxelize", &source);
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("voxelize"),
+            bind_group_layouts: &[
+                Some(&slice_layout),
+                Some(&uniforms.object_layout),
+                Some(&scene.material_layout),
+                Some(&direct.light_layout),
+            ],
+            immediate_size: 0,
+        });
+        let add = wgpu::BlendComponent {
+            src_factor: wgpu::BlendFactor::One,
+            dst_factor: wgpu::BlendFactor::One,
+            operation: wgpu::BlendOperation::Add,
+        };
+        let target = Some(wgpu::ColorTargetState {
+            format: ATLAS_FORMAT,
+            blend: Some(wgpu::BlendState {
+                color: add,
+                alpha: add,
+            }),
+            write_mask: wgpu::ColorWrites::ALL,
+        });
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("voxelize"),
+            layout: Some(&layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_voxel"),
+                compilation_options: Default::default(),
+                buffers: &[Some(Vertex::LAYOUT)],
+            },
+            primitive: wgpu::PrimitiveState {
+                cull_mode: None,
+                ..Default::default()
+            },
+            depth_stencil: None,
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_voxel"),
+                compilation_options: Default::default(),
+                targets: &[target.clone(), target.clone(), target],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        let c = wgpu::ShaderStages::COMPUTE;
+        let unfilterable = wgpu::TextureSampleType::Float { filterable: false };
+        let mut entries: Vec<wgpu::BindGroupLayoutEntry> = (0..9)
+            .map(|b| texture_entry(b, c, unfilterable, wgpu::TextureViewDimension::D2))
+            .collect();
+        entries.extend([
+            storage_entry(9, false),
+            storage_entry(10, false),
+            storage_entry(11, false),
+        ]);
+        let combine_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("voxel combine"),
+            entries: &entries,
+        });
+        let mut group_entries: Vec<wgpu::BindGroupEntry> = targets
+            .iter()
+            .flatten()
+            .enumerate()
+            .map(|(i, v)| wgpu::BindGroupEntry {
+                binding: i as u32,
+                resource: wgpu::BindingResource::TextureView(v),
+            })
+            .collect();
+        group_entries.extend([
+            entry(9, &volumes.voxels),
+            entry(10, &volumes.propagation[0]),
+            entry(11, &volumes.accumulation),
+        ]);
+        let combine_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("voxel combine"),
+            layout: &combine_layout,
+            entries: &group_entries,
+        });
+        let combine = compute_pipeline(
+            device,
+            "voxel combine",
+            &format!("{}\n{}", grid.wgsl(), include_str!("shaders/combine.wgsl")),
+            &[&combine_layout],
+            "combine",
+        );
+        gpu.check_errors()?;
+        Ok(Voxelizer {
+            n: grid.n,
+            cols: grid.cols(),
+            targets,
+            slice_group,
+            pipeline,
+            combine,
+            combine_group,
+            _slices: slices,
+            _textures: textures,
+        })
+    }
+
+    /// Records the three axes' slice passes (every slice draws the static mesh and the
+    /// movers), then the combine and injection pass.
+    pub fn encode(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        scene: &GpuScene,
+        uniforms: &FrameUniforms,
+        direct: &DirectLight,
+    ) {
+        let n = self.n;
+        for (axis, targets) in self.targets.iter().enumerate() {
+            let attachment = |view| {
+                Some(wgpu::RenderPassColorAttachment {
+                    view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })
+            };
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("voxelize"),
+                color_attachments: &[
+                    attachment(&targets[0]),
+                    attachment(&targets[1]),
+                    attachment(&targets[2]),
+                ],
+                depth_stencil_attachment: None,
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(2, &scene.material_group, &[]);
+            pass.set_bind_group(3, &direct.light_group, &[]);
+            for s in 0..n {
+                let (x, y) = ((s % self.cols) * n, (s / self.cols) * n);
+                pass.set_viewport(x as f32, y as f32, n as f32, n as f32, 0.0, 1.0);
+                pass.set_scissor_rect(x, y, n, n);
+                let offset = ((axis as u64 * n as u64 + s as u64) * SLICE_STRIDE) as u32;
+                pass.set_bind_group(0, &self.slice_group, &[offset]);
+                scene.draw(&mut pass, uniforms, 1, DrawSet::StaticAndMovers);
+            }
+        }
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("voxel combine"),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(&self.combine);
+        pass.set_bind_group(0, &self.combine_group, &[]);
+        let g = n.div_ceil(4);
+        pass.dispatch_workgroups(g, g, g);
+    }
+}
+
+/// The propagation iterations (see the module docs).
+pub struct Propagation {
+    n: u32,
+    pipeline: wgpu::ComputePipeline,
+    /// [a → b, b → a].
+    groups: [wgpu::BindGroup; 2],
+}
+
+impl Propagation {
+    pub fn new(gpu: &GpuContext, grid: &Grid, volumes: &Volumes) -> Result<Propagation> {
+        let device = &gpu.device;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("propagation"),
+            entries: &[
+                storage_entry(0, true),
+                storage_entry(1, true),
+                storage_entry(2, false),
+                storage_entry(3, false),
+            ],
+        });
+        let group = |from: usize| {
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("propagation"),
+                layout: &layout,
+                entries: &[
+                    entry(0, &volumes.voxels),
+                    entry(1, &volumes.propagation[from]),
+                    entry(2, &volumes.propagation[1 - from]),
+                    entry(3, &volumes.accumulation),
+                ],
+            })
+        };
+        let pipeline = compute_pipeline(
+            device,
+            "propagation",
+            &format!(
+                "{}\n{}",
+                grid.wgsl(),
+                include_str!("shaders/propagate.wgsl")
+            ),
+            &[&layout],
+            "propagate",
+        );
+        gpu.check_errors()?;
+        Ok(Propagation {
+            n: grid.n,
+            pipeline,
+            groups: [group(0), group(1)],
+        })
+    }
+
+    /// Records `iterations` iterations starting from propagation buffer 0. The field after
+    /// them is in buffer `iterations % 2`.
+    pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, iterations: u32) {
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("propagation"),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(&self.pipeline);
+        let g = self.n.div_ceil(4);
+        for k in 0..iterations {
+            pass.set_bind_group(0, &self.groups[k as usize % 2], &[]);
+            pass.dispatch_workgroups(g, g, g);
+        }
+    }
+}
+
+/// The per-pixel reconstruction (see the module docs).
+pub struct Reconstruction {
+    size: [u32; 2],
+    pipeline: wgpu::ComputePipeline,
+    group: wgpu::BindGroup,
+}
+
+impl Reconstruction {
+    pub fn new(
+        gpu: &GpuContext,
+        grid: &Grid,
+        gbuffer: &GBuffer,
+        volumes: &Volumes,
+        output: &wgpu::TextureView,
+    ) -> Result<Reconstruction> {
+        let device = &gpu.device;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("reconstruction"),
+            entries: &[
+                storage_entry(0, true),
+                storage_entry(1, true),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 2,
+                    visibility: wgpu::ShaderStages::COMPUTE,
+                    ty: wgpu::BindingType::StorageTexture {
+                        access: wgpu::StorageTextureAccess::WriteOnly,
+                        format: HDR_FORMAT,
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                    },
+                    count: None,
+                },
+            ],
+        });
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("reconstruction"),
+            layout: &layout,
+            entries: &[
+                entry(0, &volumes.voxels),
+                entry(1, &volumes.accumulation),
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: wgpu::BindingResource::TextureView(output),
+                },
+            ],
+        });
+        let pipeline = compute_pipeline(
+            device,
+            "reconstruction",
+            &format!(
+                "{}\n{}",
+                grid.wgsl(),
+                include_str!("shaders/reconstruct.wgsl")
+            ),
+            &[&gbuffer.read_layout, &layout],
+            "reconstruct",
+        );
+        gpu.check_errors()?;
+        Ok(Reconstruction {
+            size: gbuffer.size,
+            pipeline,
+            group,
+        })
+    }
+
+    pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, gbuffer: &GBuffer) {
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("reconstruction"),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &gbuffer.read_group, &[]);
+        pass.set_bind_group(1, &self.group, &[]);
+        pass.dispatch_workgroups(self.size[0].div_ceil(8), self.size[1].div_ceil(8), 1);
+    }
+}
