@@ -27,7 +27,7 @@ use gibench_harness::session::{RunSpec, TechniqueRun};
 use gibench_harness::technique::TechniqueInfo;
 use gibench_harness::{Error, Result};
 
-use super::{device_note, load_scene, PaperModule, ReproduceArgs, Reproduced};
+use super::{device_note, load_scene, ms, PaperModule, ReproduceArgs, Reproduced};
 use crate::Bars;
 
 /// The module's entry for `reproduce all`.
@@ -254,14 +254,8 @@ pub fn reproduce(
     for s in &specs {
         s.validate()?;
     }
-    let opened;
-    let gpu = match gpu {
-        Some(g) => g,
-        None => {
-            opened = super::open_gpu(args)?;
-            &opened
-        }
-    };
+    let mut opened = None;
+    let gpu = super::gpu_or_open(gpu, args, &mut opened)?;
     let mut runs = Vec::new();
     for s in &specs {
         runs.extend(crate::execute_with_bar(bars, gpu, s)?);
@@ -273,10 +267,6 @@ pub fn reproduce(
         (table1(&runs, &loaded)?, "gaitatzes-table1")
     };
     Ok((vec![table], runs))
-}
-
-fn ms(r: &RunResult, stage: &str) -> Option<f64> {
-    r.stage(stage).and_then(|s| s.best_ms())
 }
 
 fn iterations(r: &RunResult) -> Option<f64> {

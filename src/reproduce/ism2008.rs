@@ -27,7 +27,7 @@ use gibench_harness::{Error, Result};
 use gibench_ism::{STAGE_POINT_SPLAT, STAGE_PULL_PUSH, STAGE_RSM, STAGE_VPL_SAMPLING};
 use gibench_keller::STAGE_VPL_GENERATION;
 
-use super::{device_note, load_scene, PaperModule, ReproduceArgs, Reproduction};
+use super::{device_note, load_scene, ms, sum_ms, PaperModule, ReproduceArgs, Reproduction};
 use crate::Bars;
 use gibench_harness::gpu::GpuContext;
 
@@ -207,14 +207,8 @@ pub fn reproduce(
     let scene = load_scene(&sizes(args).scene, args)?;
     let spec = spec(args, &scene)?;
     spec.validate()?;
-    let opened;
-    let gpu = match gpu {
-        Some(g) => g,
-        None => {
-            opened = super::open_gpu(args)?;
-            &opened
-        }
-    };
+    let mut opened = None;
+    let gpu = super::gpu_or_open(gpu, args, &mut opened)?;
     let runs = crate::execute_with_bar(bars, gpu, &spec)?;
     let table = breakdown(args, &scene, &runs)?;
     Ok((vec![(table, "ism-breakdown")], runs))
@@ -225,19 +219,11 @@ fn paper() -> Result<serde_json::Value> {
     super::paper("ism2008", include_str!("../../results/papers/ism2008.json"))
 }
 
-fn ms(r: &RunResult, stage: &str) -> Option<f64> {
-    r.stage(stage).and_then(|s| s.best_ms())
-}
-
-fn sum(r: &RunResult, stages: &[&str]) -> Option<f64> {
-    stages.iter().map(|s| ms(r, s)).sum()
-}
-
 /// The time a run spends making its VPLs' maps: `ism`'s splat and pull-push, the others'
 /// rasterised maps.
 fn maps_ms(r: &RunResult) -> Option<f64> {
     if r.technique == "ism" {
-        sum(r, &[STAGE_POINT_SPLAT, STAGE_PULL_PUSH])
+        sum_ms(r, &[STAGE_POINT_SPLAT, STAGE_PULL_PUSH])
     } else {
         ms(r, STAGE_VPL_SHADOW_MAPS)
     }
@@ -306,7 +292,7 @@ fn breakdown(
             Cell::Ms(maps_ms(r)),
             Cell::Ms(ms(r, STAGE_POINT_SPLAT)),
             Cell::Ms(ms(r, STAGE_PULL_PUSH)),
-            Cell::Ms(sum(r, &GATHERING)),
+            Cell::Ms(sum_ms(r, &GATHERING)),
             Cell::Ms(ms(r, STAGE_FILTER)),
             Cell::Ms(frame),
             Cell::Num(fps(r), 1),

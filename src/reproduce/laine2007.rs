@@ -26,7 +26,9 @@ use gibench_harness::session::{RunSpec, TechniqueRun};
 use gibench_harness::technique::TechniqueInfo;
 use gibench_harness::{Error, Result};
 
-use super::{device_note, load_scene, paper_cells, PaperModule, ReproduceArgs, Reproduction};
+use super::{
+    device_note, load_scene, ms, paper_cells, sum_ms, PaperModule, ReproduceArgs, Reproduction,
+};
 use crate::Bars;
 use gibench_harness::gpu::GpuContext;
 
@@ -268,14 +270,8 @@ fn run_pairs(args: &ReproduceArgs, gpu: Option<&GpuContext>, bars: &Bars) -> Res
     for (_, _, spec) in &specs {
         spec.validate()?;
     }
-    let opened;
-    let gpu = match gpu {
-        Some(g) => g,
-        None => {
-            opened = super::open_gpu(args)?;
-            &opened
-        }
-    };
+    let mut opened = None;
+    let gpu = super::gpu_or_open(gpu, args, &mut opened)?;
     let mut out = Vec::new();
     for (name, res, spec) in &specs {
         let mut results = crate::execute_with_bar(bars, gpu, spec)?;
@@ -284,14 +280,6 @@ fn run_pairs(args: &ReproduceArgs, gpu: Option<&GpuContext>, bars: &Bars) -> Res
         out.push((name.clone(), *res, laine, keller));
     }
     Ok(out)
-}
-
-fn ms(r: &RunResult, stage: &str) -> Option<f64> {
-    r.stage(stage).and_then(|s| s.best_ms())
-}
-
-fn sum(r: &RunResult, stages: &[&str]) -> Option<f64> {
-    stages.iter().map(|s| ms(r, s)).sum()
 }
 
 fn table1(pairs: &[Pair]) -> Result<Table> {
@@ -317,7 +305,7 @@ fn table1(pairs: &[Pair]) -> Result<Table> {
     );
     let mut rows = Vec::new();
     for (scene, res, laine, keller) in pairs {
-        let direct = sum(laine, &[STAGE_DIRECT_SHADOW_MAP, STAGE_DIRECT_LIGHT]);
+        let direct = sum_ms(laine, &[STAGE_DIRECT_SHADOW_MAP, STAGE_DIRECT_LIGHT]);
         let fps = |r: &RunResult| r.frame.as_ref().map(|f| f.fps);
         let (fc, fo) = (fps(keller), fps(laine));
         let speedup_indirect = match (fc, fo, direct) {
@@ -333,7 +321,7 @@ fn table1(pairs: &[Pair]) -> Result<Table> {
             report::vpl_count_cell(keller),
             Cell::Ms(direct),
             Cell::Ms(ms(laine, STAGE_GBUFFER)),
-            Cell::Ms(sum(laine, &COMMON_STAGES)),
+            Cell::Ms(sum_ms(laine, &COMMON_STAGES)),
             Cell::Ms(ms(laine, STAGE_VPL_SHADOW_MAPS)),
             Cell::Ms(ms(keller, STAGE_VPL_SHADOW_MAPS)),
             Cell::Ms(ms(laine, gibench_laine::STAGE_VPL_MANAGEMENT)),
@@ -415,7 +403,7 @@ fn table2(pairs: &[Pair]) -> Result<Table> {
             Cell::text(format!("{}x{}", res[0], res[1])),
         ];
         row.extend(COMMON_STAGES.iter().map(|s| Cell::Ms(ms(laine, s))));
-        row.push(Cell::Ms(sum(laine, &COMMON_STAGES)));
+        row.push(Cell::Ms(sum_ms(laine, &COMMON_STAGES)));
         rows.push(row);
         if !seen.contains(res) {
             seen.push(*res);

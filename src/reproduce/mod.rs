@@ -119,6 +119,28 @@ pub fn open_gpu(args: &ReproduceArgs) -> Result<GpuContext> {
     })
 }
 
+/// `gpu`, or else the adapter `args` asks for, opened here and kept in `opened`.
+pub fn gpu_or_open<'a>(
+    gpu: Option<&'a GpuContext>,
+    args: &ReproduceArgs,
+    opened: &'a mut Option<GpuContext>,
+) -> Result<&'a GpuContext> {
+    match gpu {
+        Some(g) => Ok(g),
+        None => Ok(opened.insert(open_gpu(args)?)),
+    }
+}
+
+/// A stage's table figure in `r` (flushed wall time, else GPU timestamps), if it has it.
+pub fn ms(r: &RunResult, stage: &str) -> Option<f64> {
+    r.stage(stage).and_then(|s| s.best_ms())
+}
+
+/// The sum of `stages`' figures in `r` (`None` if one is missing).
+pub fn sum_ms(r: &RunResult, stages: &[&str]) -> Option<f64> {
+    stages.iter().map(|s| ms(r, s)).sum()
+}
+
 /// "Ours: adapter (backend, driver); git commit." for a table's notes.
 pub fn device_note(runs: &[&RunResult]) -> String {
     let mut devices: Vec<String> = runs
