@@ -2,7 +2,7 @@
 //! Cornell and Sibenik; Laine's sampling domains (disc and sphere, 256 and 1024 points): one
 //! delete + insert, the largest empty circle, the Voronoi areas; Laine's whole VPL management
 //! per frame, spot and omni; VPL generation (Keller's light paths); the reference path tracer
-//! (one path per pixel) — and one whole frame of each registered technique on the Cornell box
+//! (one path per pixel); ISM's point pool — and one whole frame of each registered technique on the Cornell box
 //! (GPU, flushed per frame).
 //!
 //! `cargo bench` runs them; `cargo bench -- rays` runs a subset; `cargo test --benches` (CI)
@@ -114,6 +114,25 @@ fn vpl_generation(c: &mut Criterion) {
     }
 }
 
+/// ISM's point pool (`ir::points`): 65,536 points on the surfaces of Cornell and Sibenik,
+/// uniform by area, shuffled — `ism`'s preparation step.
+fn point_pool(c: &mut Criterion) {
+    let assets = AssetPaths::standard(None);
+    for name in ["cornell", "sibenik"] {
+        let Ok(scene) = Scene::load_named(name, &assets) else {
+            eprintln!("skipping point-pool/{name}: scene not found");
+            continue;
+        };
+        c.bench_function(&format!("point-pool/65536/{name}"), |b| {
+            b.iter(|| {
+                gibench_harness::ir::points::sample_scene(&scene, 65_536, 1)
+                    .expect("surfaces")
+                    .len()
+            })
+        });
+    }
+}
+
 /// The reference path tracer: one path per pixel (8 bounces) over a 64x48 image of Cornell.
 fn reference_paths(c: &mut Criterion) {
     let scene =
@@ -202,6 +221,6 @@ fn frames(c: &mut Criterion) {
 criterion_group! {
     name = benches;
     config = Criterion::default().sample_size(20);
-    targets = rays, domains, laine_management, vpl_generation, reference_paths, frames
+    targets = rays, domains, laine_management, vpl_generation, point_pool, reference_paths, frames
 }
 criterion_main!(benches);

@@ -229,25 +229,29 @@ impl AtlasRasteriser {
         vpls: &[(u32, Vpl)],
         clear: AtlasClear,
     ) -> u32 {
-        let vpls: Vec<&(u32, Vpl)> = vpls.iter().filter(|(s, _)| *s < self.capacity).collect();
+        let kept = || vpls.iter().filter(|(s, _)| *s < self.capacity);
         // One upload covering every slot rendered (per-slot writes cost about 1 ms each on
         // lavapipe: 8x the maps themselves at 256 VPLs).
         let mut mirror = self.mirror.borrow_mut();
-        for (slot, vpl) in &vpls {
+        let (mut lo, mut hi) = (u32::MAX, 0);
+        for (slot, vpl) in kept() {
             self.write_view(&mut mirror, atlas, *slot, vpl);
+            (lo, hi) = (lo.min(*slot), hi.max(*slot));
         }
-        if let (Some(lo), Some(hi)) = (
-            vpls.iter().map(|(s, _)| *s).min(),
-            vpls.iter().map(|(s, _)| *s).max(),
-        ) {
+        if lo <= hi {
             let slot_bytes = self.kind.faces() as usize * VIEW_STRIDE as usize;
             let range = lo as usize * slot_bytes..(hi as usize + 1) * slot_bytes;
             gpu.queue
                 .write_buffer(&self.view_buffer, range.start as u64, &mirror[range]);
         }
-        let slots: Vec<u32> = vpls.iter().map(|(slot, _)| *slot).collect();
-        self.draw(encoder, atlas, scene, uniforms, &slots, clear);
-        slots.len() as u32
+        self.draw(
+            encoder,
+            atlas,
+            scene,
+            uniforms,
+            kept().map(|(s, _)| *s),
+            clear,
+        )
     }
 
     /// Records the maps of slots `0..count` of the store `views` reads (clamped to the
@@ -272,21 +276,20 @@ impl AtlasRasteriser {
             pass.set_bind_group(0, &views.group, &[]);
             pass.dispatch_workgroups(count.div_ceil(64), 1, 1);
         }
-        let slots: Vec<u32> = (0..count).collect();
-        self.draw(encoder, atlas, scene, uniforms, &slots, AtlasClear::Whole);
-        count
+        self.draw(encoder, atlas, scene, uniforms, 0..count, AtlasClear::Whole)
     }
 
     /// Records the maps of `slots`, whose views are in place, after the clear `clear` asks for.
+    /// Returns the number of maps recorded.
     fn draw(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         atlas: &ShadowAtlas,
         scene: &GpuScene,
         uniforms: &FrameUniforms,
-        slots: &[u32],
+        slots: impl Iterator<Item = u32>,
         clear: AtlasClear,
-    ) {
+    ) -> u32 {
         let load = match clear {
             AtlasClear::Whole => wgpu::LoadOp::Clear(0.0),
             AtlasClear::RenderedSlots => wgpu::LoadOp::Load,
@@ -308,7 +311,9 @@ impl AtlasRasteriser {
         });
         let s = atlas.settings.size;
         let faces = self.kind.faces();
-        for &slot in slots {
+        let mut count = 0;
+        for slot in slots {
+            count += 1;
             if clear == AtlasClear::RenderedSlots {
                 let ([x, y], [w, h]) = atlas.block(slot);
                 pass.set_viewport(x as f32, y as f32, w as f32, h as f32, 0.0, 1.0);
@@ -326,6 +331,7 @@ impl AtlasRasteriser {
                 scene.draw(&mut pass, uniforms, 1, self.draw_set);
             }
         }
+        count
     }
 
     /// The compute pass that writes the views of the VPLs in `store` for
