@@ -110,7 +110,8 @@ fn write_combined(gpu: &GpuContext, inter: &Interleave, rgb: &[[f32; 3]]) {
     gpu.queue.write_buffer(&inter.combined, 0, &bytes);
 }
 
-/// Runs the filter alone on `input` and reads `output` back.
+/// Runs the split (the filter reads its surfaces from the split buffers), then the filter on
+/// `input`, and reads `output` back.
 fn filter(
     gpu: &GpuContext,
     inter: &Interleave,
@@ -119,6 +120,7 @@ fn filter(
 ) -> Vec<[f32; 3]> {
     write_combined(gpu, inter, input);
     let mut enc = gpu.device.create_command_encoder(&Default::default());
+    inter.encode_split(&mut enc);
     inter.encode_filter(&mut enc);
     gpu.queue.submit([enc.finish()]);
     let out = gibench_harness::image_io::read_rgb_f32(gpu, output).unwrap();

@@ -29,8 +29,9 @@
 //!   `split_tile(sx, sy)`.
 //! * **combine** ([`Interleave::encode_combine`], label `interleave combine`) — reads:
 //!   `split_irradiance`; writes: `combined` (W×H, row-major), the exact inverse of the split.
-//! * **filter** ([`Interleave::encode_filter`], label `interleave filter`) — reads: the G-buffer
-//!   and `combined`; writes: the technique's `output` texture (Rgba16Float, rgb = filtered
+//! * **filter** ([`Interleave::encode_filter`], label `interleave filter`) — reads:
+//!   `split_position` and `split_normal` (this frame's split: each tap's surface without
+//!   rebuilding its position from depth) and `combined`; writes: the technique's `output` texture (Rgba16Float, rgb = filtered
 //!   irradiance, a = 1 where geometry was hit; background pixels are 0). Per pixel p the n×m box
 //!   of offsets x ∈ [0, n), y ∈ [0, m) from p − (⌊n/2⌋, ⌊m/2⌋) is averaged over pixels q with
 //!   |pos(q) − pos(p)| < α and normal(q)·normal(p) > β (p itself always counts). At image borders
@@ -399,7 +400,8 @@ impl Interleave {
         self.run(enc, "interleave combine", &self.combine_pipeline, self.full);
     }
 
-    /// Records the geometry-aware n×m box filter: G-buffer, `combined` → `output`.
+    /// Records the geometry-aware n×m box filter: `split_position`, `split_normal` (the split
+    /// must have run on this frame's G-buffer), `combined` → `output`.
     pub fn encode_filter(&self, enc: &mut wgpu::CommandEncoder) {
         self.run(enc, "interleave filter", &self.filter_pipeline, self.full);
     }

@@ -1,6 +1,7 @@
 
 // The harness's interleave passes: split (G-buffer → split buffers), combine (split_irradiance →
-// combined) and the geometry-aware box filter of Laine et al. 2007, Figure 5 (combined → output).
+// combined) and the geometry-aware box filter of Laine et al. 2007, Figure 5 (split position and
+// normal, combined → output).
 // Prepended: common.wgsl and interleave.wgsl.
 
 @group(0) @binding(0) var<storage, read> interleave: InterleaveParams;
@@ -32,6 +33,19 @@ fn surface_at(pix: vec2<u32>) -> Surface {
         s.position = world_from_depth(view, vec2<f32>(pix) + 0.5, depth);
     }
     return s;
+}
+
+// The same surface read back from the split buffers (written by split_main this frame): the
+// filter's taps, without rebuilding each tap's position from depth.
+fn split_surface_at(pix: vec2<u32>) -> Surface {
+    let s = split_texel_of_pixel(pix.x, pix.y);
+    let i = split_index(s.x, s.y);
+    let p = split_position[i];
+    var out: Surface;
+    out.hit = p.w != 0.0;
+    out.position = p.xyz;
+    out.normal = split_normal[i].xyz;
+    return out;
 }
 
 @compute @workgroup_size(8, 8)
@@ -70,7 +84,7 @@ fn filter_main(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let pix = id.xy;
-    let centre = surface_at(pix);
+    let centre = split_surface_at(pix);
     var result = vec4<f32>(0.0);
     if (centre.hit) {
         // The n×m box starts at p − floor(n/2), shifted to lie inside the image where it would
@@ -91,7 +105,7 @@ fn filter_main(@builtin(global_invocation_id) id: vec3<u32>) {
                 }
                 var take = all(t == pix);
                 if (!take) {
-                    let s = surface_at(t);
+                    let s = split_surface_at(t);
                     take = s.hit && length(s.position - centre.position) < alpha
                         && dot(s.normal, centre.normal) > beta;
                 }
