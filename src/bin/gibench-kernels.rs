@@ -19,7 +19,7 @@ const KERNELS: [&str; 6] = [
     "bvh-closest-hit-cornell",
     "bvh-shadow-cornell",
     "domain-delete-insert-disc-256",
-    "domain-largest-empty-circle-sphere-256",
+    "domain-fill-at-largest-empty-circle-sphere-256",
     "domain-voronoi-areas-disc-256",
     "vpl-generation-cornell",
 ];
@@ -81,8 +81,18 @@ pub extern "Rust" fn gibench_kernel_body(name: &str, s: &mut Setup, round: u64) 
             s.disc.insert(256 + round, p).expect("reinserted");
             p.x
         }
-        "domain-largest-empty-circle-sphere-256" => {
-            s.sphere.largest_empty_circle().map_or(0.0, |(_, r)| r)
+        // As the management creates points: 16 times, the largest empty circle and an insertion
+        // at its centre (the first query fills the kept candidates, the later ones update them).
+        "domain-fill-at-largest-empty-circle-sphere-256" => {
+            let mut sum = 0.0;
+            for k in 0..16 {
+                let (c, r, site) = s.sphere.largest_empty_circle_near().expect("sites");
+                s.sphere
+                    .insert_near(1_000 + 16 * round + k, c, site)
+                    .expect("inserted");
+                sum += r;
+            }
+            sum
         }
         "domain-voronoi-areas-disc-256" => s.disc.voronoi_areas().iter().map(|(_, a)| a).sum(),
         "vpl-generation-cornell" => {

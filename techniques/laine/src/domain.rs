@@ -47,15 +47,28 @@
 //! 256 and ~0.6 ms for 1024 points): the only non-incremental update, hit with probability
 //! 1/n per removal.
 //!
-//! Cost per query is O(n) (one pass over the triangulation) for n sites.
+//! Costs for n sites: the largest empty circle is kept between queries ([`crate::lec`]): O(n)
+//! after a removal, O(d log n) after inserting a site of degree d, O(1) otherwise; the
+//! shortest edge and the Voronoi areas are one pass (the areas across cores). Point location
+//! starts from a coarse grid of recently inserted sites.
 
 use std::collections::HashMap;
 use std::f64::consts::PI;
 use std::fmt;
+use std::sync::Mutex;
 
 use glam::{DVec2, DVec3};
-use spade::handles::FixedVertexHandle;
-use spade::{DelaunayTriangulation, HasPosition, Point2, Triangulation};
+use rayon::prelude::*;
+use spade::handles::{
+    FixedDirectedEdgeHandle, FixedFaceHandle, FixedUndirectedEdgeHandle, FixedVertexHandle,
+    InnerTag,
+};
+use spade::{
+    DelaunayTriangulation, HasPosition, HintGenerator, Point2, PositionInTriangulation,
+    Triangulation,
+};
+
+use crate::lec::{Candidate, LecCache};
 
 /// Which 2D domain the sampling points live in (Laine et al. 2007, §4.1, Figure 3).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -112,6 +125,44 @@ impl HasPosition for Site {
     }
 }
 
+/// A hasher for sequential ids (a multiplicative mix; the ids are the caller's, not
+/// adversarial): the domain looks ids up several times per site and frame.
+#[derive(Clone, Copy, Default)]
+struct IdHasher(u64);
+
+impl std::hash::Hasher for IdHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.0 = (self.0.rotate_left(8) ^ b as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+        }
+    }
+    fn write_u64(&mut self, n: u64) {
+        self.0 = (n ^ (n >> 32)).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+    }
+}
+
+type IdMap<V> = HashMap<u64, V, std::hash::BuildHasherDefault<IdHasher>>;
+
+/// Cells per axis of the location grids: grids over the domain's points ([−1, 1]² or ³)
+/// remembering, per cell, the id of the last site inserted there — where spade's point
+/// location for the next point in that cell starts (the fine grid's cell, or if it is empty
+/// the coarse one's). The sphere's points fill only its surface cells, hence fewer per axis.
+const GRIDS: [(usize, usize); 2] = [(8, 4), (2, 2)];
+
+/// Index of point `p`'s cell in grid `level` of [`GRIDS`] (the disc's grids have one layer).
+fn grid_cell(kind: DomainKind, level: usize, p: DVec3) -> usize {
+    let n = match kind {
+        DomainKind::Disc => GRIDS[level].0,
+        DomainKind::Sphere => GRIDS[level].1,
+    };
+    let c = |x: f64| (((x + 1.0) * 0.5 * n as f64) as isize).clamp(0, n as isize - 1) as usize;
+    let z = if kind == DomainKind::Disc { 0 } else { c(p.z) };
+    (z * n + c(p.y)) * n + c(p.x)
+}
+
 /// Where a site lives.
 #[derive(Clone, Copy, Debug)]
 enum Slot {
@@ -150,13 +201,31 @@ impl Pole {
 /// A set of sampling points with stable ids in the unit disc or on the unit sphere, and its
 /// incrementally maintained Delaunay triangulation (Laine et al. 2007, §4.1). See the module
 /// docs for the metric and for how the sphere is triangulated.
-#[derive(Clone)]
 pub struct SamplingDomain {
     kind: DomainKind,
     tri: DelaunayTriangulation<Site>,
-    slots: HashMap<u64, Slot>,
+    slots: IdMap<Slot>,
+    /// The location grids (see [`GRIDS`]): per cell the id of a site inserted there, or
+    /// `u64::MAX`; entries of removed sites are skipped when read.
+    grids: [Vec<u64>; 2],
     /// Sphere only: the projection pole (`None` for the disc and for an empty sphere).
     pole: Option<Pole>,
+    /// The largest-empty-circle candidates ([`crate::lec`]), filled by the first query and
+    /// updated by insertions.
+    lec: Mutex<LecCache>,
+}
+
+impl Clone for SamplingDomain {
+    fn clone(&self) -> Self {
+        SamplingDomain {
+            kind: self.kind,
+            tri: self.tri.clone(),
+            slots: self.slots.clone(),
+            grids: self.grids.clone(),
+            pole: self.pole,
+            lec: Mutex::new(self.lec_cache().clone()),
+        }
+    }
 }
 
 impl fmt::Debug for SamplingDomain {
@@ -253,6 +322,33 @@ fn clip_half_plane(poly: &[DVec2], m: DVec2, d: DVec2, out: &mut Vec<DVec2>) {
     }
 }
 
+/// Sites from which per-site passes (the Voronoi areas) run across cores; below it one thread
+/// is faster than handing the work out (and the instruction-count gate's 256-site kernels
+/// count all of it).
+const PARALLEL_SITES: usize = 512;
+
+/// `f(scratch, i)` for every site index `i < n`, in order: across cores (one `init()` scratch
+/// per worker) from [`PARALLEL_SITES`] sites on, on the calling thread below.
+fn map_sites<T: Send, S>(
+    n: usize,
+    init: impl Fn() -> S + Sync + Send,
+    f: impl Fn(&mut S, usize) -> T + Sync + Send,
+) -> Vec<T> {
+    if n >= PARALLEL_SITES {
+        (0..n).into_par_iter().map_init(init, f).collect()
+    } else {
+        let mut scratch = init();
+        (0..n).map(|i| f(&mut scratch, i)).collect()
+    }
+}
+
+/// Buffers for [`SamplingDomain::disc_cell`], one set per worker.
+#[derive(Default)]
+struct DiscCellScratch {
+    poly: Vec<DVec2>,
+    tmp: Vec<DVec2>,
+}
+
 /// Half the side of the square the disc's Voronoi cells are first clipped to (it contains the
 /// unit disc with margin, so the clipped cells ∩ disc are exact).
 const BOX: f64 = 2.0;
@@ -288,11 +384,25 @@ impl SamplingDomain {
 
     /// An empty domain of `kind`.
     pub fn new(kind: DomainKind) -> Self {
+        Self::with_capacity(kind, 0)
+    }
+
+    /// An empty domain of `kind` with room for `n` sites (no reallocation while it is filled
+    /// up to that).
+    pub fn with_capacity(kind: DomainKind, n: usize) -> Self {
         SamplingDomain {
             kind,
-            tri: DelaunayTriangulation::new(),
-            slots: HashMap::new(),
+            tri: DelaunayTriangulation::with_capacity(n, 3 * n, 2 * n + 1),
+            slots: IdMap::with_capacity_and_hasher(n, Default::default()),
+            grids: [0, 1].map(|level| {
+                let n = match kind {
+                    DomainKind::Disc => GRIDS[level].0.pow(2),
+                    DomainKind::Sphere => GRIDS[level].1.pow(3),
+                };
+                vec![u64::MAX; n]
+            }),
             pole: None,
+            lec: Mutex::new(LecCache::default()),
         }
     }
 
@@ -345,6 +455,21 @@ impl SamplingDomain {
     /// equal to an existing one (on the sphere: within 10⁻¹² of the pole site, or projecting
     /// onto an existing projected point).
     pub fn insert(&mut self, id: u64, point: DVec3) -> Result<(), DomainError> {
+        self.insert_near(id, point, None)
+    }
+
+    /// [`insert`](Self::insert), with the id of a site near `point` (e.g. the site of the
+    /// largest empty circle it fills) to start spade's point location from; without one (or
+    /// if it is gone) the location grid's site in `point`'s cell. The triangulation afterwards
+    /// is the one spade's plain `insert` makes, index for index: a hint is used only when the
+    /// point lies strictly inside a face (then the face is unique, whatever the walk);
+    /// otherwise the point is located from where a plain `insert` would start.
+    pub fn insert_near(
+        &mut self,
+        id: u64,
+        point: DVec3,
+        near: Option<u64>,
+    ) -> Result<(), DomainError> {
         if self.slots.contains_key(&id) {
             return Err(DomainError::DuplicateId(id));
         }
@@ -370,6 +495,7 @@ impl SamplingDomain {
                 let Some(pole) = self.pole else {
                     self.pole = Some(Pole::new(id, x));
                     self.slots.insert(id, Slot::Pole);
+                    self.lec_mut().valid = false;
                     return Ok(());
                 };
                 if (x - pole.point).length_squared() < 1e-24 {
@@ -378,14 +504,57 @@ impl SamplingDomain {
                 (pole.project(x), x)
             }
         };
-        if let Some(v) = self.tri.locate_vertex(pos) {
-            return Err(DomainError::DuplicatePoint(v.data().id));
+        let site = Site { pos, point, id };
+        let incremental = self.tri.num_inner_faces() > 0;
+        let cells = [0, 1].map(|level| grid_cell(self.kind, level, point));
+        let planar = |n: u64| match self.slots.get(&n) {
+            Some(Slot::Planar(h)) => Some(*h),
+            _ => None,
+        };
+        let hint = near
+            .and_then(planar)
+            .or_else(|| planar(self.grids[0][cells[0]]))
+            .or_else(|| planar(self.grids[1][cells[1]]))
+            .filter(|_| incremental);
+        let mut handle = None;
+        if let Some(h) = hint {
+            // Where an unhinted call would start: restored unless the hinted walk found the
+            // (unique) face containing the point.
+            let start = self.tri.hint_generator().get_hint(pos);
+            if let PositionInTriangulation::OnFace(f) = self.tri.locate_with_hint(pos, h) {
+                // Located again from a corner of the face found: a walk of one step.
+                let corner = self.tri.face(f).vertices()[0].fix();
+                handle = Some(
+                    self.tri
+                        .insert_with_hint(site, corner)
+                        .map_err(|_| DomainError::InvalidPoint)?,
+                );
+            } else {
+                HintGenerator::<f64>::notify_vertex_lookup(self.tri.hint_generator(), start);
+            }
         }
-        let handle = self
-            .tri
-            .insert(Site { pos, point, id })
-            .map_err(|_| DomainError::InvalidPoint)?;
+        let handle = match handle {
+            Some(h) => h,
+            None => {
+                if let Some(v) = self.tri.locate_vertex(pos) {
+                    return Err(DomainError::DuplicatePoint(v.data().id));
+                }
+                self.tri
+                    .insert(site)
+                    .map_err(|_| DomainError::InvalidPoint)?
+            }
+        };
         self.slots.insert(id, Slot::Planar(handle));
+        self.grids[0][cells[0]] = id;
+        self.grids[1][cells[1]] = id;
+        let lec = self.lec_mut();
+        if lec.valid && incremental {
+            let mut lec = std::mem::take(lec);
+            self.update_lec(&mut lec, handle);
+            *self.lec_mut() = lec;
+        } else {
+            lec.valid = false;
+        }
         Ok(())
     }
 
@@ -393,6 +562,7 @@ impl SamplingDomain {
     /// site of degree d); returns its point, or `None` if absent. On the sphere, removing the
     /// projection pole re-projects the other sites from a new pole (see the module docs).
     pub fn remove(&mut self, id: u64) -> Option<DVec3> {
+        self.lec_mut().valid = false;
         match self.slots.remove(&id)? {
             Slot::Planar(h) => {
                 let removed = self.tri.remove(h);
@@ -416,6 +586,7 @@ impl SamplingDomain {
         let mut sites: Vec<Site> = self.tri.vertices().map(|v| *v.data()).collect();
         self.tri = DelaunayTriangulation::new();
         self.slots.clear();
+        self.lec_mut().valid = false;
         let Some(first) = sites.pop() else {
             return;
         };
@@ -437,6 +608,27 @@ impl SamplingDomain {
         for h in self.tri.fixed_vertices() {
             self.slots
                 .insert(self.tri.vertex(h).data().id, Slot::Planar(h));
+        }
+    }
+
+    /// The largest-empty-circle cache (a poisoned lock only means a panic elsewhere mid-query;
+    /// the cache is then recomputed).
+    fn lec_cache(&self) -> std::sync::MutexGuard<'_, LecCache> {
+        self.lec.lock().unwrap_or_else(|e| {
+            let mut guard = e.into_inner();
+            guard.valid = false;
+            guard
+        })
+    }
+
+    fn lec_mut(&mut self) -> &mut LecCache {
+        match self.lec.get_mut() {
+            Ok(lec) => lec,
+            Err(e) => {
+                let lec = e.into_inner();
+                lec.valid = false;
+                lec
+            }
         }
     }
 
@@ -569,10 +761,245 @@ impl SamplingDomain {
     ///   two → the point of their bisecting great circle farthest from both.
     ///
     /// Always `Some` for a valid domain; `None` only if no candidate had a finite radius.
+    ///
+    /// Answered from candidates kept between calls ([`crate::lec`]): after an insertion only
+    /// the slots it changed are recomputed; after a removal the next call recomputes all.
     pub fn largest_empty_circle(&self) -> Option<(DVec3, f64)> {
+        self.largest_empty_circle_near().map(|(c, r, _)| (c, r))
+    }
+
+    /// [`largest_empty_circle`](Self::largest_empty_circle) with the id of a site on its
+    /// circle (a hint for [`insert_near`](Self::insert_near)), `None` where there is none.
+    pub fn largest_empty_circle_near(&self) -> Option<(DVec3, f64, Option<u64>)> {
+        match self.kind {
+            DomainKind::Disc if self.tri.num_vertices() == 0 => {
+                return Some((DVec3::ZERO, 1.0, None));
+            }
+            DomainKind::Sphere if self.len() < 3 => {
+                return self
+                    .sphere_largest_empty_circle()
+                    .map(|(c, r)| (c, r, None));
+            }
+            _ => {}
+        }
+        let mut lec = self.lec_cache();
+        if !lec.valid {
+            self.recompute_lec(&mut lec);
+        }
+        let (centre, radius, site) = lec.best()?;
+        Some((centre, radius, Some(self.site_id(site as usize))))
+    }
+
+    /// The largest empty circle by a pass over the whole triangulation, without the kept
+    /// candidates: what [`largest_empty_circle`](Self::largest_empty_circle) must equal bit
+    /// for bit (the tests compare them).
+    pub fn largest_empty_circle_by_scan(&self) -> Option<(DVec3, f64)> {
         match self.kind {
             DomainKind::Disc => self.disc_largest_empty_circle(),
             DomainKind::Sphere => self.sphere_largest_empty_circle(),
+        }
+    }
+
+    /// Disc: the circumcentre of inner face `f`.
+    fn disc_face_centre(&self, f: FixedFaceHandle<InnerTag>) -> Option<DVec2> {
+        let [a, b, c] = self
+            .tri
+            .face(f)
+            .vertices()
+            .map(|v| v.data().point.truncate());
+        circumcentre(a, b, c)
+    }
+
+    /// Disc, case (1): face `f`'s circumcentre `m` if inside the disc.
+    fn disc_face_slot(&self, f: FixedFaceHandle<InnerTag>, m: Option<DVec2>) -> Candidate {
+        let m = m?;
+        let a = self.tri.face(f).vertices()[0];
+        let r = (m - a.data().point.truncate()).length();
+        (m.length_squared() <= 1.0 && r.is_finite())
+            .then(|| (m.extend(0.0), r, a.fix().index() as u32))
+    }
+
+    /// Disc, case (2): where the Voronoi edge of undirected edge `u` crosses the rim (its two
+    /// roots, in the scan's order), from the faces' circumcentres `centres`.
+    fn disc_edge_slots(
+        &self,
+        u: FixedUndirectedEdgeHandle,
+        centres: &[Option<DVec2>],
+    ) -> [Candidate; 2] {
+        let mut out = [None, None];
+        let e = self.tri.directed_edge(u.as_directed());
+        let site = e.from().fix().index() as u32;
+        let pos = |v: spade::handles::VertexHandle<Site>| v.data().point.truncate();
+        let (p, q) = (pos(e.from()), pos(e.to()));
+        let left = e.face().as_inner().map(|f| centres[f.fix().index()]);
+        let right = e.rev().face().as_inner().map(|f| centres[f.fix().index()]);
+        let normal = (q - p).perp().normalize_or_zero();
+        let (origin, t_range) = match (left, right) {
+            (Some(Some(l)), Some(Some(r))) => (r, (0.0, (l - r).dot(normal))),
+            (None, Some(Some(r))) => (r, (0.0, f64::INFINITY)),
+            (Some(Some(l)), None) => (l, (f64::NEG_INFINITY, 0.0)),
+            (None, None) => (0.5 * (p + q), (f64::NEG_INFINITY, f64::INFINITY)),
+            _ => return out,
+        };
+        let half_b = origin.dot(normal);
+        let disc = half_b * half_b - (origin.length_squared() - 1.0);
+        if disc >= 0.0 {
+            let s = disc.sqrt();
+            for (k, t) in [-half_b - s, -half_b + s].into_iter().enumerate() {
+                if t >= t_range.0.min(t_range.1) && t <= t_range.0.max(t_range.1) {
+                    let c = origin + normal * t;
+                    let c = c / c.length();
+                    let r = (c - p).length();
+                    if r.is_finite() {
+                        out[k] = Some((c.extend(0.0), r, site));
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// Disc, case (3): the rim point opposite vertex `v` if its cell reaches it.
+    fn disc_vertex_slot(&self, v: FixedVertexHandle) -> Candidate {
+        let v = self.tri.vertex(v);
+        let p = v.data().point.truncate();
+        let len = p.length();
+        let c = if len > 0.0 { -p / len } else { DVec2::X };
+        let rp = (c - p).length_squared();
+        let inside = v.out_edges().all(|e| {
+            let q = e.to().data().point.truncate();
+            rp <= (c - q).length_squared() * (1.0 + CELL_EPS) + CELL_EPS
+        });
+        let r = rp.sqrt();
+        (inside && r.is_finite()).then(|| (c.extend(0.0), r, v.fix().index() as u32))
+    }
+
+    /// Sphere: the circumcentre of the spherical triangle of sites `t`, with its radius.
+    fn sphere_triangle_slot(&self, t: [usize; 3]) -> Candidate {
+        let [a, b, c] = t.map(|i| self.site_point(i));
+        let m = spherical_circumcentre(a, b, c);
+        let r = (m - a).length();
+        // The pole has no spade index: a wrap-around triangle's hint is its first site.
+        (m != DVec3::ZERO && r.is_finite()).then_some((m, r, t[0] as u32))
+    }
+
+    /// Sphere: inner face `f`'s triangle.
+    fn sphere_face_slot(&self, f: FixedFaceHandle<InnerTag>) -> Candidate {
+        let v = self.tri.face(f).vertices();
+        self.sphere_triangle_slot(v.map(|v| v.fix().index()))
+    }
+
+    /// Sphere: the wrap-around triangle (from, to, pole) of directed edge `d` if it is a
+    /// convex-hull edge seen from outside.
+    fn sphere_wrap_slot(&self, d: FixedDirectedEdgeHandle) -> Candidate {
+        let e = self.tri.directed_edge(d);
+        if self.pole.is_none() || self.tri.num_vertices() < 2 || !e.is_outer_edge() {
+            return None;
+        }
+        self.sphere_triangle_slot([
+            e.from().fix().index(),
+            e.to().fix().index(),
+            self.pole_index(),
+        ])
+    }
+
+    /// Fills every slot of `lec` from the current triangulation.
+    fn recompute_lec(&self, lec: &mut LecCache) {
+        let t = &self.tri;
+        lec.faces.reset(t.num_all_faces());
+        match self.kind {
+            DomainKind::Disc => {
+                lec.centres.clear();
+                lec.centres.resize(t.num_all_faces(), None);
+                for f in t.inner_faces() {
+                    lec.centres[f.fix().index()] = self.disc_face_centre(f.fix());
+                }
+                for f in t.inner_faces() {
+                    let i = f.fix().index();
+                    lec.faces
+                        .set_leaf(i, self.disc_face_slot(f.fix(), lec.centres[i]));
+                }
+                lec.edges.reset(2 * t.num_undirected_edges());
+                for u in t.fixed_undirected_edges() {
+                    let [a, b] = self.disc_edge_slots(u, &lec.centres);
+                    lec.edges.set_leaf(2 * u.index(), a);
+                    lec.edges.set_leaf(2 * u.index() + 1, b);
+                }
+                lec.vertices.reset(t.num_vertices());
+                for v in t.fixed_vertices() {
+                    lec.vertices.set_leaf(v.index(), self.disc_vertex_slot(v));
+                }
+                lec.wraps.reset(0);
+            }
+            DomainKind::Sphere => {
+                for f in t.inner_faces() {
+                    lec.faces
+                        .set_leaf(f.fix().index(), self.sphere_face_slot(f.fix()));
+                }
+                lec.wraps.reset(t.num_directed_edges());
+                for d in t.directed_edges() {
+                    lec.wraps
+                        .set_leaf(d.fix().index(), self.sphere_wrap_slot(d.fix()));
+                }
+                lec.edges.reset(0);
+                lec.vertices.reset(0);
+            }
+        }
+        for tree in [
+            &mut lec.faces,
+            &mut lec.edges,
+            &mut lec.vertices,
+            &mut lec.wraps,
+        ] {
+            tree.build();
+        }
+        lec.valid = true;
+    }
+
+    /// Updates the slots of `lec` that inserting vertex `v` changed (see [`crate::lec`]).
+    fn update_lec(&self, lec: &mut LecCache, v: FixedVertexHandle) {
+        let t = &self.tri;
+        let vh = t.vertex(v);
+        let faces: Vec<FixedFaceHandle<InnerTag>> = vh
+            .out_edges()
+            .filter_map(|e| e.face().as_inner().map(|f| f.fix()))
+            .collect();
+        match self.kind {
+            DomainKind::Disc => {
+                lec.centres.resize(t.num_all_faces(), None);
+                for &f in &faces {
+                    lec.centres[f.index()] = self.disc_face_centre(f);
+                }
+                for &f in &faces {
+                    lec.faces
+                        .set(f.index(), self.disc_face_slot(f, lec.centres[f.index()]));
+                }
+                for &f in &faces {
+                    for d in t.face(f).adjacent_edges() {
+                        let u = d.fix().as_undirected();
+                        let [a, b] = self.disc_edge_slots(u, &lec.centres);
+                        lec.edges.set(2 * u.index(), a);
+                        lec.edges.set(2 * u.index() + 1, b);
+                    }
+                }
+                lec.vertices.set(v.index(), self.disc_vertex_slot(v));
+                for e in vh.out_edges() {
+                    let w = e.to().fix();
+                    lec.vertices.set(w.index(), self.disc_vertex_slot(w));
+                }
+            }
+            DomainKind::Sphere => {
+                for &f in &faces {
+                    lec.faces.set(f.index(), self.sphere_face_slot(f));
+                }
+                for &f in &faces {
+                    for d in t.face(f).adjacent_edges() {
+                        for d in [d.fix(), d.fix().rev()] {
+                            lec.wraps.set(d.index(), self.sphere_wrap_slot(d));
+                        }
+                    }
+                }
+            }
         }
     }
 
@@ -582,30 +1009,25 @@ impl SamplingDomain {
         self.largest_empty_circle().map_or(0.0, |(_, r)| r)
     }
 
-    /// Calls `f(site index, site, clipped cell)` for every site of the disc, the cell being
-    /// the site's Voronoi region ∩ the square [−2, 2]², counter-clockwise.
-    fn for_each_disc_cell(&self, mut f: impl FnMut(usize, DVec2, &[DVec2], &[DVec2])) {
-        let square = [
+    /// The Voronoi region of disc site `v` ∩ the square [−2, 2]², counter-clockwise: the
+    /// square clipped by the bisector of each Delaunay neighbour in turn.
+    fn disc_cell<'s>(&self, v: FixedVertexHandle, scratch: &'s mut DiscCellScratch) -> &'s [DVec2] {
+        let v = self.tri.vertex(v);
+        let p = v.data().point.truncate();
+        let DiscCellScratch { poly, tmp } = scratch;
+        poly.clear();
+        poly.extend_from_slice(&[
             DVec2::new(-BOX, -BOX),
             DVec2::new(BOX, -BOX),
             DVec2::new(BOX, BOX),
             DVec2::new(-BOX, BOX),
-        ];
-        let mut poly: Vec<DVec2> = Vec::with_capacity(32);
-        let mut tmp: Vec<DVec2> = Vec::with_capacity(32);
-        let mut nbrs: Vec<DVec2> = Vec::with_capacity(16);
-        for v in self.tri.vertices() {
-            let p = v.data().point.truncate();
-            nbrs.clear();
-            nbrs.extend(v.out_edges().map(|e| e.to().data().point.truncate()));
-            poly.clear();
-            poly.extend_from_slice(&square);
-            for &q in &nbrs {
-                clip_half_plane(&poly, 0.5 * (p + q), q - p, &mut tmp);
-                std::mem::swap(&mut poly, &mut tmp);
-            }
-            f(v.fix().index(), p, &poly, &nbrs);
+        ]);
+        for e in v.out_edges() {
+            let q = e.to().data().point.truncate();
+            clip_half_plane(poly, 0.5 * (p + q), q - p, tmp);
+            std::mem::swap(poly, tmp);
         }
+        poly
     }
 
     fn disc_largest_empty_circle(&self) -> Option<(DVec3, f64)> {
@@ -808,17 +1230,20 @@ impl SamplingDomain {
     /// In no particular order.
     pub fn voronoi_areas(&self) -> Vec<(u64, f64)> {
         match self.kind {
-            DomainKind::Disc => {
-                let mut out = Vec::with_capacity(self.len());
-                self.for_each_disc_cell(|i, _, poly, _| {
+            // One cell per site, in site order.
+            DomainKind::Disc => map_sites(
+                self.tri.num_vertices(),
+                DiscCellScratch::default,
+                |scratch, i| {
+                    let v = FixedVertexHandle::from_index(i);
+                    let poly = self.disc_cell(v, scratch);
                     let n = poly.len();
                     let area: f64 = (0..n)
                         .map(|k| disc_triangle_area(poly[k], poly[(k + 1) % n]))
                         .sum();
-                    out.push((self.site_id(i), area));
-                });
-                out
-            }
+                    (self.site_id(i), area)
+                },
+            ),
             DomainKind::Sphere => self.sphere_voronoi_areas(),
         }
     }
@@ -852,21 +1277,26 @@ impl SamplingDomain {
                 .sum::<f64>()
                 .abs()
         };
-        let mut out = Vec::with_capacity(pts.len());
-        let mut ring: Vec<DVec3> = Vec::with_capacity(16);
-        for v in self.tri.vertices() {
-            ring.clear();
-            for e in v.out_edges() {
-                match e.face().as_inner() {
-                    Some(f) => ring.push(centres[f.fix().index() - 1]),
-                    None => {
-                        ring.push(centres[wraps[e.fix().index()] as usize]);
-                        ring.push(centres[wraps[e.prev().fix().index()] as usize]);
+        // One cell per planar site, in site order; then the pole's.
+        let mut out: Vec<(u64, f64)> = map_sites(
+            self.tri.num_vertices(),
+            || Vec::with_capacity(16),
+            |ring: &mut Vec<DVec3>, i| {
+                let v = self.tri.vertex(FixedVertexHandle::from_index(i));
+                ring.clear();
+                for e in v.out_edges() {
+                    match e.face().as_inner() {
+                        Some(f) => ring.push(centres[f.fix().index() - 1]),
+                        None => {
+                            ring.push(centres[wraps[e.fix().index()] as usize]);
+                            ring.push(centres[wraps[e.prev().fix().index()] as usize]);
+                        }
                     }
                 }
-            }
-            out.push((v.data().id, fan_area(v.data().point, &ring)));
-        }
+                (v.data().id, fan_area(v.data().point, ring))
+            },
+        );
+        let mut ring: Vec<DVec3> = Vec::with_capacity(16);
         if let Some(pole) = self.pole {
             ring.clear();
             if let Some(start) = self.tri.directed_edges().find(|e| e.is_outer_edge()) {

@@ -32,6 +32,7 @@
 //! spot lights at their centre.
 
 pub mod domain;
+mod lec;
 
 use domain::{DomainKind, SamplingDomain};
 use gibench_harness::anim::LightPose;
@@ -49,6 +50,7 @@ use gibench_harness::technique::{
 };
 use gibench_harness::vpl::{self, Vpl};
 use gibench_harness::{wgpu, Error, Result};
+use rayon::prelude::*;
 
 /// Stage: the CPU VPL management of §4 (validity, deletion, creation, intensities).
 pub const STAGE_VPL_MANAGEMENT: &str = "vpl-management";
@@ -242,13 +244,18 @@ impl Manager {
         let (extent, eps) = (&scene.extent, scene.extent.ray_epsilon);
         let mut deleted = 0;
         // 1. Validity, and the surviving VPLs' sampling points from the new light position.
-        let mut domain = SamplingDomain::new(kind);
+        let capacity = self.vpls.len() + self.misses.len() + self.max_lights as usize;
+        let mut domain = SamplingDomain::with_capacity(kind, capacity);
         let mut kept = Vec::with_capacity(self.vpls.len());
-        for m in self.vpls.drain(..) {
+        // The validity rays, across cores (one per VPL, independent); then the domain in order.
+        let valid: Vec<bool> = self
+            .vpls
+            .par_iter()
+            .map(|m| still_valid(bvh, &light, &m.vpl, eps))
+            .collect();
+        for (m, valid) in self.vpls.drain(..).zip(valid) {
             let sample = light.sample_of_point(m.vpl.position, extent);
-            if still_valid(bvh, &light, &m.vpl, eps)
-                && domain.insert(m.id, sample.as_dvec3()).is_ok()
-            {
+            if valid && domain.insert(m.id, sample.as_dvec3()).is_ok() {
                 kept.push(Managed {
                     vpl: Vpl { sample, ..m.vpl },
                     ..m
@@ -260,10 +267,17 @@ impl Manager {
         }
         self.vpls = kept;
         // Missed sampling points stay (fixed relative to the light) while their ray still misses.
+        let still_missing: Vec<bool> = self
+            .misses
+            .par_iter()
+            .map(|(_, sample)| {
+                let (origin, dir) = light.ray_of_sample(*sample, extent);
+                bvh.closest_hit(origin, dir, eps, f32::INFINITY).is_none()
+            })
+            .collect();
+        let mut still_missing = still_missing.into_iter();
         self.misses.retain(|(id, sample)| {
-            let (origin, dir) = light.ray_of_sample(*sample, extent);
-            bvh.closest_hit(origin, dir, eps, f32::INFINITY).is_none()
-                && domain.insert(*id, sample.as_dvec3()).is_ok()
+            still_missing.next() == Some(true) && domain.insert(*id, sample.as_dvec3()).is_ok()
         });
         // 2. Deletion of redundant VPLs until recalc-min slots are free.
         while (self.free_slots.len() as u32) < self.recalc_min {
@@ -292,12 +306,12 @@ impl Manager {
             && (self.vpls.len() as u32) < self.max_lights
             && self.misses.len() < self.max_lights as usize
         {
-            let Some((centre, _)) = domain.largest_empty_circle() else {
+            let Some((centre, _, site)) = domain.largest_empty_circle_near() else {
                 break;
             };
             let id = self.next_id;
             self.next_id += 1;
-            if domain.insert(id, centre).is_err() {
+            if domain.insert_near(id, centre, site).is_err() {
                 break;
             }
             created += 1;

@@ -579,3 +579,99 @@ fn deletion_removes_the_endpoint_with_the_closer_second_neighbour() {
         }
     }
 }
+
+/// The largest empty circle answered from the kept candidates equals a full scan bit for bit
+/// (centre and radius) after every step of a mixed sequence — inserts at the largest empty
+/// circle (as the management does), random inserts, rim points (disc) and removals including
+/// the sphere's pole — on both domains.
+#[test]
+fn lec_cache_equals_the_scan() {
+    // Many short sequences (few sites: where the rim candidates of case (3) win) and one long.
+    let runs = (0..400u64).map(|seed| (seed, 20)).chain([(77, 1500)]);
+    for ((seed, steps), kind) in runs.flat_map(|r| [(r, DomainKind::Disc), (r, DomainKind::Sphere)])
+    {
+        let mut rng = Rng(seed);
+        let mut d = SamplingDomain::new(kind);
+        let mut live: Vec<u64> = Vec::new();
+        let mut next = 0u64;
+        for step in 0..steps {
+            let r = rng.next();
+            if r < 0.15 && live.len() > 3 {
+                let k = (rng.next() * live.len() as f64) as usize;
+                let id = live.swap_remove(k.min(live.len() - 1));
+                d.remove(id);
+            } else {
+                let p = if r < 0.6 {
+                    d.largest_empty_circle().unwrap().0
+                } else if r < 0.7 && kind == DomainKind::Disc {
+                    let phi = 2.0 * PI * rng.next();
+                    DVec3::new(phi.cos(), phi.sin(), 0.0)
+                } else {
+                    match kind {
+                        DomainKind::Disc => to_disc(rng.next(), rng.next()),
+                        DomainKind::Sphere => to_sphere(rng.next(), rng.next()),
+                    }
+                };
+                if d.insert(next, p).is_ok() {
+                    live.push(next);
+                }
+                next += 1;
+            }
+            let cached = d
+                .largest_empty_circle()
+                .map(|(c, r)| (c.to_array().map(f64::to_bits), r.to_bits()));
+            let scan = d
+                .largest_empty_circle_by_scan()
+                .map(|(c, r)| (c.to_array().map(f64::to_bits), r.to_bits()));
+            assert_eq!(
+                cached,
+                scan,
+                "{kind:?}, seed {seed}, step {step}, {} sites",
+                d.len()
+            );
+        }
+    }
+}
+
+/// Inserting with a hint (any site, near or far) gives the triangulation a plain insert gives,
+/// triangle for triangle in the same order, and the same largest empty circle.
+#[test]
+fn hinted_inserts_build_the_same_triangulation() {
+    for kind in [DomainKind::Disc, DomainKind::Sphere] {
+        for random in [true, false] {
+            let mut pts = point_set(kind, 400, random);
+            let mut rng = Rng(5);
+            // Every third disc point on the rim: outside the hull of the points before it.
+            if kind == DomainKind::Disc {
+                for p in pts.iter_mut().step_by(3) {
+                    *p = p.normalize();
+                }
+            }
+            let mut plain = SamplingDomain::new(kind);
+            let mut hinted = SamplingDomain::new(kind);
+            for (i, p) in pts.iter().enumerate() {
+                let a = plain.insert(i as u64, *p);
+                let hint = (i > 0).then(|| (rng.next() * i as f64) as u64);
+                let b = hinted.insert_near(i as u64, *p, hint);
+                assert_eq!(a, b, "{kind:?} point {i}");
+                assert_eq!(plain.triangles(), hinted.triangles(), "{kind:?} point {i}");
+            }
+            // Then fill at the largest empty circle, hinted by the circle's site.
+            for k in 0..200u64 {
+                let (c, _) = plain.largest_empty_circle().unwrap();
+                let (ch, _, site) = hinted.largest_empty_circle_near().unwrap();
+                assert_eq!(
+                    c.to_array().map(f64::to_bits),
+                    ch.to_array().map(f64::to_bits)
+                );
+                plain.insert(10_000 + k, c).unwrap();
+                hinted.insert_near(10_000 + k, ch, site).unwrap();
+            }
+            assert_eq!(
+                plain.triangles(),
+                hinted.triangles(),
+                "{kind:?} random {random}"
+            );
+        }
+    }
+}

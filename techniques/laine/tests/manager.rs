@@ -129,3 +129,42 @@ fn area_light_vpls_lie_in_front_of_the_light() {
         }
     }
 }
+
+/// FNV-1a over 64-bit words.
+fn fnv(h: &mut u64, word: u64) {
+    for b in word.to_le_bytes() {
+        *h = (*h ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3);
+    }
+}
+
+/// The VPL layout frame by frame — every VPL's slot, position, normal and sampling point, the
+/// counts created and deleted, the dispersion — over 300 frames of the moving light, hashed
+/// and pinned: the faster management (kept largest-empty-circle candidates, hinted point
+/// location, rays and Voronoi areas across cores) must give exactly the layout the rules gave
+/// before it (the constants were computed before that change; the per-frame flux, which goes
+/// through libm's atan2, is left out). A deliberate change of the rules changes these.
+#[test]
+fn the_vpl_layout_is_the_one_the_rules_gave_before() {
+    let mut got = Vec::new();
+    for kind in [LightKind::Spot, LightKind::Omni] {
+        let (scene, bvh) = cornell(kind);
+        let clock = FrameClock::new(&scene.descriptor);
+        let mut m = Manager::new(256, 4, 8);
+        let mut h = 0xcbf2_9ce4_8422_2325u64;
+        for frame in 0..300 {
+            let s = m.step(&scene, &bvh, clock.frame(frame).light);
+            fnv(&mut h, m.dispersion().to_bits());
+            fnv(&mut h, ((s.created as u64) << 32) | s.deleted as u64);
+            for (slot, v) in m.vpls() {
+                fnv(&mut h, slot as u64);
+                for x in [v.position, v.normal, v.sample] {
+                    for c in x.to_array() {
+                        fnv(&mut h, c.to_bits() as u64);
+                    }
+                }
+            }
+        }
+        got.push(format!("{h:016x}"));
+    }
+    assert_eq!(got, ["47549ec0619d44a4", "5019a681094df951"]);
+}
