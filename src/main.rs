@@ -1,6 +1,7 @@
 //! `gibench`: run real-time indirect-illumination techniques side by side on the same scenes,
 //! frames and timing harness, and render their per-stage timing tables.
 
+mod export;
 mod registry;
 mod reproduce;
 
@@ -56,6 +57,9 @@ enum Command {
     /// Count the CPU kernels' instructions under callgrind (deterministic, unlike time) and
     /// compare them with a baseline; fails on a regression beyond the threshold.
     Instructions(InstructionsArgs),
+    /// Write one frame of a scene as PLY meshes per material and a JSON of its camera, light
+    /// and albedos, for another renderer (`scripts/compare_mitsuba.py`).
+    ExportScene(export::ExportArgs),
 }
 
 #[derive(Args)]
@@ -296,6 +300,7 @@ fn main() -> ExitCode {
         Some(Command::PlotQuality(args)) => plot_quality(&args),
         Some(Command::Compare(args)) => compare_cmd(&args),
         Some(Command::Instructions(args)) => instructions_cmd(&args),
+        Some(Command::ExportScene(args)) => export::export_scene(&args),
         Some(Command::Reproduce(args)) => reproduce::reproduce(&args),
     };
     match outcome {

@@ -39,7 +39,11 @@ pub struct Hit {
 pub struct SceneBvh {
     /// `None` for a mesh without triangles.
     bvh: Option<CwBvh>,
-    /// The mesh triangle of each of the tree's primitives.
+    /// Per primitive slot of the tree (the id its traversal reports), in that order: the
+    /// triangle's first corner and edges and its mesh triangle — what the traversal's
+    /// intersection callback reads, contiguous.
+    leaves: Vec<Leaf>,
+    /// The mesh triangle of each triangle built into the tree.
     built: Vec<u32>,
     /// Corner positions per triangle, in mesh order.
     tris: Vec<[Vec3; 3]>,
@@ -51,25 +55,34 @@ pub struct SceneBvh {
     materials: Vec<u32>,
 }
 
+/// A triangle as the intersection test reads it: the first corner, the edges to the other two
+/// (computed once, exactly as the test would), and its index in the mesh.
+#[derive(Clone, Copy, Debug)]
+struct Leaf {
+    v0: Vec3,
+    e1: Vec3,
+    e2: Vec3,
+    triangle: u32,
+}
+
 /// Möller–Trumbore: `(t, u, v)` of the hit of `origin + t·dir` with triangle `tri` for `t` in
 /// the open interval `(t_min, t_max)`, where `(u, v)` weight corners 1 and 2. Both sides hit.
 #[inline]
 fn intersect(
-    tri: &[Vec3; 3],
+    tri: &Leaf,
     origin: Vec3,
     dir: Vec3,
     t_min: f32,
     t_max: f32,
 ) -> Option<(f32, f32, f32)> {
-    let e1 = tri[1] - tri[0];
-    let e2 = tri[2] - tri[0];
+    let (e1, e2) = (tri.e1, tri.e2);
     let p = dir.cross(e2);
     let det = e1.dot(p);
     if det == 0.0 || !det.is_finite() {
         return None;
     }
     let inv_det = 1.0 / det;
-    let s = origin - tri[0];
+    let s = origin - tri.v0;
     let u = s.dot(p) * inv_det;
     if !(0.0..=1.0).contains(&u) {
         return None;
@@ -145,8 +158,24 @@ impl SceneBvh {
             let mut build_time = Duration::ZERO;
             build_cwbvh_from_tris(&obvhs_tris, BvhBuildParams::medium_build(), &mut build_time)
         });
+        let leaves = bvh.as_ref().map_or(Vec::new(), |b| {
+            b.primitive_indices
+                .iter()
+                .map(|&k| {
+                    let triangle = built[k as usize];
+                    let t = &tris[triangle as usize];
+                    Leaf {
+                        v0: t[0],
+                        e1: t[1] - t[0],
+                        e2: t[2] - t[0],
+                        triangle,
+                    }
+                })
+                .collect()
+        });
         SceneBvh {
             bvh,
+            leaves,
             built,
             tris,
             normals,
@@ -194,10 +223,10 @@ impl SceneBvh {
         let mut best: Option<(u32, f32, f32, f32)> = None;
         let mut hit = RayHit::none();
         bvh.ray_traverse(Self::ray(origin, dir, t_min, t_max), &mut hit, |ray, id| {
-            let tri = self.built[bvh.primitive_indices[id] as usize] as usize;
-            match intersect(&self.tris[tri], origin, dir, t_min, ray.tmax) {
+            let leaf = &self.leaves[id];
+            match intersect(leaf, origin, dir, t_min, ray.tmax) {
                 Some((t, u, v)) => {
-                    best = Some((tri as u32, t, u, v));
+                    best = Some((leaf.triangle, t, u, v));
                     t
                 }
                 None => f32::INFINITY,
@@ -251,8 +280,7 @@ impl SceneBvh {
             return false;
         }
         !bvh.ray_traverse_miss(Self::ray(origin, dir, t_min, t_max), |_, id| {
-            let tri = self.built[bvh.primitive_indices[id] as usize] as usize;
-            intersect(&self.tris[tri], origin, dir, t_min, t_max)
+            intersect(&self.leaves[id], origin, dir, t_min, t_max)
                 .map_or(f32::INFINITY, |(t, _, _)| t)
         })
     }
