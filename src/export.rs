@@ -30,6 +30,10 @@ pub(crate) struct ExportArgs {
     assets: Option<PathBuf>,
 }
 
+/// One material's triangles: their corners, the triangles as indices into them, and the map
+/// from the frame mesh's vertex index to that list (`u32::MAX`: not used yet).
+type Group = (Vec<[f32; 3]>, Vec<[u32; 3]>, Vec<u32>);
+
 /// A binary little-endian PLY of `positions` and the triangles `tris` (indices into them).
 fn ply(positions: &[[f32; 3]], tris: &[[u32; 3]]) -> Vec<u8> {
     let mut out = format!(
@@ -63,7 +67,7 @@ pub(crate) fn export_scene(args: &ExportArgs) -> Result<()> {
     let mesh = gibench_harness::reference::frame_mesh(&scene, &frame);
     // Triangles per material (a triangle's material is its first vertex's), each with its
     // own compact vertex list.
-    let mut groups: Vec<(Vec<[f32; 3]>, Vec<[u32; 3]>, Vec<u32>)> = (0..scene.materials.len())
+    let mut groups: Vec<Group> = (0..scene.materials.len())
         .map(|_| (Vec::new(), Vec::new(), vec![u32::MAX; mesh.positions.len()]))
         .collect();
     for t in mesh.indices.chunks_exact(3) {

@@ -65,6 +65,17 @@ struct Leaf {
     triangle: u32,
 }
 
+impl Leaf {
+    fn new(t: &[Vec3; 3], triangle: u32) -> Leaf {
+        Leaf {
+            v0: t[0],
+            e1: t[1] - t[0],
+            e2: t[2] - t[0],
+            triangle,
+        }
+    }
+}
+
 /// Möller–Trumbore: `(t, u, v)` of the hit of `origin + t·dir` with triangle `tri` for `t` in
 /// the open interval `(t_min, t_max)`, where `(u, v)` weight corners 1 and 2. Both sides hit.
 #[inline]
@@ -163,13 +174,7 @@ impl SceneBvh {
                 .iter()
                 .map(|&k| {
                     let triangle = built[k as usize];
-                    let t = &tris[triangle as usize];
-                    Leaf {
-                        v0: t[0],
-                        e1: t[1] - t[0],
-                        e2: t[2] - t[0],
-                        triangle,
-                    }
+                    Leaf::new(&tris[triangle as usize], triangle)
                 })
                 .collect()
         });
@@ -343,8 +348,14 @@ mod tests {
     fn brute_force(mesh: &Mesh, origin: Vec3, dir: Vec3) -> Option<(f32, u32)> {
         (0..mesh.triangle_count())
             .filter_map(|t| {
-                intersect(&mesh.triangle(t), origin, dir, 0.0, f32::INFINITY)
-                    .map(|(d, _, _)| (d, t as u32))
+                intersect(
+                    &Leaf::new(&mesh.triangle(t), t as u32),
+                    origin,
+                    dir,
+                    0.0,
+                    f32::INFINITY,
+                )
+                .map(|(d, _, _)| (d, t as u32))
             })
             .min_by(|a, b| a.0.total_cmp(&b.0))
     }
