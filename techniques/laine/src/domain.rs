@@ -792,7 +792,8 @@ impl SamplingDomain {
 
     /// The largest empty circle by a pass over the whole triangulation, without the kept
     /// candidates: what [`largest_empty_circle`](Self::largest_empty_circle) must equal bit
-    /// for bit (the tests compare them).
+    /// for bit (the tests compare them: it checks the keeping and updating, while the slot
+    /// functions both use are pinned by the management's layout test).
     pub fn largest_empty_circle_by_scan(&self) -> Option<(DVec3, f64)> {
         match self.kind {
             DomainKind::Disc => self.disc_largest_empty_circle(),
@@ -820,7 +821,11 @@ impl SamplingDomain {
     }
 
     /// Disc, case (2): where the Voronoi edge of undirected edge `u` crosses the rim (its two
-    /// roots, in the scan's order), from the faces' circumcentres `centres`.
+    /// roots, in the scan's order), from the faces' circumcentres `centres`. The Voronoi edge
+    /// dual to p→q runs along their bisector between the circumcentres of the faces on either
+    /// side; an outer face makes it a ray leaving the triangulation on that side, two make it
+    /// the whole bisector (collinear sites); a degenerate face (circumcentre at infinity) gives
+    /// none.
     fn disc_edge_slots(
         &self,
         u: FixedUndirectedEdgeHandle,
@@ -859,7 +864,8 @@ impl SamplingDomain {
         out
     }
 
-    /// Disc, case (3): the rim point opposite vertex `v` if its cell reaches it.
+    /// Disc, case (3): the rim point opposite vertex `v` if its cell reaches it (then it holds
+    /// the whole segment from the site through the origin, the cell being convex).
     fn disc_vertex_slot(&self, v: FixedVertexHandle) -> Candidate {
         let v = self.tri.vertex(v);
         let p = v.data().point.truncate();
@@ -1030,78 +1036,35 @@ impl SamplingDomain {
         poly
     }
 
+    /// Disc: one pass over every slot — (1) faces, (2) edges, (3) vertices, each in index
+    /// order, the first strictly largest radius winning — with the slot functions the kept
+    /// candidates use.
     fn disc_largest_empty_circle(&self) -> Option<(DVec3, f64)> {
         if self.tri.num_vertices() == 0 {
             return Some((DVec3::ZERO, 1.0));
         }
-        let mut best: Option<(DVec2, f64)> = None;
-        let mut consider = |c: DVec2, r: f64| {
-            if r.is_finite() && best.is_none_or(|(_, br)| r > br) {
-                best = Some((c, r));
+        let mut best: Candidate = None;
+        let mut consider = |c: Candidate| {
+            if let Some(c) = c {
+                if best.is_none_or(|b| c.1 > b.1) {
+                    best = Some(c);
+                }
             }
         };
-        let pos = |v: &spade::handles::VertexHandle<Site>| v.data().point.truncate();
-        // (1) Voronoi vertices (circumcentres of Delaunay triangles) inside the disc.
         let mut centres = vec![None; self.tri.num_all_faces()];
         for f in self.tri.inner_faces() {
-            let [a, b, c] = f.vertices();
-            let (a, b, c) = (pos(&a), pos(&b), pos(&c));
-            if let Some(m) = circumcentre(a, b, c) {
-                centres[f.fix().index()] = Some(m);
-                if m.length_squared() <= 1.0 {
-                    consider(m, (m - a).length());
-                }
+            centres[f.fix().index()] = self.disc_face_centre(f.fix());
+            consider(self.disc_face_slot(f.fix(), centres[f.fix().index()]));
+        }
+        for u in self.tri.fixed_undirected_edges() {
+            for c in self.disc_edge_slots(u, &centres) {
+                consider(c);
             }
         }
-        // (2) Voronoi edges crossing the bounding circle. The Voronoi edge dual to p→q runs
-        // along their bisector between the circumcentres of the faces on either side; an
-        // outer face makes it a ray leaving the triangulation on that side, two make it the
-        // whole bisector (collinear sites).
-        for e in self.tri.directed_edges() {
-            if e.fix().index() > e.rev().fix().index() {
-                continue;
-            }
-            let (p, q) = (pos(&e.from()), pos(&e.to()));
-            let left = e.face().as_inner().map(|f| centres[f.fix().index()]);
-            let right = e.rev().face().as_inner().map(|f| centres[f.fix().index()]);
-            // Unit normal pointing to the left of p→q, along the bisector.
-            let normal = (q - p).perp().normalize_or_zero();
-            let (origin, t_range) = match (left, right) {
-                (Some(Some(l)), Some(Some(r))) => (r, (0.0, (l - r).dot(normal))),
-                (None, Some(Some(r))) => (r, (0.0, f64::INFINITY)),
-                (Some(Some(l)), None) => (l, (f64::NEG_INFINITY, 0.0)),
-                (None, None) => (0.5 * (p + q), (f64::NEG_INFINITY, f64::INFINITY)),
-                // A degenerate (zero-area) face: its circumcentre is at infinity.
-                _ => continue,
-            };
-            let half_b = origin.dot(normal);
-            let disc = half_b * half_b - (origin.length_squared() - 1.0);
-            if disc >= 0.0 {
-                let s = disc.sqrt();
-                for t in [-half_b - s, -half_b + s] {
-                    if t >= t_range.0.min(t_range.1) && t <= t_range.0.max(t_range.1) {
-                        let c = origin + normal * t;
-                        let c = c / c.length();
-                        consider(c, (c - p).length());
-                    }
-                }
-            }
+        for v in self.tri.fixed_vertices() {
+            consider(self.disc_vertex_slot(v));
         }
-        // (3) The boundary point opposite site p, if p's Voronoi cell reaches it (then it holds
-        // the whole segment from p through the origin, the cell being convex).
-        for v in self.tri.vertices() {
-            let p = pos(&v);
-            let len = p.length();
-            let c = if len > 0.0 { -p / len } else { DVec2::X };
-            let rp = (c - p).length_squared();
-            if v.out_edges().all(|e| {
-                let q = pos(&e.to());
-                rp <= (c - q).length_squared() * (1.0 + CELL_EPS) + CELL_EPS
-            }) {
-                consider(c, rp.sqrt());
-            }
-        }
-        best.map(|(c, r)| (c.extend(0.0), r))
+        best.map(|(c, r, _)| (c, r))
     }
 
     fn sphere_largest_empty_circle(&self) -> Option<(DVec3, f64)> {
