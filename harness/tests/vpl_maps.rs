@@ -1,4 +1,4 @@
-//! VPL depth maps, paraboloid and cube, at the shipped defaults (16-bit depth, 128² maps):
+//! VPL depth maps, paraboloid, cube and octahedral, at the shipped defaults (16-bit depth, 128² maps):
 //! rendering a VPL's map and looking receivers up in it is a round trip through the projection;
 //! away from shadow boundaries its visibility must agree with CPU ray casts on 98 % of the
 //! receivers; the accumulation's irradiance clamp bounds each VPL's irradiance at k / A times
@@ -349,6 +349,11 @@ fn maps_from_the_gpu_store_equal_maps_from_the_cpu_list() {
 #[test]
 fn cube_maps_agree_with_ray_casts() {
     check(Fill::Raster(MapKind::Cube));
+}
+
+#[test]
+fn octahedral_maps_agree_with_ray_casts() {
+    check(Fill::Raster(MapKind::Octahedral));
 }
 
 /// A float atlas filled from outside the rasteriser (as imperfect shadow maps will fill theirs)

@@ -20,7 +20,7 @@
 //! ```
 //!
 //! * [`store::VplStore`] — slot-indexed VPLs on the GPU, written by the CPU or a GPU pass.
-//! * [`atlas::ShadowAtlas`] — one visibility map per slot (paraboloid or cube; 16/32-bit depth
+//! * [`atlas::ShadowAtlas`] — one visibility map per slot (paraboloid, cube or octahedral; 16/32-bit depth
 //!   or a 32-bit float texture), its parameters and its WGSL lookup.
 //! * [`raster::AtlasRasteriser`] — renders chosen slots of a depth atlas from a
 //!   [`DrawSet`](crate::passes::DrawSet), uploading its own views.

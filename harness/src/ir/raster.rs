@@ -11,7 +11,10 @@
 //! map is kept as it was.
 //!
 //! Paraboloid maps are rendered with the VPL's frame in the vertex shader (Brabec et al. 2002)
-//! and back-hemisphere fragments discarded; cube maps with one 90° view per face.
+//! and back-hemisphere fragments discarded; cube maps with one 90° view per face; octahedral
+//! maps (Barczak 2006 §4.2) with one pass per octahedron face into the same square, the face's
+//! projection in the vertex shader, fragments outside its triangle discarded (Barczak clips with
+//! user clip planes, which wgpu's GL backend lacks) and the exact distance written as depth.
 //!
 //! VPLs a GPU pass wrote into a [`VplStore`] (imperfect shadow maps' RSM-sampled VPLs) are
 //! rendered with [`StoreViews`]: a compute pass writes each slot's paraboloid view from the store
@@ -135,6 +138,7 @@ impl AtlasRasteriser {
         let (vs, fs) = match settings.kind {
             MapKind::Paraboloid => ("vs_paraboloid", Some("fs_paraboloid")),
             MapKind::Cube => ("vs_cube", None),
+            MapKind::Octahedral => ("vs_octahedral", Some("fs_octahedral")),
         };
         let map_pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("vpl shadow map"),
@@ -201,13 +205,21 @@ impl AtlasRasteriser {
         for f in 0..faces {
             let view_proj = match self.kind {
                 MapKind::Cube => cube_face_matrix(eye, f, atlas.near),
-                MapKind::Paraboloid => Mat4::IDENTITY,
+                MapKind::Paraboloid | MapKind::Octahedral => Mat4::IDENTITY,
+            };
+            // Octahedral face f's quadrant: (sx, sy) = (±1, ±1).
+            let (sx, sy) = match self.kind {
+                MapKind::Octahedral => (
+                    if f & 1 == 0 { 1.0 } else { -1.0 },
+                    if f & 2 == 0 { 1.0 } else { -1.0 },
+                ),
+                _ => (0.0, 0.0),
             };
             let d = ViewData {
                 view_proj: view_proj.to_cols_array(),
                 position: eye.extend(atlas.far).to_array(),
-                tangent: t.extend(0.0).to_array(),
-                bitangent: b.extend(0.0).to_array(),
+                tangent: t.extend(sx).to_array(),
+                bitangent: b.extend(sy).to_array(),
                 normal: vpl.normal.extend(0.0).to_array(),
             };
             let o = f * VIEW_STRIDE as usize;

@@ -1,11 +1,13 @@
 // Visibility lookups in a VPL shadow atlas (ShadowAtlas): one map per slot, paraboloid
-// (Brabec et al. 2002, as Laine et al. 2007 use) or cube (3x2 faces). Stored values are reversed
-// depth: 1 near, 0 far/empty (paraboloid: 1 - distance / far; cube: reversed-Z NDC depth).
+// (Brabec et al. 2002, as Laine et al. 2007 use), cube (3x2 faces) or octahedral (Barczak 2006:
+// four octahedron faces unfolded to a square). Stored values are reversed depth: 1 near,
+// 0 far/empty (paraboloid, octahedral: 1 - distance / far; cube: reversed-Z NDC depth).
 // Expects `GpuVpl` (VPL_STORE_WGSL) and the bindings `atlas_params` and `vpl_atlas` that
 // ShadowAtlas::wgsl declares.
 
 struct AtlasParams {
-    // x: slots per atlas row; y: map size (texels); z: parameterisation (0 paraboloid, 1 cube)
+    // x: slots per atlas row; y: map size (texels); z: parameterisation (0 paraboloid, 1 cube,
+    // 2 octahedral)
     counts: vec4<u32>,
     // x: far distance; y: depth bias (fraction of distance); z: cube near plane; w: lift (the
     // map's centre sits this far off the VPL's surface along its normal)
@@ -29,6 +31,17 @@ fn paraboloid_texel(local: vec3<f32>, size: u32) -> vec2<i32> {
     return clamp(st, vec2<i32>(0), vec2<i32>(i32(size) - 1));
 }
 
+// The texel of a `size`² octahedral map that the unit direction `local` (the map's frame, z
+// along the VPL's normal, z >= 0) falls in: o = local / (|x| + |y| + z) on the octahedron, the
+// diamond turned onto the square, uv = (o.x + o.y, o.x - o.y), row 0 at the top (atlas.rs
+// `octahedral_uv`).
+fn octahedral_texel(local: vec3<f32>, size: u32) -> vec2<i32> {
+    let o = local.xy / max(abs(local.x) + abs(local.y) + max(local.z, 0.0), 1e-30);
+    let uv = vec2<f32>(o.x + o.y, o.x - o.y);
+    let st = vec2<i32>(floor(vec2<f32>(uv.x * 0.5 + 0.5, 0.5 - uv.y * 0.5) * f32(size)));
+    return clamp(st, vec2<i32>(0), vec2<i32>(i32(size) - 1));
+}
+
 // 1 if receiver `p` (unit normal `n`) is visible from VPL `v` according to its map, else 0.
 // The receiver is first moved off its surface by about two map texels (normal offset), so that
 // surfaces tilted away from the VPL do not shadow themselves.
@@ -41,12 +54,17 @@ fn vpl_visibility(v: GpuVpl, p_surface: vec3<f32>, n: vec3<f32>) -> f32 {
     let len = length(d);
     let far = atlas_params.distances.x;
     let bias = atlas_params.distances.y;
-    if (atlas_params.counts.z == 0u) {
+    if (atlas_params.counts.z != 1u) {
         let local = vec3<f32>(dot(d, v.tangent.xyz), dot(d, v.bitangent.xyz), dot(d, v.normal.xyz)) / max(len, 1e-20);
         if (local.z <= 0.0) {
             return 0.0;
         }
-        let t = paraboloid_texel(local, size);
+        var t: vec2<i32>;
+        if (atlas_params.counts.z == 0u) {
+            t = paraboloid_texel(local, size);
+        } else {
+            t = octahedral_texel(local, size);
+        }
         let stored = textureLoad(vpl_atlas, vpl_tile_origin(slot, size, size) + t, 0).r;
         let receiver = 1.0 - len * (1.0 - bias) / far;
         return select(0.0, 1.0, receiver >= stored);

@@ -1,12 +1,14 @@
-// Depth maps of virtual point lights: paraboloid (Brabec et al. 2002, as Laine et al. 2007 use)
-// or cube faces, all in one depth atlas. Reversed depth everywhere: 1 near, 0 far/empty.
+// Depth maps of virtual point lights: paraboloid (Brabec et al. 2002, as Laine et al. 2007 use),
+// cube faces or octahedral faces (Barczak 2006), all in one depth atlas. Reversed depth
+// everywhere: 1 near, 0 far/empty.
 
 struct VplView {
     // Cube faces: view-projection of the face (reversed-Z); unused for paraboloids.
     view_proj: mat4x4<f32>,
     // xyz: VPL position; w: far distance (paraboloid depth = 1 - distance / far)
     position: vec4<f32>,
-    // The VPL's frame: tangent, bitangent, normal (xyz).
+    // The VPL's frame: tangent, bitangent, normal (xyz). Octahedral faces: tangent.w and
+    // bitangent.w are the signs (sx, sy) of the face's quadrant.
     tangent: vec4<f32>,
     bitangent: vec4<f32>,
     normal: vec4<f32>,
@@ -39,6 +41,41 @@ fn fs_paraboloid(in: ParaboloidOut) {
     if (in.side < 0.0) {
         discard;
     }
+}
+
+struct OctahedralOut {
+    @builtin(position) clip: vec4<f32>,
+    // The point in the VPL's frame (z along the normal), interpolated exactly: it is linear on
+    // the triangle and the face's projection is a perspective one.
+    @location(0) local: vec3<f32>,
+};
+
+// One face of an octahedral map (Barczak 2006 §4.2.1): the projection from the VPL onto the
+// face's plane sx*x + sy*y + z = 1, unfolded, (u, v) = (x + y, x - y) / (sx*x + sy*y + z), is
+// projective, so the triangle is rasterised exactly. w = 0.5 * depth keeps only points in front of
+// the face's plane; the fragment keeps its quadrant (the face's triangle of the square).
+@vertex
+fn vs_octahedral(@location(0) position: vec3<f32>) -> OctahedralOut {
+    let world = (object.model * vec4<f32>(position, 1.0)).xyz;
+    let d = world - vpl_view.position.xyz;
+    let local = vec3<f32>(dot(d, vpl_view.tangent.xyz), dot(d, vpl_view.bitangent.xyz), dot(d, vpl_view.normal.xyz));
+    let w = vpl_view.tangent.w * local.x + vpl_view.bitangent.w * local.y + local.z;
+    var out: OctahedralOut;
+    out.clip = vec4<f32>(local.x + local.y, local.x - local.y, 0.5 * w, w);
+    out.local = local;
+    return out;
+}
+
+// Keeps the face's quadrant of the upper hemisphere (x >= 0 belongs to sx = +1) and stores the
+// exact distance (Barczak: the pixel shader writes the light-space distance as depth).
+@fragment
+fn fs_octahedral(in: OctahedralOut) -> @builtin(frag_depth) f32 {
+    let sx = vpl_view.tangent.w;
+    let sy = vpl_view.bitangent.w;
+    if (in.local.z < 0.0 || (in.local.x >= 0.0) != (sx > 0.0) || (in.local.y >= 0.0) != (sy > 0.0)) {
+        discard;
+    }
+    return clamp(1.0 - length(in.local) / vpl_view.position.w, 0.0, 1.0);
 }
 
 @vertex
