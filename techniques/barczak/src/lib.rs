@@ -1,0 +1,24 @@
+//! `barczak` (in progress): Barczak 2006, "Interactive Illumination Using Large Sets of Point
+//! Lights" (M.S. thesis, University of Maryland) — light-mapped, visibility-culled instant
+//! radiosity with moving objects.
+//!
+//! What exists so far, each part tested on the CPU:
+//!
+//! * [`visibility`] — §4.3.1: occlusion pyramids from patches (and complex objects' bounding
+//!   spheres) to each light, polygon and sphere blockers, lights classified unblocked / partial /
+//!   fully blocked, hierarchical patch subdivision with early termination.
+//! * [`passes`] — §4.3.5: the greedy render-pass optimiser of Figure 4-10 over elements (sets of
+//!   objects with the lights they share), a pass drawing up to K lights.
+//! * [`samples`] — §4.1: the direct light samples on area emitters and the indirect ones from
+//!   random walks, computed once from the static geometry.
+//!
+//! The shadow maps are the shared atlas's octahedral kind (§4.2.1,
+//! `gibench_harness::ir::atlas::MapKind::Octahedral`). Still to come (issue 11): light maps
+//! and the subtraction pass, the low-resolution pass with edge detection, PRT for complex
+//! meshes, the movers' visibility database and prioritised shadow-map updates, the optimisation
+//! levels, the thesis' scenes and `gibench reproduce barczak2006`; until then `barczak` is not
+//! in the technique registry.
+
+pub mod passes;
+pub mod samples;
+pub mod visibility;

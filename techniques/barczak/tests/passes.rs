@@ -1,0 +1,124 @@
+//! The render-pass optimiser: it never adds passes, and every (object, light) pair stays in
+//! exactly one element.
+
+use std::collections::BTreeMap;
+
+use gibench_barczak::passes::{one_per_object, optimise, total_passes, LightSet};
+
+/// SplitMix64.
+struct Rng(u64);
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+    fn below(&mut self, n: u64) -> u64 {
+        self.next() % n
+    }
+}
+
+/// Objects whose partial lights cluster (neighbouring objects see overlapping ranges of
+/// lights, as walls near the same blockers do), plus random strays.
+fn instance(rng: &mut Rng, objects: usize, lights: u32) -> Vec<LightSet> {
+    (0..objects)
+        .map(|_| {
+            let start = rng.below(lights as u64) as u32;
+            let len = rng.below(lights as u64 / 2) as u32;
+            let strays: Vec<u32> = (0..rng.below(10))
+                .map(|_| rng.below(lights as u64) as u32)
+                .collect();
+            let set = LightSet::from_indices(
+                (start..start + len)
+                    .map(|l| l % lights)
+                    .filter(|l| l % 3 != 0 || len % 2 == 0)
+                    .chain(strays),
+            );
+            if rng.below(8) == 0 {
+                LightSet::default()
+            } else {
+                set
+            }
+        })
+        .collect()
+}
+
+fn pairs(elements: &[gibench_barczak::passes::Element]) -> BTreeMap<(u32, u32), usize> {
+    let mut m = BTreeMap::new();
+    for e in elements {
+        for &o in &e.objects {
+            for l in e.lights.iter() {
+                *m.entry((o, l)).or_insert(0) += 1;
+            }
+        }
+    }
+    m
+}
+
+#[test]
+fn never_more_passes_and_every_pair_exactly_once() {
+    let mut rng = Rng(3);
+    let (mut before_all, mut after_all) = (0, 0);
+    for case in 0..150 {
+        let objects = 1 + rng.below(40) as usize;
+        let k = 1 + rng.below(8) as usize;
+        let lights = instance(&mut rng, objects, 300);
+        let start = one_per_object(&lights);
+        let before = total_passes(&start, k);
+        let out = optimise(start.clone(), k);
+        let after = total_passes(&out, k);
+        assert!(after <= before, "case {case}: {before} -> {after} passes");
+        let want = pairs(&start);
+        let got = pairs(&out);
+        assert!(
+            got.values().all(|n| *n == 1),
+            "case {case}: a pair is drawn twice"
+        );
+        assert_eq!(
+            want.keys().collect::<Vec<_>>(),
+            got.keys().collect::<Vec<_>>(),
+            "case {case}"
+        );
+        assert!(out
+            .iter()
+            .all(|e| !e.lights.is_empty() && !e.objects.is_empty()));
+        assert_eq!(out, optimise(start, k), "case {case}: not deterministic");
+        before_all += before;
+        after_all += after;
+    }
+    eprintln!("passes: {before_all} drawing each object alone, {after_all} optimised");
+    assert!(
+        after_all * 10 < before_all * 9,
+        "the optimiser hardly merged: {before_all} -> {after_all}"
+    );
+}
+
+/// The thesis' example (§4.3.5): 20 objects lit by the same 300 lights, 6 per pass, take 1000
+/// passes alone and 50 together.
+#[test]
+fn twenty_objects_sharing_three_hundred_lights_take_fifty_passes() {
+    let lights = vec![LightSet::from_indices(0..300); 20];
+    let start = one_per_object(&lights);
+    assert_eq!(total_passes(&start, 6), 1000);
+    let out = optimise(start, 6);
+    assert_eq!(total_passes(&out, 6), 50);
+    assert_eq!(out.len(), 1);
+    assert_eq!(out[0].objects, (0..20).collect::<Vec<u32>>());
+}
+
+/// Merges that save nothing are not made, counting the merged element's own passes: at K = 7
+/// an object with 8 lights (2 passes) and one with 7 (1 pass) sharing one light would become
+/// 1 + 1 + 1 passes; two with 7 sharing one, 1 + 1 + 1 instead of 2.
+#[test]
+fn merges_that_save_nothing_are_not_made() {
+    for lights in [
+        vec![LightSet::from_indices(0..8), LightSet::from_indices(7..14)],
+        vec![LightSet::from_indices(0..7), LightSet::from_indices(6..13)],
+    ] {
+        let start = one_per_object(&lights);
+        let out = optimise(start.clone(), 7);
+        assert_eq!(out, start);
+    }
+}
