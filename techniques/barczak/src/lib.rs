@@ -7,6 +7,9 @@
 //! * [`visibility`] — §4.3.1: occlusion pyramids from patches (and complex objects' bounding
 //!   spheres) to each light, polygon and sphere blockers, lights classified unblocked / partial /
 //!   fully blocked, hierarchical patch subdivision with early termination.
+//! * [`database`] — §4.5.1–4.5.2: the visibility database of every receiver node and light,
+//!   updated by Table 4-1 when an object moves, with the light-map changes and the shadow
+//!   maps a motion affects.
 //! * [`passes`] — §4.3.5: the greedy render-pass optimiser of Figure 4-10 over elements (sets of
 //!   objects with the lights they share), a pass drawing up to K lights.
 //! * [`samples`] — §4.1: the direct light samples on area emitters and the indirect ones from
@@ -15,10 +18,11 @@
 //! The shadow maps are the shared atlas's octahedral kind (§4.2.1,
 //! `gibench_harness::ir::atlas::MapKind::Octahedral`). Still to come (issue 11): light maps
 //! and the subtraction pass, the low-resolution pass with edge detection, PRT for complex
-//! meshes, the movers' visibility database and prioritised shadow-map updates, the optimisation
+//! meshes, prioritised shadow-map updates, the optimisation
 //! levels, the thesis' scenes and `gibench reproduce barczak2006`; until then `barczak` is not
 //! in the technique registry.
 
+pub mod database;
 pub mod passes;
 pub mod samples;
 pub mod visibility;

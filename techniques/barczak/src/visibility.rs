@@ -470,6 +470,105 @@ pub struct NodeVisibility {
     pub tested: bool,
 }
 
+/// Where a light's rays to a receiver node run: nowhere (the light is behind it or faces away),
+/// everywhere (a light inside a complex object's bounds: every blocker may shadow it), or
+/// through an occlusion pyramid.
+#[derive(Clone, Debug)]
+pub enum Reach {
+    Behind,
+    Everything,
+    Pyramid(Pyramid),
+}
+
+impl Reach {
+    /// To the patch node with `corners` (front normal `normal`), with the whole patch's
+    /// `tolerance`.
+    pub fn patch(
+        light: &PointLight,
+        corners: [Vec3; 4],
+        normal: Vec3,
+        tolerance: Tolerance,
+    ) -> Reach {
+        if misses(light, &corners) {
+            return Reach::Behind;
+        }
+        match Pyramid::to_patch(light.position, corners, normal, tolerance) {
+            Some(p) => Reach::Pyramid(p),
+            None => Reach::Behind,
+        }
+    }
+
+    /// To a complex object with bounding sphere (`center`, `radius`).
+    pub fn object(light: &PointLight, center: Vec3, radius: f32) -> Reach {
+        if light
+            .normal
+            .is_some_and(|ln| ln.dot(center - light.position) <= -radius)
+        {
+            return Reach::Behind;
+        }
+        match Pyramid::to_sphere(light.position, center, radius) {
+            Some(p) => Reach::Pyramid(p),
+            None => Reach::Everything,
+        }
+    }
+
+    /// What `shape` does to these rays.
+    pub fn test(&self, shape: &Shape) -> Option<Occlusion> {
+        match self {
+            Reach::Behind => None,
+            Reach::Everything => Some(Occlusion::Partial),
+            Reach::Pyramid(p) => p.test(shape),
+        }
+    }
+
+    /// The light's state over the node, from the blockers reaching in.
+    pub fn state(&self, blockers: &[(u32, Occlusion)]) -> LightState {
+        if matches!(self, Reach::Behind) {
+            LightState::Behind
+        } else if blockers.iter().any(|(_, o)| *o == Occlusion::Full) {
+            LightState::Blocked
+        } else if blockers.is_empty() {
+            LightState::Unblocked
+        } else {
+            LightState::Partial
+        }
+    }
+
+    /// The node's visibility against `candidates` (indices into `blockers`; `object`'s own
+    /// blockers skipped).
+    pub fn classify(
+        &self,
+        object: u32,
+        blockers: &[Blocker],
+        candidates: impl Iterator<Item = u32>,
+    ) -> NodeVisibility {
+        let mut list = Vec::new();
+        if !matches!(self, Reach::Behind) {
+            for b in candidates {
+                let blocker = &blockers[b as usize];
+                if blocker.object == object {
+                    continue;
+                }
+                if let Some(o) = self.test(&blocker.shape) {
+                    list.push((b, o));
+                }
+            }
+        }
+        NodeVisibility {
+            state: self.state(&list),
+            blockers: list,
+            tested: true,
+        }
+    }
+}
+
+/// Whether the light's hemisphere misses every corner of the patch.
+fn misses(light: &PointLight, corners: &[Vec3; 4]) -> bool {
+    light
+        .normal
+        .is_some_and(|ln| corners.iter().all(|c| ln.dot(*c - light.position) <= 0.0))
+}
+
 /// The light's state over one patch node against `candidates` (indices into `blockers`), and
 /// the blockers reaching into its pyramid, with the whole patch's `tolerance`.
 #[allow(clippy::too_many_arguments)]
@@ -482,25 +581,7 @@ pub fn classify_patch(
     candidates: impl Iterator<Item = u32>,
     tolerance: Tolerance,
 ) -> NodeVisibility {
-    let behind = NodeVisibility {
-        state: LightState::Behind,
-        blockers: Vec::new(),
-        tested: true,
-    };
-    if misses(light, &corners) {
-        return behind;
-    }
-    let Some(pyramid) = Pyramid::to_patch(light.position, corners, normal, tolerance) else {
-        return behind;
-    };
-    classify(&pyramid, object, blockers, candidates)
-}
-
-/// Whether the light's hemisphere misses every corner of the patch.
-fn misses(light: &PointLight, corners: &[Vec3; 4]) -> bool {
-    light
-        .normal
-        .is_some_and(|ln| corners.iter().all(|c| ln.dot(*c - light.position) <= 0.0))
+    Reach::patch(light, corners, normal, tolerance).classify(object, blockers, candidates)
 }
 
 /// The light's state over a complex object with bounding sphere (`center`, `radius`).
@@ -511,64 +592,7 @@ pub fn classify_object(
     light: &PointLight,
     blockers: &[Blocker],
 ) -> NodeVisibility {
-    if let Some(ln) = light.normal {
-        if ln.dot(center - light.position) <= -radius {
-            return NodeVisibility {
-                state: LightState::Behind,
-                blockers: Vec::new(),
-                tested: true,
-            };
-        }
-    }
-    match Pyramid::to_sphere(light.position, center, radius) {
-        Some(pyramid) => classify(&pyramid, object, blockers, 0..blockers.len() as u32),
-        // A light inside the bounds: every other blocker may shadow it.
-        None => {
-            let list: Vec<(u32, Occlusion)> = (0..blockers.len() as u32)
-                .filter(|&b| blockers[b as usize].object != object)
-                .map(|b| (b, Occlusion::Partial))
-                .collect();
-            NodeVisibility {
-                state: if list.is_empty() {
-                    LightState::Unblocked
-                } else {
-                    LightState::Partial
-                },
-                blockers: list,
-                tested: true,
-            }
-        }
-    }
-}
-
-fn classify(
-    pyramid: &Pyramid,
-    object: u32,
-    blockers: &[Blocker],
-    candidates: impl Iterator<Item = u32>,
-) -> NodeVisibility {
-    let mut list = Vec::new();
-    for b in candidates {
-        let blocker = &blockers[b as usize];
-        if blocker.object == object {
-            continue;
-        }
-        if let Some(o) = pyramid.test(&blocker.shape) {
-            list.push((b, o));
-        }
-    }
-    let state = if list.iter().any(|(_, o)| *o == Occlusion::Full) {
-        LightState::Blocked
-    } else if list.is_empty() {
-        LightState::Unblocked
-    } else {
-        LightState::Partial
-    };
-    NodeVisibility {
-        state,
-        blockers: list,
-        tested: true,
-    }
+    Reach::object(light, center, radius).classify(object, blockers, 0..blockers.len() as u32)
 }
 
 /// The light's visibility over every node of `tree` by the hierarchical test (see the module

@@ -1,0 +1,312 @@
+//! The visibility database for moving objects (Barczak 2006 §4.5.1–4.5.2, Table 4-1).
+//!
+//! Reads: the lights, the receivers (patch trees and complex objects' bounding spheres) and the
+//! blockers, each tagged with its object; a mover's rigid motion.
+//! Writes: per receiver node and light, the blockers reaching into the node's occlusion pyramid
+//! (each partial or full) and the light's [`LightState`] inferred from them; per motion, the
+//! light-map changes (a leaf gaining or losing a light: fully blocked or behind ⇄ lit) and the
+//! shadow maps the motion affects.
+//!
+//! What is stored follows one rule per blocker and node: at a root the blocker is tested; below,
+//! a blocker *full* on the parent is full on the child (no test), one *partial* on the parent is
+//! tested on the child, one missing the parent is missing on the child (the child's pyramid lies
+//! inside the parent's). A node behind the light stores nothing. So a blocker is stored in every
+//! node its recursion reaches, "once as a partial occluder and once as a full occluder" where it
+//! changes, as the thesis describes.
+//!
+//! When an object moves ([`VisibilityDatabase::move_object`]): its own receivers are recomputed;
+//! for every other receiver and light only the mover's blockers are revisited, top down, with
+//! Table 4-1's cases: unchanged full or unchanged missing ends the descent; partial (unchanged
+//! or new) recurses with tests; a change to full or to missing is propagated to the children
+//! without tests (the rule gives them full or missing). The result equals rebuilding the
+//! database on the moved scene (tested).
+
+use glam::Vec3;
+
+use crate::visibility::{Blocker, LightState, Occlusion, PatchTree, PointLight, Reach, Shape};
+
+/// A receiver's geometry.
+#[derive(Clone, Debug)]
+pub enum ReceiverShape {
+    /// A planar patch and its sub-patches (light-mapped).
+    Patch(PatchTree),
+    /// A complex object's bounding sphere (lit by PRT; one node).
+    Object { center: Vec3, radius: f32 },
+}
+
+/// A receiver: its object and geometry.
+#[derive(Clone, Debug)]
+pub struct Receiver {
+    pub object: u32,
+    pub shape: ReceiverShape,
+}
+
+impl Receiver {
+    pub fn node_count(&self) -> usize {
+        match &self.shape {
+            ReceiverShape::Patch(t) => t.nodes.len(),
+            ReceiverShape::Object { .. } => 1,
+        }
+    }
+    fn children(&self, node: usize) -> Option<[u32; 4]> {
+        match &self.shape {
+            ReceiverShape::Patch(t) => t.nodes[node].children,
+            ReceiverShape::Object { .. } => None,
+        }
+    }
+    fn reach(&self, node: usize, light: &PointLight) -> Reach {
+        match &self.shape {
+            ReceiverShape::Patch(t) => {
+                Reach::patch(light, t.nodes[node].corners, t.normal, t.tolerance(light))
+            }
+            ReceiverShape::Object { center, radius } => Reach::object(light, *center, *radius),
+        }
+    }
+    /// Moves the receiver by the rigid map `to`.
+    fn transform(&mut self, to: &impl Fn(Vec3) -> Vec3) {
+        match &mut self.shape {
+            ReceiverShape::Patch(t) => {
+                let origin = t.nodes[0].corners[0];
+                t.normal = (to(origin + t.normal) - to(origin)).normalize();
+                for n in &mut t.nodes {
+                    n.corners = n.corners.map(to);
+                }
+            }
+            ReceiverShape::Object { center, .. } => *center = to(*center),
+        }
+    }
+}
+
+/// What the database stores for one node and light.
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct NodeEntry {
+    pub state: Option<LightState>,
+    /// Blockers reaching in, by blocker index, ascending.
+    pub blockers: Vec<(u32, Occlusion)>,
+}
+
+/// A light added to or removed from a leaf's light map.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LightMapChange {
+    pub receiver: u32,
+    pub node: u32,
+    pub light: u32,
+    /// True: the light now lights the leaf (add its contribution); false: remove it.
+    pub add: bool,
+}
+
+/// What one motion changed.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Update {
+    pub light_map: Vec<LightMapChange>,
+    /// Lights whose shadow maps see the mover before or after the motion, ascending.
+    pub shadow_maps: Vec<u32>,
+    /// Blocker-against-pyramid tests made.
+    pub tests: usize,
+}
+
+/// See the module docs.
+#[derive(Clone, Debug)]
+pub struct VisibilityDatabase {
+    pub lights: Vec<PointLight>,
+    pub receivers: Vec<Receiver>,
+    pub blockers: Vec<Blocker>,
+    /// `[receiver][node][light]`.
+    entries: Vec<Vec<Vec<NodeEntry>>>,
+}
+
+/// Whether a light lights a node in this state (it belongs in the light map).
+fn lit(state: Option<LightState>) -> bool {
+    matches!(state, Some(LightState::Unblocked | LightState::Partial))
+}
+
+impl VisibilityDatabase {
+    /// The database of the scene, computed in full. Returns it and the tests made.
+    pub fn build(
+        lights: Vec<PointLight>,
+        receivers: Vec<Receiver>,
+        blockers: Vec<Blocker>,
+    ) -> (VisibilityDatabase, usize) {
+        let mut db = VisibilityDatabase {
+            entries: receivers
+                .iter()
+                .map(|r| vec![vec![NodeEntry::default(); lights.len()]; r.node_count()])
+                .collect(),
+            lights,
+            receivers,
+            blockers,
+        };
+        let mut tests = 0;
+        for r in 0..db.receivers.len() {
+            tests += db.recompute_receiver(r);
+        }
+        (db, tests)
+    }
+
+    /// The entry of `node` of `receiver` for `light`.
+    pub fn entry(&self, receiver: usize, node: usize, light: usize) -> &NodeEntry {
+        &self.entries[receiver][node][light]
+    }
+
+    /// The light's state over the node.
+    pub fn state(&self, receiver: usize, node: usize, light: usize) -> LightState {
+        self.entries[receiver][node][light]
+            .state
+            .expect("every node is computed")
+    }
+
+    /// Every entry, `[receiver][node][light]` (to compare two databases).
+    pub fn entries(&self) -> &[Vec<Vec<NodeEntry>>] {
+        &self.entries
+    }
+
+    /// Recomputes every node of receiver `r` for every light against every blocker.
+    fn recompute_receiver(&mut self, r: usize) -> usize {
+        let candidates: Vec<u32> = (0..self.blockers.len() as u32).collect();
+        let mut tests = 0;
+        for l in 0..self.lights.len() {
+            tests += self.visit(r, l, 0, None, &candidates, true);
+        }
+        tests
+    }
+
+    /// Brings node `n` of receiver `r` for light `l` up to date for the blockers `only`, given
+    /// its parent's entry (`None` at the root), and descends where Table 4-1 says so; `full`
+    /// recomputes the whole subtree. Returns the tests made.
+    fn visit(
+        &mut self,
+        r: usize,
+        l: usize,
+        n: usize,
+        parent: Option<&NodeEntry>,
+        only: &[u32],
+        full: bool,
+    ) -> usize {
+        let receiver = &self.receivers[r];
+        let reach = receiver.reach(n, &self.lights[l]);
+        let mut tests = 0;
+        let mut fresh: Vec<(u32, Occlusion)> = Vec::new();
+        if !matches!(reach, Reach::Behind) {
+            for &b in only {
+                let blocker = &self.blockers[b as usize];
+                if blocker.object == receiver.object {
+                    continue;
+                }
+                let o = match parent {
+                    None => {
+                        tests += 1;
+                        reach.test(&blocker.shape)
+                    }
+                    Some(p) => match p.blockers.iter().find(|(pb, _)| *pb == b).map(|x| x.1) {
+                        Some(Occlusion::Full) => Some(Occlusion::Full),
+                        Some(Occlusion::Partial) => {
+                            tests += 1;
+                            reach.test(&blocker.shape)
+                        }
+                        None => None,
+                    },
+                };
+                if let Some(o) = o {
+                    fresh.push((b, o));
+                }
+            }
+        }
+        let entry = &mut self.entries[r][n][l];
+        // The entries of the blockers not revisited stay; the revisited ones are replaced.
+        let old: Vec<(u32, Occlusion)> = entry
+            .blockers
+            .iter()
+            .filter(|(b, _)| only.contains(b))
+            .copied()
+            .collect();
+        // A full recomputation (a moved or new receiver) also renews the state: its reach moved.
+        let unchanged = old == fresh && entry.state.is_some() && !full;
+        let descend = !unchanged || fresh.iter().any(|(_, o)| *o == Occlusion::Partial);
+        if !unchanged {
+            entry.blockers.retain(|(b, _)| !only.contains(b));
+            entry.blockers.extend(fresh);
+            entry.blockers.sort_unstable_by_key(|(b, _)| *b);
+            entry.state = Some(reach.state(&entry.blockers));
+        }
+        if descend {
+            if let Some(children) = self.receivers[r].children(n) {
+                let parent = self.entries[r][n][l].clone();
+                for c in children {
+                    tests += self.visit(r, l, c as usize, Some(&parent), only, full);
+                }
+            }
+        }
+        tests
+    }
+
+    /// Moves `object` (its blockers and receivers) by the rigid map `to` and updates the
+    /// database (see the module docs).
+    pub fn move_object(&mut self, object: u32, to: impl Fn(Vec3) -> Vec3) -> Update {
+        let leaf_states = |db: &VisibilityDatabase| -> Vec<(u32, u32, u32, bool)> {
+            let mut v = Vec::new();
+            for (r, rec) in db.receivers.iter().enumerate() {
+                for n in 0..rec.node_count() {
+                    if rec.children(n).is_none() {
+                        for l in 0..db.lights.len() {
+                            v.push((r as u32, n as u32, l as u32, lit(db.entries[r][n][l].state)));
+                        }
+                    }
+                }
+            }
+            v
+        };
+        let sees_mover = |db: &VisibilityDatabase| -> Vec<bool> {
+            (0..db.lights.len())
+                .map(|l| {
+                    db.receivers
+                        .iter()
+                        .enumerate()
+                        .filter(|(_, r)| r.object == object)
+                        .any(|(r, _)| lit(db.entries[r][0][l].state))
+                })
+                .collect()
+        };
+        let before = leaf_states(self);
+        let seen_before = sees_mover(self);
+        let moved: Vec<u32> = (0..self.blockers.len() as u32)
+            .filter(|&b| self.blockers[b as usize].object == object)
+            .collect();
+        for &b in &moved {
+            let shape = &mut self.blockers[b as usize].shape;
+            match shape {
+                Shape::Polygon(v) => v.iter_mut().for_each(|p| *p = to(*p)),
+                Shape::Sphere { center, .. } => *center = to(*center),
+            }
+        }
+        let mut tests = 0;
+        for r in 0..self.receivers.len() {
+            if self.receivers[r].object == object {
+                self.receivers[r].transform(&to);
+                tests += self.recompute_receiver(r);
+            } else {
+                for l in 0..self.lights.len() {
+                    tests += self.visit(r, l, 0, None, &moved, false);
+                }
+            }
+        }
+        let after = leaf_states(self);
+        let seen_after = sees_mover(self);
+        Update {
+            light_map: before
+                .iter()
+                .zip(&after)
+                .filter(|(a, b)| a.3 != b.3)
+                .map(|(_, b)| LightMapChange {
+                    receiver: b.0,
+                    node: b.1,
+                    light: b.2,
+                    add: b.3,
+                })
+                .collect(),
+            shadow_maps: (0..self.lights.len() as u32)
+                .filter(|&l| seen_before[l as usize] || seen_after[l as usize])
+                .collect(),
+            tests,
+        }
+    }
+}
