@@ -111,7 +111,6 @@ fn room() -> (Vec<Receiver>, Vec<Blocker>) {
     for (c, n) in faces {
         add(7, c.map(|(x, y, z)| cube(x, y, z)), n, 0, true);
     }
-    drop(add);
     // The sphere mover, object 8 (the bunny's stand-in).
     receivers.push(Receiver {
         object: 8,
