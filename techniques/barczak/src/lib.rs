@@ -12,17 +12,20 @@
 //!   maps a motion affects.
 //! * [`passes`] — §4.3.5: the greedy render-pass optimiser of Figure 4-10 over elements (sets of
 //!   objects with the lights they share), a pass drawing up to K lights.
+//! * [`schedule`] — §4.5.3: shadow maps a motion made out of date re-rendered a fixed number
+//!   per frame, by brightness × frames out of date.
 //! * [`samples`] — §4.1: the direct light samples on area emitters and the indirect ones from
 //!   random walks, computed once from the static geometry.
 //!
 //! The shadow maps are the shared atlas's octahedral kind (§4.2.1,
 //! `gibench_harness::ir::atlas::MapKind::Octahedral`). Still to come (issue 11): light maps
 //! and the subtraction pass, the low-resolution pass with edge detection, PRT for complex
-//! meshes, prioritised shadow-map updates, the optimisation
+//! meshes, the optimisation
 //! levels, the thesis' scenes and `gibench reproduce barczak2006`; until then `barczak` is not
 //! in the technique registry.
 
 pub mod database;
 pub mod passes;
 pub mod samples;
+pub mod schedule;
 pub mod visibility;
