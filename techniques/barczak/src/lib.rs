@@ -14,18 +14,21 @@
 //!   objects with the lights they share), a pass drawing up to K lights.
 //! * [`schedule`] — §4.5.3: shadow maps a motion made out of date re-rendered a fixed number
 //!   per frame, by brightness × frames out of date.
+//! * [`prt`] — §4.4: 5th-order SH transfer per vertex of a complex mesh (self-shadowed, by ray
+//!   casts, prepared once), the lighting environment at its centre from the visible light
+//!   samples, and irradiance as their dot product.
 //! * [`samples`] — §4.1: the direct light samples on area emitters and the indirect ones from
 //!   random walks, computed once from the static geometry.
 //!
 //! The shadow maps are the shared atlas's octahedral kind (§4.2.1,
 //! `gibench_harness::ir::atlas::MapKind::Octahedral`). Still to come (issue 11): light maps
-//! and the subtraction pass, the low-resolution pass with edge detection, PRT for complex
-//! meshes, the optimisation
+//! and the subtraction pass, the low-resolution pass with edge detection, PRT's draw, the optimisation
 //! levels, the thesis' scenes and `gibench reproduce barczak2006`; until then `barczak` is not
 //! in the technique registry.
 
 pub mod database;
 pub mod passes;
+pub mod prt;
 pub mod samples;
 pub mod schedule;
 pub mod visibility;
