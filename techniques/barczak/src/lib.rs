@@ -10,6 +10,9 @@
 //! * [`database`] — §4.5.1–4.5.2: the visibility database of every receiver node and light,
 //!   updated by Table 4-1 when an object moves, with the light-map changes and the shadow
 //!   maps a motion affects.
+//! * [`lightmap`] — §4.3.2, §4.5.2: a light map per leaf sub-patch holding its lit lights'
+//!   irradiance without visibility, updated by single lights when a motion blocks or frees
+//!   them; with the partial lights' subtraction it equals summing every light with visibility.
 //! * [`passes`] — §4.3.5: the greedy render-pass optimiser of Figure 4-10 over elements (sets of
 //!   objects with the lights they share), a pass drawing up to K lights.
 //! * [`schedule`] — §4.5.3: shadow maps a motion made out of date re-rendered a fixed number
@@ -21,12 +24,13 @@
 //!   random walks, computed once from the static geometry.
 //!
 //! The shadow maps are the shared atlas's octahedral kind (§4.2.1,
-//! `gibench_harness::ir::atlas::MapKind::Octahedral`). Still to come (issue 11): light maps
-//! and the subtraction pass, the low-resolution pass with edge detection, PRT's draw, the optimisation
+//! `gibench_harness::ir::atlas::MapKind::Octahedral`). Still to come (issue 11): the GPU
+//! passes (light maps drawn, the shadow-mapped subtraction), the low-resolution pass with edge detection, PRT's draw, the optimisation
 //! levels, the thesis' scenes and `gibench reproduce barczak2006`; until then `barczak` is not
 //! in the technique registry.
 
 pub mod database;
+pub mod lightmap;
 pub mod passes;
 pub mod prt;
 pub mod samples;

@@ -25,14 +25,10 @@ fn basis_is_orthonormal() {
             }
         }
     }
-    for i in 0..COEFFS {
-        for j in 0..COEFFS {
+    for (i, row) in gram.iter().enumerate() {
+        for (j, g) in row.iter().enumerate() {
             let want = (i == j) as u8 as f64;
-            assert!(
-                (gram[i][j] - want).abs() < 2e-3,
-                "<Y{i}, Y{j}> = {}",
-                gram[i][j]
-            );
+            assert!((g - want).abs() < 2e-3, "<Y{i}, Y{j}> = {g}");
         }
     }
     // The band-0 and band-1 terms in closed form (z polar, x for m = 1, y for m = −1).

@@ -1,0 +1,155 @@
+//! A test room for the visibility database and the light maps: six patches, a table, a box
+//! mover (object 7) and a sphere mover (object 8), and light samples on its surfaces.
+
+use gibench_barczak::database::{Receiver, ReceiverShape};
+use gibench_barczak::visibility::{Blocker, PatchTree, PointLight, Shape};
+use glam::Vec3;
+
+/// A 6 × 3 × 6 room: floor (split three times), walls and ceiling (split once), a table top
+/// (both a receiver and a blocker), a box mover (six faces, each a receiver and a blocker)
+/// and a sphere mover (a complex object: its bounding sphere).
+pub fn room() -> (Vec<Receiver>, Vec<Blocker>) {
+    let mut receivers = Vec::new();
+    let mut blockers = Vec::new();
+    let mut add = |object: u32, c: [Vec3; 4], n: Vec3, levels: u32, blocks: bool| {
+        receivers.push(Receiver {
+            object,
+            shape: ReceiverShape::Patch(PatchTree::new(object, c, n, levels)),
+        });
+        if blocks {
+            blockers.push(Blocker {
+                object,
+                shape: Shape::Polygon(c.to_vec()),
+            });
+        }
+    };
+    let v = Vec3::new;
+    let (w, h) = (6.0, 3.0);
+    add(
+        0,
+        [v(0., 0., 0.), v(0., 0., w), v(w, 0., w), v(w, 0., 0.)],
+        Vec3::Y,
+        3,
+        false,
+    );
+    add(
+        1,
+        [v(0., h, 0.), v(w, h, 0.), v(w, h, w), v(0., h, w)],
+        Vec3::NEG_Y,
+        1,
+        false,
+    );
+    add(
+        2,
+        [v(0., 0., 0.), v(w, 0., 0.), v(w, h, 0.), v(0., h, 0.)],
+        Vec3::Z,
+        1,
+        true,
+    );
+    add(
+        3,
+        [v(0., 0., w), v(0., h, w), v(w, h, w), v(w, 0., w)],
+        Vec3::NEG_Z,
+        1,
+        true,
+    );
+    add(
+        4,
+        [v(0., 0., 0.), v(0., h, 0.), v(0., h, w), v(0., 0., w)],
+        Vec3::X,
+        1,
+        true,
+    );
+    add(
+        5,
+        [v(w, 0., 0.), v(w, 0., w), v(w, h, w), v(w, h, 0.)],
+        Vec3::NEG_X,
+        1,
+        true,
+    );
+    // Table top at 1 m, both sides.
+    let top = [
+        v(2., 1., 2.),
+        v(2., 1., 3.5),
+        v(3.5, 1., 3.5),
+        v(3.5, 1., 2.),
+    ];
+    add(6, top, Vec3::Y, 1, true);
+    let mut under = top;
+    under.reverse();
+    add(6, under, Vec3::NEG_Y, 1, false);
+    // The box mover, object 7: 0.6 m cube at (1, 0.3..0.9, 1).
+    let cube = |x: f32, y: f32, z: f32| v(0.7 + 0.6 * x, 0.3 + 0.6 * y, 0.7 + 0.6 * z);
+    let faces = [
+        (
+            [(0., 0., 0.), (1., 0., 0.), (1., 0., 1.), (0., 0., 1.)],
+            Vec3::NEG_Y,
+        ),
+        (
+            [(0., 1., 0.), (0., 1., 1.), (1., 1., 1.), (1., 1., 0.)],
+            Vec3::Y,
+        ),
+        (
+            [(0., 0., 0.), (0., 0., 1.), (0., 1., 1.), (0., 1., 0.)],
+            Vec3::NEG_X,
+        ),
+        (
+            [(1., 0., 0.), (1., 1., 0.), (1., 1., 1.), (1., 0., 1.)],
+            Vec3::X,
+        ),
+        (
+            [(0., 0., 0.), (0., 1., 0.), (1., 1., 0.), (1., 0., 0.)],
+            Vec3::NEG_Z,
+        ),
+        (
+            [(0., 0., 1.), (1., 0., 1.), (1., 1., 1.), (0., 1., 1.)],
+            Vec3::Z,
+        ),
+    ];
+    for (c, n) in faces {
+        add(7, c.map(|(x, y, z)| cube(x, y, z)), n, 0, true);
+    }
+    // The sphere mover, object 8 (the bunny's stand-in).
+    receivers.push(Receiver {
+        object: 8,
+        shape: ReceiverShape::Object {
+            center: v(4.5, 0.5, 4.5),
+            radius: 0.45,
+        },
+    });
+    blockers.push(Blocker {
+        object: 8,
+        shape: Shape::Sphere {
+            center: v(4.5, 0.5, 4.5),
+            radius: 0.45,
+        },
+    });
+    (receivers, blockers)
+}
+
+/// Lights on the room's surfaces facing in (as light samples are), one omni near the ceiling.
+pub fn lights() -> Vec<PointLight> {
+    let mut out = vec![PointLight {
+        position: Vec3::new(3.1, 2.7, 2.9),
+        normal: None,
+    }];
+    let mut k = 1u32;
+    let mut next = || {
+        k = k.wrapping_mul(1_103_515_245).wrapping_add(12345);
+        (k >> 8) as f32 / (1u32 << 24) as f32
+    };
+    for i in 0..48 {
+        let (a, b) = (0.2 + 5.6 * next(), 0.2 + 5.6 * next());
+        let (position, normal) = match i % 4 {
+            0 => (Vec3::new(a, 0.001, b), Vec3::Y),
+            1 => (Vec3::new(a, 2.999, b), Vec3::NEG_Y),
+            2 => (Vec3::new(0.001, 0.2 + 2.6 * next(), b), Vec3::X),
+            _ => (Vec3::new(a, 0.2 + 2.6 * next(), 5.999), Vec3::NEG_Z),
+        };
+        out.push(PointLight {
+            position,
+            normal: Some(normal),
+        });
+    }
+    out
+}
