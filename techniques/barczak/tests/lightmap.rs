@@ -44,8 +44,8 @@ fn worst_error(db: &VisibilityDatabase, maps: &LightMaps, flux: &[Vec3]) -> (f32
                     };
                     let mut truth = Vec3::ZERO;
                     let mut shown = maps.texels(r, n)[(j * RES + i) as usize];
-                    for l in 0..db.lights.len() {
-                        let c = contribution(&db.lights[l], flux[l], x, tree.normal);
+                    for (l, (light, f)) in db.lights.iter().zip(flux).enumerate() {
+                        let c = contribution(light, *f, x, tree.normal);
                         let v = visible(l);
                         if v {
                             truth += c;
