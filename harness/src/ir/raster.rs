@@ -13,8 +13,9 @@
 //! Paraboloid maps are rendered with the VPL's frame in the vertex shader (Brabec et al. 2002)
 //! and back-hemisphere fragments discarded; cube maps with one 90° view per face; octahedral
 //! maps (Barczak 2006 §4.2) with one pass per octahedron face into the same square, the face's
-//! projection in the vertex shader, fragments outside its triangle discarded (Barczak clips with
-//! user clip planes, which wgpu's GL backend lacks) and the exact distance written as depth.
+//! projection in the vertex shader, fragments outside its triangle (widened by a sliver, so
+//! neighbouring faces leave no crack) discarded (Barczak clips with user clip planes, which
+//! wgpu's GL backend lacks) and the exact distance written as depth.
 //!
 //! VPLs a GPU pass wrote into a [`VplStore`] (imperfect shadow maps' RSM-sampled VPLs) are
 //! rendered with [`StoreViews`]: a compute pass writes each slot's paraboloid view from the store
@@ -220,7 +221,7 @@ impl AtlasRasteriser {
                 position: eye.extend(atlas.far).to_array(),
                 tangent: t.extend(sx).to_array(),
                 bitangent: b.extend(sy).to_array(),
-                normal: vpl.normal.extend(0.0).to_array(),
+                normal: vpl.normal.extend(atlas.near).to_array(),
             };
             let o = f * VIEW_STRIDE as usize;
             bytes[o..o + std::mem::size_of::<ViewData>()].copy_from_slice(bytemuck::bytes_of(&d));

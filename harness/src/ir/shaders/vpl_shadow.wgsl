@@ -8,7 +8,7 @@ struct VplView {
     // xyz: VPL position; w: far distance (paraboloid depth = 1 - distance / far)
     position: vec4<f32>,
     // The VPL's frame: tangent, bitangent, normal (xyz). Octahedral faces: tangent.w and
-    // bitangent.w are the signs (sx, sy) of the face's quadrant.
+    // bitangent.w are the signs (sx, sy) of the face's quadrant, normal.w the near distance.
     tangent: vec4<f32>,
     bitangent: vec4<f32>,
     normal: vec4<f32>,
@@ -52,8 +52,10 @@ struct OctahedralOut {
 
 // One face of an octahedral map (Barczak 2006 §4.2.1): the projection from the VPL onto the
 // face's plane sx*x + sy*y + z = 1, unfolded, (u, v) = (x + y, x - y) / (sx*x + sy*y + z), is
-// projective, so the triangle is rasterised exactly. w = 0.5 * depth keeps only points in front of
-// the face's plane; the fragment keeps its quadrant (the face's triangle of the square).
+// projective, so the triangle is rasterised exactly. The clip depth w - near keeps only points
+// at least `near` in front of the face's plane (as the cube faces' near plane does; clipping at
+// w = 0 itself would make vertices at infinity); the fragment writes the depth and keeps its
+// quadrant (the face's triangle of the square).
 @vertex
 fn vs_octahedral(@location(0) position: vec3<f32>) -> OctahedralOut {
     let world = (object.model * vec4<f32>(position, 1.0)).xyz;
@@ -61,18 +63,24 @@ fn vs_octahedral(@location(0) position: vec3<f32>) -> OctahedralOut {
     let local = vec3<f32>(dot(d, vpl_view.tangent.xyz), dot(d, vpl_view.bitangent.xyz), dot(d, vpl_view.normal.xyz));
     let w = vpl_view.tangent.w * local.x + vpl_view.bitangent.w * local.y + local.z;
     var out: OctahedralOut;
-    out.clip = vec4<f32>(local.x + local.y, local.x - local.y, 0.5 * w, w);
+    out.clip = vec4<f32>(local.x + local.y, local.x - local.y, w - vpl_view.normal.w, w);
     out.local = local;
     return out;
 }
 
-// Keeps the face's quadrant of the upper hemisphere (x >= 0 belongs to sx = +1) and stores the
-// exact distance (Barczak: the pixel shader writes the light-space distance as depth).
+// Keeps the face's quadrant of the upper hemisphere, widened by 1e-3 of the distance, and stores
+// the exact distance (Barczak: the pixel shader writes the light-space distance as depth). The
+// margin makes neighbouring faces overlap by a sliver: with exact quadrants, texel centres on a
+// face boundary (the square's diagonals) were discarded by both faces' interpolation rounding,
+// leaving cracks of empty texels that directions near a face boundary looked up (a floor seen
+// from just above it lies along one: 40 % of a wall's shadow leaked, tests/vpl_maps.rs). A
+// sliver point drawn by the neighbouring face lands within 2e-3 of its true place in the map.
 @fragment
 fn fs_octahedral(in: OctahedralOut) -> @builtin(frag_depth) f32 {
     let sx = vpl_view.tangent.w;
     let sy = vpl_view.bitangent.w;
-    if (in.local.z < 0.0 || (in.local.x >= 0.0) != (sx > 0.0) || (in.local.y >= 0.0) != (sy > 0.0)) {
+    let margin = 1e-3 * length(in.local);
+    if (in.local.z < -margin || sx * in.local.x < -margin || sy * in.local.y < -margin) {
         discard;
     }
     return clamp(1.0 - length(in.local) / vpl_view.position.w, 0.0, 1.0);
