@@ -430,3 +430,96 @@ fn sibenik_tessellation_counts() {
         );
     }
 }
+
+/// Barczak's rooms are exactly covered by their recorded patches: every patch a rectangle facing
+/// its normal (corners counter-clockwise from the front), patch areas summing to the mesh's,
+/// every triangle inside one patch — also when the mesh is split finely for paraboloid maps;
+/// the room's shell casts no shadows, everything in it does.
+#[test]
+fn barczak_rooms_are_covered_by_their_patches() {
+    use gibench_harness::scene::barczak;
+    for (name, build) in [
+        ("area", barczak::area_room as fn(Option<f32>) -> _),
+        ("table", barczak::table_room),
+        ("pillars", barczak::pillar_room),
+    ] {
+        for tessellate in [None, Some(0.25)] {
+            let (mesh, materials, patches) = build(tessellate);
+            let mut patch_area = 0.0f64;
+            for (i, p) in patches.iter().enumerate() {
+                let [a, b, c, d] = p.corners;
+                let (u, v) = (b - a, d - a);
+                assert!(
+                    u.dot(v).abs() < 1e-5 * u.length() * v.length(),
+                    "{name} patch {i}: not a rectangle"
+                );
+                assert!(
+                    (a + u + v - c).length() < 1e-5,
+                    "{name} patch {i}: not a rectangle"
+                );
+                assert!(
+                    u.cross(v).normalize().dot(p.normal) > 0.9999,
+                    "{name} patch {i}: faces away from its normal"
+                );
+                assert!((p.material as usize) < materials.len());
+                assert_eq!(p.casts_shadows, p.object >= 6, "{name} patch {i}");
+                patch_area += u.cross(v).length() as f64;
+            }
+            let mut mesh_area = 0.0f64;
+            for t in 0..mesh.triangle_count() {
+                let [p0, p1, p2] = mesh.triangle(t);
+                mesh_area += 0.5 * (p1 - p0).cross(p2 - p0).length() as f64;
+                let centre = (p0 + p1 + p2) / 3.0;
+                let inside = patches.iter().any(|p| {
+                    let [a, b, _, d] = p.corners;
+                    let (u, v, w) = (b - a, d - a, centre - a);
+                    let (s, t) = (w.dot(u) / u.length_squared(), w.dot(v) / v.length_squared());
+                    p.normal.dot(w).abs() < 1e-5
+                        && (0.0..=1.0).contains(&s)
+                        && (0.0..=1.0).contains(&t)
+                });
+                assert!(inside, "{name}: triangle {t} lies in no patch");
+            }
+            assert!(
+                (patch_area - mesh_area).abs() < 1e-5 * mesh_area,
+                "{name}: patches {patch_area} m², mesh {mesh_area} m²"
+            );
+            let objects: std::collections::BTreeSet<u32> =
+                patches.iter().map(|p| p.object).collect();
+            assert_eq!(
+                objects,
+                (0..objects.len() as u32).collect(),
+                "{name}: object ids not contiguous"
+            );
+        }
+    }
+    // Loaded through the descriptor, the static patches come along (the pillar room's mover is
+    // generated, so no asset is needed).
+    let scene = Scene::load_named("barczak-pillars", &AssetPaths::standard(None)).unwrap();
+    assert_eq!(scene.patches.len(), 6 + 4 * 4);
+    assert_eq!(scene.movers[0].mesh.positions.len(), 820);
+}
+
+/// The torus mover: 820 vertices (41 × 20, as the thesis'), closed, its triangles facing along
+/// its normals.
+#[test]
+fn torus_mover_is_closed_with_820_vertices() {
+    let (mesh, _) = gibench_harness::scene::barczak::torus();
+    assert_eq!(mesh.positions.len(), 820);
+    assert_eq!(mesh.triangle_count(), 1640);
+    let mut edges = std::collections::HashMap::new();
+    for t in 0..mesh.triangle_count() {
+        let i = &mesh.indices[3 * t..3 * t + 3];
+        for k in 0..3 {
+            let (a, b) = (i[k].min(i[(k + 1) % 3]), i[k].max(i[(k + 1) % 3]));
+            *edges.entry((a, b)).or_insert(0) += 1;
+        }
+        let [p0, p1, p2] = mesh.triangle(t);
+        let n = (p1 - p0).cross(p2 - p0);
+        assert!(
+            n.dot(mesh.normals[i[0] as usize]) > 0.0,
+            "triangle {t} faces inwards"
+        );
+    }
+    assert!(edges.values().all(|n| *n == 2), "the torus has open edges");
+}

@@ -12,14 +12,19 @@ use crate::{Error, Result};
 pub const GENERATED_CORNELL_BOX: &str = "cornell-box";
 /// Name of the generated maze of Laine et al. 2007's MAZE scene ([`crate::scene::maze`]).
 pub const GENERATED_MAZE: &str = "maze";
-/// Every generated mesh name: the Cornell box, the maze, and the scenes of Gaitatzes et al.
-/// 2010 ([`crate::scene::gaitatzes`]).
+/// Every generated mesh name: the Cornell box, the maze, the scenes of Gaitatzes et al. 2010
+/// ([`crate::scene::gaitatzes`]) and of Barczak 2006 with its torus mover
+/// ([`crate::scene::barczak`]).
 pub const GENERATED_MESHES: &[&str] = &[
     GENERATED_CORNELL_BOX,
     GENERATED_MAZE,
     "gaitatzes-test",
     "gaitatzes-room",
     "gaitatzes-arena",
+    "barczak-area-room",
+    "barczak-table-room",
+    "barczak-pillar-room",
+    "torus-820",
 ];
 
 /// Where a mesh comes from: exactly one of `file` (a glTF binary on the asset search path) or
@@ -247,6 +252,18 @@ const BUILTINS: &[(&str, &str)] = &[
     (
         "gaitatzes-arena",
         include_str!("../../../scenes/gaitatzes-arena.json"),
+    ),
+    (
+        "barczak-area",
+        include_str!("../../../scenes/barczak-area.json"),
+    ),
+    (
+        "barczak-table",
+        include_str!("../../../scenes/barczak-table.json"),
+    ),
+    (
+        "barczak-pillars",
+        include_str!("../../../scenes/barczak-pillars.json"),
     ),
     ("maze", include_str!("../../../scenes/maze.json")),
     (

@@ -9,6 +9,7 @@
 //! Vertices are never shared between materials, so a triangle's material is the material of
 //! any of its vertices.
 
+pub mod barczak;
 pub mod cornell;
 pub mod descriptor;
 pub mod gaitatzes;
@@ -307,6 +308,26 @@ fn check_coordinates(scene: &str, what: &str, mesh: &Mesh) -> Result<()> {
     }
 }
 
+/// A planar rectangular surface of the static mesh and the object it belongs to: what
+/// light-mapped, visibility-culled techniques (Barczak 2006 §4.3) light and test against.
+/// Generated scenes that are built from rectangles record them ([`barczak`]); other scenes
+/// have none.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Patch {
+    /// Corners in order, counter-clockwise seen from the front (the side `normal` points to).
+    pub corners: [Vec3; 4],
+    pub normal: Vec3,
+    /// The object: an object never shadows itself, and its patches move together.
+    pub object: u32,
+    pub material: u32,
+    /// How many times to split it 2 × 2 for visibility determination (the thesis set this per
+    /// surface: floors more than ceilings).
+    pub levels: u32,
+    /// Whether it can shadow another surface (a convex room's own walls cannot; the thesis leaves
+    /// them out of the occluders).
+    pub casts_shadows: bool,
+}
+
 /// The whole scene.
 #[derive(Clone, Debug)]
 pub struct Scene {
@@ -325,6 +346,8 @@ pub struct Scene {
     pub gltf_lights: Vec<PunctualLight>,
     /// Bounds, diagonal and ray ε of [`Scene::mesh`], computed once at load.
     pub extent: SceneExtent,
+    /// The static mesh's rectangles by object, where its source records them (see [`Patch`]).
+    pub patches: Vec<Patch>,
 }
 
 /// A mesh built from a [`MeshSource`], with materials and textures indexed from zero.
@@ -333,17 +356,23 @@ struct BuiltMesh {
     materials: Vec<Material>,
     textures: Vec<Texture>,
     lights: Vec<PunctualLight>,
+    patches: Vec<Patch>,
 }
 
-/// The mesh and materials of the generated mesh `name` (one of
+/// The mesh, materials and patches of the generated mesh `name` (one of
 /// [`descriptor::GENERATED_MESHES`]), split into cells of about `tessellate` where given.
-fn generate(name: &str, tessellate: Option<f32>) -> Result<(Mesh, Vec<Material>)> {
+fn generate(name: &str, tessellate: Option<f32>) -> Result<(Mesh, Vec<Material>, Vec<Patch>)> {
+    let none = |(m, mat): (Mesh, Vec<Material>)| (m, mat, Vec::new());
     Ok(match name {
-        GENERATED_CORNELL_BOX => cornell::cornell_box(tessellate),
-        GENERATED_MAZE => maze::maze(tessellate),
-        "gaitatzes-test" => gaitatzes::test_scene(tessellate),
-        "gaitatzes-room" => gaitatzes::room(tessellate),
-        "gaitatzes-arena" => gaitatzes::arena(tessellate),
+        GENERATED_CORNELL_BOX => none(cornell::cornell_box(tessellate)),
+        GENERATED_MAZE => none(maze::maze(tessellate)),
+        "gaitatzes-test" => none(gaitatzes::test_scene(tessellate)),
+        "gaitatzes-room" => none(gaitatzes::room(tessellate)),
+        "gaitatzes-arena" => none(gaitatzes::arena(tessellate)),
+        "barczak-area-room" => barczak::area_room(tessellate),
+        "barczak-table-room" => barczak::table_room(tessellate),
+        "barczak-pillar-room" => barczak::pillar_room(tessellate),
+        "torus-820" => none(barczak::torus()),
         _ => {
             return Err(crate::Error::Invalid(format!(
                 "unknown generated mesh '{name}'; expected one of: {}",
@@ -380,15 +409,17 @@ fn build_mesh(src: &MeshSource, assets: &AssetPaths, field: &str) -> Result<Buil
                 materials: g.materials,
                 textures: g.textures,
                 lights: g.lights,
+                patches: Vec::new(),
             })
         }
         (None, Some(name)) => {
-            let (mesh, materials) = generate(name, src.tessellate)?;
+            let (mesh, materials, patches) = generate(name, src.tessellate)?;
             Ok(BuiltMesh {
                 mesh,
                 materials,
                 textures: Vec::new(),
                 lights: Vec::new(),
+                patches,
             })
         }
         (None, None) => Err(crate::Error::Invalid(
@@ -552,6 +583,7 @@ impl Scene {
             textures,
             movers,
             gltf_lights: main.lights,
+            patches: main.patches,
         })
     }
 

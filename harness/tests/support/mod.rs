@@ -53,5 +53,6 @@ pub fn scene(mesh: Mesh, materials: Vec<Material>) -> Scene {
         textures: Vec::new(),
         movers: Vec::new(),
         gltf_lights: Vec::new(),
+        patches: Vec::new(),
     }
 }

@@ -320,6 +320,7 @@ fn voxelize_triangle(a: Vec3, b: Vec3, c: Vec3) {
         textures: Vec::new(),
         movers: Vec::new(),
         gltf_lights: Vec::new(),
+        patches: Vec::new(),
     };
     for backend in backends() {
         let gpu = gpu(backend);

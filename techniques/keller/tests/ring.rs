@@ -137,6 +137,7 @@ fn closed_box_bounce_flux_is_exact_at_n_64() {
         textures: Vec::new(),
         movers: Vec::new(),
         gltf_lights: Vec::new(),
+        patches: Vec::new(),
     };
     let bvh = SceneBvh::new(&scene.mesh);
     let light = LightPose {
