@@ -667,11 +667,10 @@ mod tests {
         for name in names {
             let d = SceneDescriptor::resolve(name).unwrap_or_else(|e| panic!("{name}: {e}"));
             assert_eq!(d.name, name);
-            // Both the camera and the light move (Laine measured with both moving).
-            assert!(
-                d.camera.path.keys.len() >= 2 && d.light.path.keys.len() >= 2,
-                "{name}"
-            );
+            // Both the camera and the light move (Laine measured with both moving), but in
+            // Barczak's rooms (the thesis measured fixed views).
+            let moving = d.camera.path.keys.len() >= 2 && d.light.path.keys.len() >= 2;
+            assert_eq!(moving, !name.starts_with("barczak-"), "{name}");
         }
     }
 

@@ -20,13 +20,16 @@
 //! * [`prt`] — §4.4: 5th-order SH transfer per vertex of a complex mesh (self-shadowed, by ray
 //!   casts, prepared once), the lighting environment at its centre from the visible light
 //!   samples, and irradiance as their dot product.
+//! * [`setup`] — the above put together from a scene once: receivers and blockers from the
+//!   scene's patches and movers (`gibench_harness::scene::Patch`; the `barczak-*` rooms record
+//!   them), light samples, the database and the light maps.
 //! * [`samples`] — §4.1: the direct light samples on area emitters and the indirect ones from
 //!   random walks, computed once from the static geometry.
 //!
 //! The shadow maps are the shared atlas's octahedral kind (§4.2.1,
 //! `gibench_harness::ir::atlas::MapKind::Octahedral`). Still to come (issue 11): the GPU
 //! passes (light maps drawn, the shadow-mapped subtraction), the low-resolution pass with edge detection, PRT's draw, the optimisation
-//! levels, the thesis' scenes and `gibench reproduce barczak2006`; until then `barczak` is not
+//! levels and `gibench reproduce barczak2006`; until then `barczak` is not
 //! in the technique registry.
 
 pub mod database;
@@ -35,4 +38,5 @@ pub mod passes;
 pub mod prt;
 pub mod samples;
 pub mod schedule;
+pub mod setup;
 pub mod visibility;

@@ -1,0 +1,133 @@
+//! The scene as Barczak's technique sees it, prepared once (§4.1, §4.3, §4.5): receivers and
+//! blockers from the scene's patches and movers, the light samples, the visibility database
+//! and the light maps.
+//!
+//! Reads: the scene's patches (generated scenes record them: the `barczak-*` rooms), its movers
+//! and their poses at the first frame, the light's pose, the static BVH.
+//! Writes: [`BarczakScene`].
+//!
+//! * Every patch is a receiver, split `levels` times; a patch that casts shadows is also a
+//!   polygon blocker. Patches of one object never shadow each other.
+//! * Every mover is a complex object: its bounding sphere (about its origin, posed) is both a
+//!   receiver (lit by PRT) and a sphere blocker; mover k is object `first_mover_object + k`.
+//! * The light samples are oriented point lights at the sample positions.
+
+use gibench_harness::anim::{FrameState, LightPose};
+use gibench_harness::bvh::SceneBvh;
+use gibench_harness::scene::Scene;
+use gibench_harness::{Error, Result};
+use glam::{Mat4, Vec3};
+
+use crate::database::{Receiver, ReceiverShape, VisibilityDatabase};
+use crate::lightmap::LightMaps;
+use crate::samples::{self, LightSamples, SampleSettings};
+use crate::visibility::{Blocker, PatchTree, PointLight, Shape};
+
+/// A mover's bounding sphere in its own space (centre, radius).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MoverBounds {
+    pub center: Vec3,
+    pub radius: f32,
+}
+
+impl MoverBounds {
+    /// The sphere posed by `model` (rigid, uniformly scaled).
+    pub fn posed(&self, model: Mat4) -> (Vec3, f32) {
+        let scale = model.x_axis.truncate().length();
+        (model.transform_point3(self.center), self.radius * scale)
+    }
+}
+
+/// See the module docs.
+#[derive(Clone, Debug)]
+pub struct BarczakScene {
+    pub samples: LightSamples,
+    /// Each light's flux, in database order (direct samples first).
+    pub flux: Vec<Vec3>,
+    pub db: VisibilityDatabase,
+    pub light_maps: LightMaps,
+    pub movers: Vec<MoverBounds>,
+    /// The object number of mover 0.
+    pub first_mover_object: u32,
+}
+
+/// Prepares `scene` at `frame` (the movers' poses) with light `light` (see the module docs).
+/// Errors name the scene when it records no patches.
+pub fn prepare(
+    scene: &Scene,
+    bvh: &SceneBvh,
+    frame: &FrameState,
+    light: &LightPose,
+    settings: SampleSettings,
+    light_map_res: u32,
+) -> Result<BarczakScene> {
+    if scene.patches.is_empty() {
+        return Err(Error::Invalid(format!(
+            "barczak lights patches (planar rectangles with their objects), and scene '{}' records none; use a scene that does (barczak-area, barczak-table, barczak-pillars)",
+            scene.descriptor.name
+        )));
+    }
+    let samples = samples::generate(scene, bvh, light, settings)?;
+    let lights: Vec<PointLight> = samples
+        .all()
+        .map(|v| PointLight {
+            position: v.position,
+            normal: Some(v.normal),
+        })
+        .collect();
+    let flux: Vec<Vec3> = samples.all().map(|v| v.flux).collect();
+    let mut receivers = Vec::new();
+    let mut blockers = Vec::new();
+    for p in &scene.patches {
+        receivers.push(Receiver {
+            object: p.object,
+            shape: ReceiverShape::Patch(PatchTree::new(p.object, p.corners, p.normal, p.levels)),
+        });
+        if p.casts_shadows {
+            blockers.push(Blocker {
+                object: p.object,
+                shape: Shape::Polygon(p.corners.to_vec()),
+            });
+        }
+    }
+    let first_mover_object = scene.patches.iter().map(|p| p.object).max().unwrap_or(0) + 1;
+    let mut movers = Vec::new();
+    for (k, m) in scene.movers.iter().enumerate() {
+        let (lo, hi) = m.mesh.bounds();
+        let center = (lo + hi) * 0.5;
+        let radius = m
+            .mesh
+            .positions
+            .iter()
+            .map(|p| (*p - center).length())
+            .fold(0f32, f32::max);
+        let bounds = MoverBounds { center, radius };
+        let (c, r) = bounds.posed(frame.movers.get(k).copied().unwrap_or(Mat4::IDENTITY));
+        let object = first_mover_object + k as u32;
+        receivers.push(Receiver {
+            object,
+            shape: ReceiverShape::Object {
+                center: c,
+                radius: r,
+            },
+        });
+        blockers.push(Blocker {
+            object,
+            shape: Shape::Sphere {
+                center: c,
+                radius: r,
+            },
+        });
+        movers.push(bounds);
+    }
+    let (db, _) = VisibilityDatabase::build(lights, receivers, blockers);
+    let light_maps = LightMaps::bake(&db, &flux, light_map_res);
+    Ok(BarczakScene {
+        samples,
+        flux,
+        db,
+        light_maps,
+        movers,
+        first_mover_object,
+    })
+}

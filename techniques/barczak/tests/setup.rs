@@ -1,0 +1,97 @@
+//! Barczak's scene set-up on a generated room: the light maps minus the occluded partial lights
+//! equal summing every light sample with visibility ray-cast against the real geometry (the
+//! static mesh and the posed torus mover, whose bounding sphere stands in for it as a blocker).
+
+use gibench_barczak::database::ReceiverShape;
+use gibench_barczak::lightmap::{contribution, texel_position};
+use gibench_barczak::samples::SampleSettings;
+use gibench_barczak::setup::prepare;
+use gibench_barczak::visibility::LightState;
+use gibench_harness::anim::FrameClock;
+use gibench_harness::assets::AssetPaths;
+use gibench_harness::bvh::SceneBvh;
+use gibench_harness::glam::Vec3;
+use gibench_harness::scene::Scene;
+
+const RES: u32 = 3;
+
+#[test]
+fn light_maps_of_the_pillar_room_agree_with_ray_casts() {
+    let scene = Scene::load_named("barczak-pillars", &AssetPaths::standard(None)).unwrap();
+    let bvh = SceneBvh::new(&scene.mesh);
+    let frame = FrameClock::new(&scene.descriptor).frame(0);
+    let settings = SampleSettings {
+        direct: 16,
+        indirect: 48,
+        bounces: 3,
+    };
+    let bz = prepare(&scene, &bvh, &frame, &frame.light, settings, RES).unwrap();
+    assert_eq!(bz.db.lights.len(), 64);
+    // The real occluders: the static mesh and the torus where frame 0 puts it.
+    let mut world = scene.mesh.clone();
+    let mut torus = scene.movers[0].mesh.clone();
+    for p in &mut torus.positions {
+        *p = frame.movers[0].transform_point3(*p);
+    }
+    world.append(&torus, 0);
+    let real = SceneBvh::new(&world);
+    let eps = 1e-4 * scene.extent.diagonal;
+    let (mut worst, mut top, mut subtracted) = (0f32, 0f32, 0);
+    for (r, receiver) in bz.db.receivers.iter().enumerate() {
+        let ReceiverShape::Patch(tree) = &receiver.shape else {
+            continue;
+        };
+        for n in tree.leaves() {
+            for j in 0..RES {
+                for i in 0..RES {
+                    let x = texel_position(tree, n, RES, i, j);
+                    let mut shown = bz.light_maps.texels(r, n)[(j * RES + i) as usize];
+                    let mut truth = Vec3::ZERO;
+                    for (l, light) in bz.db.lights.iter().enumerate() {
+                        let c = contribution(light, bz.flux[l], x, tree.normal);
+                        if c == Vec3::ZERO {
+                            continue;
+                        }
+                        let ln = light.normal.unwrap();
+                        let visible =
+                            !real.occluded(x + tree.normal * eps, light.position + ln * eps, 0.0);
+                        if visible {
+                            truth += c;
+                        }
+                        if bz.db.state(r, n, l) == LightState::Partial && !visible {
+                            shown -= c;
+                            subtracted += 1;
+                        }
+                    }
+                    worst = worst.max((shown - truth).abs().max_element());
+                    top = top.max(truth.max_element());
+                }
+            }
+        }
+    }
+    assert!(subtracted > 50, "hardly any occlusion ({subtracted})");
+    assert!(
+        worst <= 1e-4 * top,
+        "light map − occluded partial lights is {worst} off the ray-cast sum (largest {top})"
+    );
+}
+
+/// A scene that records no patches is refused with a message naming it.
+#[test]
+fn scenes_without_patches_are_refused() {
+    let scene = Scene::load_named("cornell", &AssetPaths::standard(None)).unwrap();
+    let bvh = SceneBvh::new(&scene.mesh);
+    let frame = FrameClock::new(&scene.descriptor).frame(0);
+    let settings = SampleSettings {
+        direct: 0,
+        indirect: 8,
+        bounces: 1,
+    };
+    let err = prepare(&scene, &bvh, &frame, &frame.light, settings, 2)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("'cornell'") && err.contains("patches"),
+        "{err}"
+    );
+}
