@@ -36,11 +36,14 @@
 //!   pool splatted into its paraboloid map, one dispatch for all VPLs (Ritschel et al. 2008).
 //! * [`pullpush::PullPush`] — fills the splats' holes in every map at once and writes them
 //!   into a float atlas.
+//! * [`edges::EdgeMask`] — pixels where the G-buffer's surface plane changes within a few
+//!   pixels, for a low-resolution illumination pass (Barczak 2006 §4.3.3).
 //! * [`gather::VplGather`] — the common case wired: CPU list, rasterised static casters,
 //!   interleaved gathering, with the shared parameters and stage names.
 
 pub mod accumulate;
 pub mod atlas;
+pub mod edges;
 pub mod gather;
 pub mod interleave;
 pub mod points;
