@@ -15,45 +15,14 @@ use gibench_harness::vpl::{
 };
 
 mod support;
-use support::{material, quad, scene};
+use support::{closed_box_mesh, material, quad, scene};
 
 const ALBEDO: Vec3 = Vec3::new(0.5, 0.6, 0.7);
 const BOX: Vec3 = Vec3::new(4.0, 3.0, 5.0);
 
 /// A closed 4 × 3 × 5 box of six inward-facing quads, all of albedo [`ALBEDO`].
 fn closed_box() -> Scene {
-    let mut m = Mesh::default();
-    let corner = |(x, y, z): (f32, f32, f32)| Vec3::new(x, y, z) * BOX;
-    let faces = [
-        (
-            [(0., 0., 0.), (1., 0., 0.), (1., 0., 1.), (0., 0., 1.)],
-            Vec3::Y,
-        ),
-        (
-            [(0., 1., 0.), (0., 1., 1.), (1., 1., 1.), (1., 1., 0.)],
-            Vec3::NEG_Y,
-        ),
-        (
-            [(0., 0., 0.), (0., 0., 1.), (0., 1., 1.), (0., 1., 0.)],
-            Vec3::X,
-        ),
-        (
-            [(1., 0., 0.), (1., 1., 0.), (1., 1., 1.), (1., 0., 1.)],
-            Vec3::NEG_X,
-        ),
-        (
-            [(0., 0., 0.), (0., 1., 0.), (1., 1., 0.), (1., 0., 0.)],
-            Vec3::Z,
-        ),
-        (
-            [(0., 0., 1.), (1., 0., 1.), (1., 1., 1.), (0., 1., 1.)],
-            Vec3::NEG_Z,
-        ),
-    ];
-    for (c, n) in faces {
-        quad(&mut m, c.map(corner), n, 0);
-    }
-    scene(m, vec![material("box", ALBEDO)])
+    scene(closed_box_mesh(BOX, 0), vec![material("box", ALBEDO)])
 }
 
 /// The square [−h, h]² in the y = 0 plane, facing +Y, albedo [`ALBEDO`].

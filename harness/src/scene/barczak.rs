@@ -20,15 +20,6 @@ use glam::{Vec2, Vec3};
 use super::maze::quad;
 use super::{Material, Mesh, Patch};
 
-fn material(name: &str, c: Vec3) -> Material {
-    Material {
-        name: name.into(),
-        base_color: c,
-        texture: None,
-        average_color: c,
-    }
-}
-
 const W: f32 = 6.0;
 const H: f32 = 3.0;
 
@@ -134,12 +125,12 @@ impl Builder {
 /// Materials: 0 floor, 1 ceiling, 2 wall, 3 red wall, 4 blue wall, 5 objects.
 fn materials() -> Vec<Material> {
     vec![
-        material("floor", Vec3::splat(0.6)),
-        material("ceiling", Vec3::splat(0.75)),
-        material("wall", Vec3::splat(0.7)),
-        material("red wall", Vec3::new(0.63, 0.065, 0.05)),
-        material("blue wall", Vec3::new(0.1, 0.15, 0.6)),
-        material("grey", Vec3::splat(0.5)),
+        Material::plain("floor", Vec3::splat(0.6)),
+        Material::plain("ceiling", Vec3::splat(0.75)),
+        Material::plain("wall", Vec3::splat(0.7)),
+        Material::plain("red wall", Vec3::new(0.63, 0.065, 0.05)),
+        Material::plain("blue wall", Vec3::new(0.1, 0.15, 0.6)),
+        Material::plain("grey", Vec3::splat(0.5)),
     ]
 }
 
@@ -292,5 +283,8 @@ pub fn torus() -> (Mesh, Vec<Material>) {
             mesh.indices.extend([a, c, b, a, d, c]);
         }
     }
-    (mesh, vec![material("torus", Vec3::new(0.8, 0.7, 0.2))])
+    (
+        mesh,
+        vec![Material::plain("torus", Vec3::new(0.8, 0.7, 0.2))],
+    )
 }

@@ -19,12 +19,7 @@ use super::maze::quad;
 use super::{Material, Mesh};
 
 fn material(name: &str, c: Vec3) -> Material {
-    Material {
-        name: name.into(),
-        base_color: c,
-        texture: None,
-        average_color: c,
-    }
+    Material::plain(name, c)
 }
 
 /// An axis-aligned box from `lo` to `hi`, all six faces facing out, each face split into cells

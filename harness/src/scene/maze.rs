@@ -25,12 +25,7 @@ pub const FLOOR: u32 = 0;
 pub const WALL: u32 = 1;
 
 fn materials() -> Vec<Material> {
-    let m = |name: &str, c: Vec3| Material {
-        name: name.into(),
-        base_color: c,
-        texture: None,
-        average_color: c,
-    };
+    let m = Material::plain;
     vec![
         m("floor", Vec3::new(0.55, 0.5, 0.45)),
         m("wall", Vec3::new(0.75, 0.75, 0.72)),

@@ -40,6 +40,18 @@ pub struct Material {
     pub average_color: Vec3,
 }
 
+impl Material {
+    /// An untextured material of colour `color`.
+    pub fn plain(name: &str, color: Vec3) -> Material {
+        Material {
+            name: name.into(),
+            base_color: color,
+            texture: None,
+            average_color: color,
+        }
+    }
+}
+
 /// A base-colour texture, decoded to RGBA8 with sRGB-encoded colour channels.
 #[derive(Clone, Debug)]
 pub struct Texture {

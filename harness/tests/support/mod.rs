@@ -22,12 +22,43 @@ pub fn descriptor() -> SceneDescriptor {
 }
 
 pub fn material(name: &str, color: Vec3) -> Material {
-    Material {
-        name: name.into(),
-        base_color: color,
-        texture: None,
-        average_color: color,
+    Material::plain(name, color)
+}
+
+/// A closed box of `size` from the origin: six inward-facing quads of `material`.
+pub fn closed_box_mesh(size: Vec3, material: u32) -> Mesh {
+    let mut m = Mesh::default();
+    let corner = |(x, y, z): (f32, f32, f32)| Vec3::new(x, y, z) * size;
+    let faces = [
+        (
+            [(0., 0., 0.), (1., 0., 0.), (1., 0., 1.), (0., 0., 1.)],
+            Vec3::Y,
+        ),
+        (
+            [(0., 1., 0.), (0., 1., 1.), (1., 1., 1.), (1., 1., 0.)],
+            Vec3::NEG_Y,
+        ),
+        (
+            [(0., 0., 0.), (0., 0., 1.), (0., 1., 1.), (0., 1., 0.)],
+            Vec3::X,
+        ),
+        (
+            [(1., 0., 0.), (1., 1., 0.), (1., 1., 1.), (1., 0., 1.)],
+            Vec3::NEG_X,
+        ),
+        (
+            [(0., 0., 0.), (0., 1., 0.), (1., 1., 0.), (1., 0., 0.)],
+            Vec3::Z,
+        ),
+        (
+            [(0., 0., 1.), (1., 0., 1.), (1., 1., 1.), (0., 1., 1.)],
+            Vec3::NEG_Z,
+        ),
+    ];
+    for (c, n) in faces {
+        quad(&mut m, c.map(corner), n, material);
     }
+    m
 }
 
 /// Appends quad `c` (corners in order) as two triangles with flat normal `n` and `material`.

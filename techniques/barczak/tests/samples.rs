@@ -6,49 +6,18 @@ use gibench_harness::anim::LightPose;
 use gibench_harness::bvh::SceneBvh;
 use gibench_harness::glam::Vec3;
 use gibench_harness::scene::descriptor::LightKind;
-use gibench_harness::scene::{Mesh, Scene};
+use gibench_harness::scene::Scene;
 
 #[path = "../../../harness/tests/support/mod.rs"]
 mod support;
-use support::{material, quad, scene};
+use support::{closed_box_mesh, material, scene};
 
 const ALBEDO: Vec3 = Vec3::new(0.5, 0.6, 0.7);
 const BOX: Vec3 = Vec3::new(4.0, 3.0, 5.0);
 
 /// A closed 4 × 3 × 5 box of inward-facing quads of albedo [`ALBEDO`].
 fn closed_box() -> Scene {
-    let mut m = Mesh::default();
-    let c = |(x, y, z): (f32, f32, f32)| Vec3::new(x, y, z) * BOX;
-    let faces = [
-        (
-            [(0., 0., 0.), (1., 0., 0.), (1., 0., 1.), (0., 0., 1.)],
-            Vec3::Y,
-        ),
-        (
-            [(0., 1., 0.), (0., 1., 1.), (1., 1., 1.), (1., 1., 0.)],
-            Vec3::NEG_Y,
-        ),
-        (
-            [(0., 0., 0.), (0., 0., 1.), (0., 1., 1.), (0., 1., 0.)],
-            Vec3::X,
-        ),
-        (
-            [(1., 0., 0.), (1., 1., 0.), (1., 1., 1.), (1., 0., 1.)],
-            Vec3::NEG_X,
-        ),
-        (
-            [(0., 0., 0.), (0., 1., 0.), (1., 1., 0.), (1., 0., 0.)],
-            Vec3::Z,
-        ),
-        (
-            [(0., 0., 1.), (1., 0., 1.), (1., 1., 1.), (0., 1., 1.)],
-            Vec3::NEG_Z,
-        ),
-    ];
-    for (corners, n) in faces {
-        quad(&mut m, corners.map(c), n, 0);
-    }
-    scene(m, vec![material("box", ALBEDO)])
+    scene(closed_box_mesh(BOX, 0), vec![material("box", ALBEDO)])
 }
 
 /// A 1.2 × 0.8 area light just under the ceiling, facing down.
