@@ -13,6 +13,8 @@
 //! * [`lightmap`] — §4.3.2, §4.5.2: a light map per leaf sub-patch holding its lit lights'
 //!   irradiance without visibility, updated by single lights when a motion blocks or frees
 //!   them; with the partial lights' subtraction it equals summing every light with visibility.
+//! * [`lightmap_pass`] — §4.3.2 on the GPU: the light maps drawn for every patch leaf the camera
+//!   sees (one draw), bilinear inside each leaf.
 //! * [`passes`] — §4.3.5: the greedy render-pass optimiser of Figure 4-10 over elements (sets of
 //!   objects with the lights they share), a pass drawing up to K lights.
 //! * [`schedule`] — §4.5.3: shadow maps a motion made out of date re-rendered a fixed number
@@ -27,13 +29,15 @@
 //!   random walks, computed once from the static geometry.
 //!
 //! The shadow maps are the shared atlas's octahedral kind (§4.2.1,
-//! `gibench_harness::ir::atlas::MapKind::Octahedral`). Still to come (issue 11): the GPU
-//! passes (light maps drawn, the shadow-mapped subtraction), the low-resolution pass with edge detection, PRT's draw, the optimisation
-//! levels and `gibench reproduce barczak2006`; until then `barczak` is not
-//! in the technique registry.
+//! `gibench_harness::ir::atlas::MapKind::Octahedral`), the low-resolution pass's mask the kit's
+//! `EdgeMask`. Still to come (issue 11): the shadow-mapped subtraction pass (draws of up to K
+//! lights per optimised element), the low-resolution pass itself, PRT's draw, the optimisation
+//! levels and `gibench reproduce barczak2006`; until then `barczak` is not in the technique
+//! registry.
 
 pub mod database;
 pub mod lightmap;
+pub mod lightmap_pass;
 pub mod passes;
 pub mod prt;
 pub mod samples;

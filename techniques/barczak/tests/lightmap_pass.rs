@@ -1,0 +1,145 @@
+//! The light-map pass on the GPU: at every pixel of the pillar room the irradiance equals the
+//! CPU light map of the leaf the pixel lies in, bilinear between texel centres inside the leaf
+//! (Vulkan and GL); pixels on the torus mover (no patch) stay zero.
+
+use gibench_barczak::database::ReceiverShape;
+use gibench_barczak::lightmap_pass::LightMapPass;
+use gibench_barczak::samples::SampleSettings;
+use gibench_barczak::setup::prepare;
+use gibench_harness::assets::AssetPaths;
+use gibench_harness::glam::Vec3;
+use gibench_harness::gpu::{GpuContext, GpuOptions};
+use gibench_harness::runner::{Harness, RunConfig, TimingMode};
+use gibench_harness::scene::Scene;
+use gibench_harness::wgpu;
+
+const W: u32 = 96;
+const H: u32 = 72;
+const RES: u32 = 4;
+
+#[test]
+fn light_map_pass_draws_the_cpu_light_maps() {
+    let scene = Scene::load_named("barczak-pillars", &AssetPaths::standard(None)).unwrap();
+    for backend in gibench_harness::gpu::available_backends() {
+        let gpu = GpuContext::new(&GpuOptions {
+            backend: Some(backend.into()),
+            adapter: None,
+        })
+        .unwrap();
+        let config = RunConfig {
+            resolution: [W, H],
+            frames: 1,
+            warmup: 0,
+            first_frame: 0,
+            timing: TimingMode::Stages,
+            seed: 1,
+            shadow_size: 64,
+        };
+        let harness = Harness::new(&gpu, &scene, &config).unwrap();
+        let frame = harness.clock.frame(0);
+        harness.uniforms.write(&gpu.queue, &frame);
+        let settings = SampleSettings {
+            direct: 8,
+            indirect: 24,
+            bounces: 2,
+        };
+        let bz = prepare(&scene, &harness.bvh, &frame, &frame.light, settings, RES).unwrap();
+        let pass = LightMapPass::new(
+            &gpu,
+            &harness.uniforms,
+            &harness.gbuffer,
+            &bz.db,
+            &bz.light_maps,
+        )
+        .unwrap();
+        let target = gpu.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("test irradiance"),
+            size: wgpu::Extent3d {
+                width: W,
+                height: H,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: gibench_harness::passes::HDR_FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                | wgpu::TextureUsages::COPY_SRC
+                | wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        });
+        let view = target.create_view(&Default::default());
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        harness
+            .gbuffer
+            .encode(&mut enc, &harness.gpu_scene, &harness.uniforms);
+        assert_eq!(pass.encode(&mut enc, &harness.uniforms, &view), 1);
+        gpu.queue.submit([enc.finish()]);
+        let gpu_e = gibench_harness::image_io::read_rgb_f32(&gpu, &target).unwrap();
+        let g = harness.gbuffer.export(&gpu).unwrap();
+        let (mut checked, mut agree, mut mover, mut mover_zero) = (0, 0, 0, 0);
+        for (i, p) in g.positions.iter().enumerate() {
+            let Some(p) = p else { continue };
+            let e = Vec3::from(gpu_e[i]);
+            // The leaf the point lies in, and where in it.
+            let mut found = None;
+            for (r, receiver) in bz.db.receivers.iter().enumerate() {
+                let ReceiverShape::Patch(tree) = &receiver.shape else {
+                    continue;
+                };
+                if tree.normal.dot(g.normals[i]) < 0.99 {
+                    continue;
+                }
+                for n in tree.leaves() {
+                    let [a, b, _, d] = tree.nodes[n].corners;
+                    let (u, v, w) = (b - a, d - a, *p - a);
+                    if tree.normal.dot(w).abs() > 1e-3 * scene.extent.diagonal {
+                        continue;
+                    }
+                    let (s, t) = (w.dot(u) / u.length_squared(), w.dot(v) / v.length_squared());
+                    let margin = 0.02;
+                    if (margin..=1.0 - margin).contains(&s) && (margin..=1.0 - margin).contains(&t)
+                    {
+                        found = Some((r, n, s, t));
+                    }
+                }
+            }
+            let Some((r, n, s, t)) = found else {
+                // Not a patch: the torus (or a leaf's border, left out).
+                let on_torus = scene.patches.iter().all(|pa| {
+                    pa.normal.dot(*p - pa.corners[0]).abs() > 1e-3 * scene.extent.diagonal
+                });
+                if on_torus {
+                    mover += 1;
+                    mover_zero += (e == Vec3::ZERO) as usize;
+                }
+                continue;
+            };
+            let texels = bz.light_maps.texels(r, n);
+            let last = (RES - 1) as f32;
+            let x = (s * RES as f32 - 0.5).clamp(0.0, last);
+            let y = (t * RES as f32 - 0.5).clamp(0.0, last);
+            let (i0, j0) = (x.floor() as u32, y.floor() as u32);
+            let (i1, j1) = ((i0 + 1).min(RES - 1), (j0 + 1).min(RES - 1));
+            let at = |i: u32, j: u32| texels[(j * RES + i) as usize];
+            let (fx, fy) = (x - i0 as f32, y - j0 as f32);
+            let want = at(i0, j0)
+                .lerp(at(i1, j0), fx)
+                .lerp(at(i0, j1).lerp(at(i1, j1), fx), fy);
+            checked += 1;
+            // Rgba16Float output: 3 significant digits; the pixel centre's (s, t) on the GPU comes
+            // from interpolation, on the CPU from the reconstructed position.
+            agree += ((e - want).abs().max_element() <= 0.01 * want.max_element() + 1e-6) as usize;
+        }
+        eprintln!("{backend}: {agree} of {checked} agree; torus {mover_zero} zero of {mover}");
+        assert!(checked > 2000, "{backend}: only {checked} pixels checked");
+        assert!(
+            agree * 100 >= checked * 99,
+            "{backend}: {agree} of {checked} pixels agree with the CPU light maps"
+        );
+        assert!(
+            mover > 20 && mover_zero == mover,
+            "{backend}: torus pixels {mover_zero} zero of {mover}"
+        );
+    }
+}
