@@ -15,6 +15,9 @@
 //!   them; with the partial lights' subtraction it equals summing every light with visibility.
 //! * [`lightmap_pass`] — §4.3.2 on the GPU: the light maps drawn for every patch leaf the camera
 //!   sees (one draw), bilinear inside each leaf.
+//! * [`subtract_pass`] — §4.3.2's second pass drawn as §4.3.4–4.3.5 do: per optimised element,
+//!   draws of up to K lights subtracting the occluded partial lights' contributions (shared
+//!   octahedral atlas lookups); the draws are counted.
 //! * [`passes`] — §4.3.5: the greedy render-pass optimiser of Figure 4-10 over elements (sets of
 //!   objects with the lights they share), a pass drawing up to K lights.
 //! * [`schedule`] — §4.5.3: shadow maps a motion made out of date re-rendered a fixed number
@@ -30,10 +33,10 @@
 //!
 //! The shadow maps are the shared atlas's octahedral kind (§4.2.1,
 //! `gibench_harness::ir::atlas::MapKind::Octahedral`), the low-resolution pass's mask the kit's
-//! `EdgeMask`. Still to come (issue 11): the shadow-mapped subtraction pass (draws of up to K
-//! lights per optimised element), the low-resolution pass itself, PRT's draw, the optimisation
-//! levels and `gibench reproduce barczak2006`; until then `barczak` is not in the technique
-//! registry.
+//! `EdgeMask`. Still to come (issue 11): the low-resolution pass itself, PRT's draw, the
+//! technique wiring them per frame with the optimisation levels (Full, VD+LP, VD, Naive), its
+//! registry and conformance entries and `gibench reproduce barczak2006`; until then `barczak`
+//! is not in the technique registry.
 
 pub mod database;
 pub mod lightmap;
@@ -43,4 +46,5 @@ pub mod prt;
 pub mod samples;
 pub mod schedule;
 pub mod setup;
+pub mod subtract_pass;
 pub mod visibility;

@@ -24,16 +24,78 @@ use crate::lightmap::LightMaps;
 struct LeafVertex {
     position: [f32; 3],
     leaf: u32,
+    normal: [f32; 3],
     st: [f32; 2],
+}
+
+/// The patch leaves as GPU geometry, shared by the light-map and subtraction passes: leaf `t`
+/// (its tile) is vertices `6t .. 6t + 6`, two triangles, each vertex with its position, tile,
+/// the patch normal and its (s, t) in the leaf.
+pub struct Leaves {
+    /// (receiver, node) of each leaf, in tile order.
+    pub tiles: Vec<(usize, usize)>,
+    vertices: wgpu::Buffer,
+}
+
+impl Leaves {
+    /// The leaves of every patch receiver of `db`.
+    pub fn new(gpu: &GpuContext, db: &VisibilityDatabase) -> Leaves {
+        let mut tiles = Vec::new();
+        let mut vertices = Vec::new();
+        for (r, receiver) in db.receivers.iter().enumerate() {
+            let ReceiverShape::Patch(tree) = &receiver.shape else {
+                continue;
+            };
+            for n in tree.leaves() {
+                let tile = tiles.len() as u32;
+                tiles.push((r, n));
+                let c = tree.nodes[n].corners;
+                let st = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+                for k in [0, 1, 2, 0, 2, 3] {
+                    vertices.push(LeafVertex {
+                        position: c[k].to_array(),
+                        leaf: tile,
+                        normal: tree.normal.to_array(),
+                        st: st[k],
+                    });
+                }
+            }
+        }
+        let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("barczak leaves"),
+            size: (std::mem::size_of_val(vertices.as_slice()) as u64).max(4),
+            usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        gpu.queue
+            .write_buffer(&buffer, 0, bytemuck::cast_slice(&vertices));
+        Leaves {
+            tiles,
+            vertices: buffer,
+        }
+    }
+
+    /// The vertex buffer.
+    pub fn buffer(&self) -> &wgpu::Buffer {
+        &self.vertices
+    }
+
+    /// Its layout: 0 position, 1 tile, 2 normal, 3 (s, t).
+    pub fn layout() -> wgpu::VertexBufferLayout<'static> {
+        const ATTRIBUTES: [wgpu::VertexAttribute; 4] =
+            wgpu::vertex_attr_array![0 => Float32x3, 1 => Uint32, 2 => Float32x3, 3 => Float32x2];
+        wgpu::VertexBufferLayout {
+            array_stride: std::mem::size_of::<LeafVertex>() as u64,
+            step_mode: wgpu::VertexStepMode::Vertex,
+            attributes: &ATTRIBUTES,
+        }
+    }
 }
 
 /// See the module docs.
 pub struct LightMapPass {
     res: u32,
-    /// (receiver, node) of each leaf, in tile order.
-    leaves: Vec<(usize, usize)>,
-    vertices: wgpu::Buffer,
-    vertex_count: u32,
+    leaves: std::sync::Arc<Leaves>,
     texels: wgpu::Buffer,
     group: wgpu::BindGroup,
     gbuffer_group: wgpu::BindGroup,
@@ -41,47 +103,19 @@ pub struct LightMapPass {
 }
 
 impl LightMapPass {
-    /// The pass for the patch leaves of `db`, with maps of `maps.res`² texels.
+    /// The pass for `leaves` (of `db`), with maps of `maps.res`² texels.
     pub fn new(
         gpu: &GpuContext,
         uniforms: &FrameUniforms,
         gbuffer: &GBuffer,
-        db: &VisibilityDatabase,
+        leaves: std::sync::Arc<Leaves>,
         maps: &LightMaps,
     ) -> Result<LightMapPass> {
         let device = &gpu.device;
-        let mut leaves = Vec::new();
-        let mut vertices = Vec::new();
-        for (r, receiver) in db.receivers.iter().enumerate() {
-            let ReceiverShape::Patch(tree) = &receiver.shape else {
-                continue;
-            };
-            for n in tree.leaves() {
-                let tile = leaves.len() as u32;
-                leaves.push((r, n));
-                let c = tree.nodes[n].corners;
-                let st = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
-                for k in [0, 1, 2, 0, 2, 3] {
-                    vertices.push(LeafVertex {
-                        position: c[k].to_array(),
-                        leaf: tile,
-                        st: st[k],
-                    });
-                }
-            }
-        }
         let res = maps.res;
-        let vertex_buffer = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("barczak leaves"),
-            size: (std::mem::size_of_val(vertices.as_slice()) as u64).max(4),
-            usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        gpu.queue
-            .write_buffer(&vertex_buffer, 0, bytemuck::cast_slice(&vertices));
         let texels = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("barczak light maps"),
-            size: (leaves.len() as u64 * (res * res) as u64 * 16).max(16),
+            size: (leaves.tiles.len() as u64 * (res * res) as u64 * 16).max(16),
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
@@ -144,11 +178,7 @@ impl LightMapPass {
                 module: &module,
                 entry_point: Some("vs_leaf"),
                 compilation_options: Default::default(),
-                buffers: &[Some(wgpu::VertexBufferLayout {
-                    array_stride: std::mem::size_of::<LeafVertex>() as u64,
-                    step_mode: wgpu::VertexStepMode::Vertex,
-                    attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Uint32, 2 => Float32x2],
-                })],
+                buffers: &[Some(Leaves::layout())],
             },
             primitive: wgpu::PrimitiveState::default(),
             depth_stencil: None,
@@ -165,9 +195,7 @@ impl LightMapPass {
         gpu.check_errors()?;
         let pass = LightMapPass {
             res,
-            vertex_count: vertices.len() as u32,
             leaves,
-            vertices: vertex_buffer,
             texels,
             group,
             gbuffer_group: gbuffer.read_group.clone(),
@@ -180,8 +208,8 @@ impl LightMapPass {
     /// Writes `maps` (same leaves and resolution) to the GPU.
     pub fn upload(&self, gpu: &GpuContext, maps: &LightMaps) {
         let mut data: Vec<[f32; 4]> =
-            Vec::with_capacity(self.leaves.len() * (self.res * self.res) as usize);
-        for &(r, n) in &self.leaves {
+            Vec::with_capacity(self.leaves.tiles.len() * (self.res * self.res) as usize);
+        for &(r, n) in &self.leaves.tiles {
             data.extend(maps.texels(r, n).iter().map(|t| [t.x, t.y, t.z, 0.0]));
         }
         gpu.queue
@@ -219,8 +247,8 @@ impl LightMapPass {
         );
         pass.set_bind_group(1, &self.gbuffer_group, &[]);
         pass.set_bind_group(2, &self.group, &[]);
-        pass.set_vertex_buffer(0, self.vertices.slice(..));
-        pass.draw(0..self.vertex_count, 0..1);
+        pass.set_vertex_buffer(0, self.leaves.buffer().slice(..));
+        pass.draw(0..6 * self.leaves.tiles.len() as u32, 0..1);
         1
     }
 }

@@ -2,8 +2,7 @@
 //! CPU light map of the leaf the pixel lies in, bilinear between texel centres inside the leaf
 //! (Vulkan and GL); pixels on the torus mover (no patch) stay zero.
 
-use gibench_barczak::database::ReceiverShape;
-use gibench_barczak::lightmap_pass::LightMapPass;
+use gibench_barczak::lightmap_pass::{Leaves, LightMapPass};
 use gibench_barczak::samples::SampleSettings;
 use gibench_barczak::setup::prepare;
 use gibench_harness::assets::AssetPaths;
@@ -12,6 +11,8 @@ use gibench_harness::gpu::{GpuContext, GpuOptions};
 use gibench_harness::runner::{Harness, RunConfig, TimingMode};
 use gibench_harness::scene::Scene;
 use gibench_harness::wgpu;
+
+mod support;
 
 const W: u32 = 96;
 const H: u32 = 72;
@@ -44,11 +45,12 @@ fn light_map_pass_draws_the_cpu_light_maps() {
             bounces: 2,
         };
         let bz = prepare(&scene, &harness.bvh, &frame, &frame.light, settings, RES).unwrap();
+        let leaves = std::sync::Arc::new(Leaves::new(&gpu, &bz.db));
         let pass = LightMapPass::new(
             &gpu,
             &harness.uniforms,
             &harness.gbuffer,
-            &bz.db,
+            leaves,
             &bz.light_maps,
         )
         .unwrap();
@@ -81,29 +83,8 @@ fn light_map_pass_draws_the_cpu_light_maps() {
         for (i, p) in g.positions.iter().enumerate() {
             let Some(p) = p else { continue };
             let e = Vec3::from(gpu_e[i]);
-            // The leaf the point lies in, and where in it.
-            let mut found = None;
-            for (r, receiver) in bz.db.receivers.iter().enumerate() {
-                let ReceiverShape::Patch(tree) = &receiver.shape else {
-                    continue;
-                };
-                if tree.normal.dot(g.normals[i]) < 0.99 {
-                    continue;
-                }
-                for n in tree.leaves() {
-                    let [a, b, _, d] = tree.nodes[n].corners;
-                    let (u, v, w) = (b - a, d - a, *p - a);
-                    if tree.normal.dot(w).abs() > 1e-3 * scene.extent.diagonal {
-                        continue;
-                    }
-                    let (s, t) = (w.dot(u) / u.length_squared(), w.dot(v) / v.length_squared());
-                    let margin = 0.02;
-                    if (margin..=1.0 - margin).contains(&s) && (margin..=1.0 - margin).contains(&t)
-                    {
-                        found = Some((r, n, s, t));
-                    }
-                }
-            }
+            let found =
+                support::leaf_at(&bz.db, *p, g.normals[i], 1e-3 * scene.extent.diagonal, 0.02);
             let Some((r, n, s, t)) = found else {
                 // Not a patch: the torus (or a leaf's border, left out).
                 let on_torus = scene.patches.iter().all(|pa| {
@@ -115,17 +96,7 @@ fn light_map_pass_draws_the_cpu_light_maps() {
                 }
                 continue;
             };
-            let texels = bz.light_maps.texels(r, n);
-            let last = (RES - 1) as f32;
-            let x = (s * RES as f32 - 0.5).clamp(0.0, last);
-            let y = (t * RES as f32 - 0.5).clamp(0.0, last);
-            let (i0, j0) = (x.floor() as u32, y.floor() as u32);
-            let (i1, j1) = ((i0 + 1).min(RES - 1), (j0 + 1).min(RES - 1));
-            let at = |i: u32, j: u32| texels[(j * RES + i) as usize];
-            let (fx, fy) = (x - i0 as f32, y - j0 as f32);
-            let want = at(i0, j0)
-                .lerp(at(i1, j0), fx)
-                .lerp(at(i0, j1).lerp(at(i1, j1), fx), fy);
+            let want = support::bilinear(bz.light_maps.texels(r, n), RES, s, t);
             checked += 1;
             // Rgba16Float output: 3 significant digits; the pixel centre's (s, t) on the GPU comes
             // from interpolation, on the CPU from the reconstructed position.

@@ -25,7 +25,7 @@ struct LeafOut {
 };
 
 @vertex
-fn vs_leaf(@location(0) position: vec3<f32>, @location(1) leaf: u32, @location(2) st: vec2<f32>) -> LeafOut {
+fn vs_leaf(@location(0) position: vec3<f32>, @location(1) leaf: u32, @location(3) st: vec2<f32>) -> LeafOut {
     var out: LeafOut;
     out.clip = camera.view_proj * vec4<f32>(position, 1.0);
     out.leaf = leaf;

@@ -1,7 +1,9 @@
 //! A test room for the visibility database and the light maps: six patches, a table, a box
 //! mover (object 7) and a sphere mover (object 8), and light samples on its surfaces.
 
-use gibench_barczak::database::{Receiver, ReceiverShape};
+#![allow(dead_code)]
+
+use gibench_barczak::database::{Receiver, ReceiverShape, VisibilityDatabase};
 use gibench_barczak::visibility::{Blocker, PatchTree, PointLight, Shape};
 use glam::Vec3;
 
@@ -152,4 +154,51 @@ pub fn lights() -> Vec<PointLight> {
         });
     }
     out
+}
+
+/// The patch leaf of `db` that `p` (normal `n`) lies in, at least `margin` inside its edges in
+/// its (s, t), and where: (receiver, node, s, t). `tolerance`: largest distance off the plane.
+pub fn leaf_at(
+    db: &VisibilityDatabase,
+    p: Vec3,
+    n: Vec3,
+    tolerance: f32,
+    margin: f32,
+) -> Option<(usize, usize, f32, f32)> {
+    let mut found = None;
+    for (r, receiver) in db.receivers.iter().enumerate() {
+        let ReceiverShape::Patch(tree) = &receiver.shape else {
+            continue;
+        };
+        if tree.normal.dot(n) < 0.99 {
+            continue;
+        }
+        for node in tree.leaves() {
+            let [a, b, _, d] = tree.nodes[node].corners;
+            let (u, v, w) = (b - a, d - a, p - a);
+            if tree.normal.dot(w).abs() > tolerance {
+                continue;
+            }
+            let (s, t) = (w.dot(u) / u.length_squared(), w.dot(v) / v.length_squared());
+            if (margin..=1.0 - margin).contains(&s) && (margin..=1.0 - margin).contains(&t) {
+                found = Some((r, node, s, t));
+            }
+        }
+    }
+    found
+}
+
+/// A `res`² light map (row by row) at (s, t), bilinear between texel centres, clamped inside:
+/// what `lightmap.wgsl` computes.
+pub fn bilinear(texels: &[Vec3], res: u32, s: f32, t: f32) -> Vec3 {
+    let last = (res - 1) as f32;
+    let x = (s * res as f32 - 0.5).clamp(0.0, last);
+    let y = (t * res as f32 - 0.5).clamp(0.0, last);
+    let (i0, j0) = (x.floor() as u32, y.floor() as u32);
+    let (i1, j1) = ((i0 + 1).min(res - 1), (j0 + 1).min(res - 1));
+    let at = |i: u32, j: u32| texels[(j * res + i) as usize];
+    let (fx, fy) = (x - i0 as f32, y - j0 as f32);
+    at(i0, j0)
+        .lerp(at(i1, j0), fx)
+        .lerp(at(i0, j1).lerp(at(i1, j1), fx), fy)
 }

@@ -1,0 +1,69 @@
+// Barczak 2006 §4.3.2 (second pass), §4.3.4–4.3.5: the shadow-mapped subtraction. Each draw
+// covers the leaves of one optimised element and up to K of the lights partially blocked on
+// them; a fragment where the leaf is what the camera sees sums, over those lights, the
+// contribution of each light its shadow map says is occluded, and the blend subtracts the sum
+// from the light-map pass's irradiance. Needs GpuVpl / vpl_store (group 2, binding 0) and the
+// atlas lookup (group 3) declared before it.
+
+@group(0) @binding(0) var<uniform> camera: View;
+@group(1) @binding(0) var<uniform> view: View;
+@group(1) @binding(1) var gbuffer_depth: texture_2d<f32>;
+@group(1) @binding(2) var gbuffer_normal: texture_2d<f32>;
+@group(1) @binding(3) var gbuffer_albedo: texture_2d<f32>;
+
+struct DrawLights {
+    // x: lights in this draw (at most 16)
+    count: vec4<u32>,
+    // The lights' store slots, four per vector.
+    lights: array<vec4<u32>, 4>,
+};
+@group(2) @binding(1) var<uniform> draw_lights: DrawLights;
+
+struct LeafOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) world: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+};
+
+@vertex
+fn vs_leaf(@location(0) position: vec3<f32>, @location(2) normal: vec3<f32>) -> LeafOut {
+    var out: LeafOut;
+    out.clip = camera.view_proj * vec4<f32>(position, 1.0);
+    out.world = position;
+    out.normal = normal;
+    return out;
+}
+
+// A light sample's irradiance at p (normal n) without visibility: flux/pi * cos at the light,
+// times cos at the receiver, over the squared distance (lightmap.rs `contribution`).
+fn contribution(v: GpuVpl, p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    let d = v.position.xyz - p;
+    let r2 = dot(d, d);
+    if (r2 <= 0.0) {
+        return vec3<f32>(0.0);
+    }
+    let w = d * inverseSqrt(r2);
+    let receive = max(dot(n, w), 0.0);
+    let emit = max(-dot(v.normal.xyz, w), 0.0);
+    return v.flux.rgb / 3.14159265358979 * emit * receive / r2;
+}
+
+@fragment
+fn fs_leaf(in: LeafOut) -> @location(0) vec4<f32> {
+    let shown = textureLoad(gbuffer_depth, vec2<i32>(in.clip.xy), 0).r;
+    if (abs(in.clip.z - shown) > 1e-4 * shown) {
+        discard;
+    }
+    let n = normalize(in.normal);
+    var occluded = vec3<f32>(0.0);
+    let count = min(draw_lights.count.x, 16u);
+    for (var k = 0u; k < count; k++) {
+        let slot = draw_lights.lights[k / 4u][k % 4u];
+        let v = vpl_store.items[slot];
+        let c = contribution(v, in.world, n);
+        if (any(c > vec3<f32>(0.0))) {
+            occluded += c * (1.0 - vpl_visibility(v, in.world, n));
+        }
+    }
+    return vec4<f32>(occluded, 0.0);
+}
