@@ -28,12 +28,14 @@
 //! * [`setup`] — the above put together from a scene once: receivers and blockers from the
 //!   scene's patches and movers (`gibench_harness::scene::Patch`; the `barczak-*` rooms record
 //!   them), light samples, the database and the light maps.
+//! * [`prt_pass`] — §4.4 on the GPU: each mover drawn once, per vertex its transfer dotted with
+//!   the lighting environment (taken into the mover's frame).
 //! * [`samples`] — §4.1: the direct light samples on area emitters and the indirect ones from
 //!   random walks, computed once from the static geometry.
 //!
 //! The shadow maps are the shared atlas's octahedral kind (§4.2.1,
 //! `gibench_harness::ir::atlas::MapKind::Octahedral`), the low-resolution pass's mask the kit's
-//! `EdgeMask`. Still to come (issue 11): the low-resolution pass itself, PRT's draw, the
+//! `EdgeMask`. Still to come (issue 11): the low-resolution pass itself, the
 //! technique wiring them per frame with the optimisation levels (Full, VD+LP, VD, Naive), its
 //! registry and conformance entries and `gibench reproduce barczak2006`; until then `barczak`
 //! is not in the technique registry.
@@ -43,6 +45,7 @@ pub mod lightmap;
 pub mod lightmap_pass;
 pub mod passes;
 pub mod prt;
+pub mod prt_pass;
 pub mod samples;
 pub mod schedule;
 pub mod setup;

@@ -100,8 +100,15 @@ pub fn transfer(mesh: &Mesh, bvh: &SceneBvh, directions: usize, lift: f32) -> Ve
 }
 
 /// The lighting environment at `center` from the light samples `lights`, of which `visible`
-/// says which reach the centre (the thesis ray-traces this).
-pub fn lighting(center: Vec3, lights: &[Vpl], visible: impl Fn(&Vpl) -> bool) -> [Vec3; COEFFS] {
+/// says which reach the centre (the thesis ray-traces this), in the object's frame:
+/// `to_object` turns world directions into the object's (the inverse of its rotation), so that
+/// it meets transfer computed in object space.
+pub fn lighting(
+    center: Vec3,
+    to_object: glam::Mat3,
+    lights: &[Vpl],
+    visible: impl Fn(&Vpl) -> bool,
+) -> [Vec3; COEFFS] {
     let mut l = [Vec3::ZERO; COEFFS];
     for v in lights {
         let d = v.position - center;
@@ -115,7 +122,7 @@ pub fn lighting(center: Vec3, lights: &[Vpl], visible: impl Fn(&Vpl) -> bool) ->
             continue;
         }
         let intensity = v.flux / std::f32::consts::PI * cos / r2;
-        let y = basis(w);
+        let y = basis(to_object * w);
         for k in 0..COEFFS {
             l[k] += intensity * y[k];
         }
