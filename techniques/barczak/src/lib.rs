@@ -30,14 +30,16 @@
 //!   them), light samples, the database and the light maps.
 //! * [`prt_pass`] — §4.4 on the GPU: each mover drawn once, per vertex its transfer dotted with
 //!   the lighting environment (taken into the mover's frame).
+//! * [`renderer`] — the parts wired frame after frame: movers moved in the database, light maps
+//!   and shadow maps updated (by priority), the subtraction planned and drawn, movers lit by PRT.
 //! * [`samples`] — §4.1: the direct light samples on area emitters and the indirect ones from
 //!   random walks, computed once from the static geometry.
 //!
 //! The shadow maps are the shared atlas's octahedral kind (§4.2.1,
 //! `gibench_harness::ir::atlas::MapKind::Octahedral`), the low-resolution pass's mask the kit's
 //! `EdgeMask`. Still to come (issue 11): the low-resolution pass itself, the
-//! technique wiring them per frame with the optimisation levels (Full, VD+LP, VD, Naive), its
-//! registry and conformance entries and `gibench reproduce barczak2006`; until then `barczak`
+//! optimisation levels (Full, VD+LP, VD, Naive), the technique's registry and conformance
+//! entries (timed stages, counters) and `gibench reproduce barczak2006`; until then `barczak`
 //! is not in the technique registry.
 
 pub mod database;
@@ -46,6 +48,7 @@ pub mod lightmap_pass;
 pub mod passes;
 pub mod prt;
 pub mod prt_pass;
+pub mod renderer;
 pub mod samples;
 pub mod schedule;
 pub mod setup;
