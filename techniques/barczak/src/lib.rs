@@ -15,9 +15,10 @@
 //!   them; with the partial lights' subtraction it equals summing every light with visibility.
 //! * [`lightmap_pass`] — §4.3.2 on the GPU: the light maps drawn for every patch leaf the camera
 //!   sees (one draw), bilinear inside each leaf.
-//! * [`subtract_pass`] — §4.3.2's second pass drawn as §4.3.4–4.3.5 do: per optimised element,
-//!   draws of up to K lights subtracting the occluded partial lights' contributions (shared
-//!   octahedral atlas lookups); the draws are counted.
+//! * [`light_draws`] — §4.3.2's second pass drawn as §4.3.4–4.3.5 do: per optimised element,
+//!   draws of up to K lights (shared octahedral atlas lookups), subtracting the occluded partial
+//!   lights after the light maps (Full), or adding lights with lookups only where partial (VD)
+//!   or everywhere (Naive); the draws are counted.
 //! * [`passes`] — §4.3.5: the greedy render-pass optimiser of Figure 4-10 over elements (sets of
 //!   objects with the lights they share), a pass drawing up to K lights.
 //! * [`schedule`] — §4.5.3: shadow maps a motion made out of date re-rendered a fixed number
@@ -37,12 +38,12 @@
 //!
 //! The shadow maps are the shared atlas's octahedral kind (§4.2.1,
 //! `gibench_harness::ir::atlas::MapKind::Octahedral`), the low-resolution pass's mask the kit's
-//! `EdgeMask`. Still to come (issue 11): the low-resolution pass itself, the
-//! optimisation levels (Full, VD+LP, VD, Naive), the technique's registry and conformance
-//! entries (timed stages, counters) and `gibench reproduce barczak2006`; until then `barczak`
-//! is not in the technique registry.
+//! `EdgeMask`. Still to come (issue 11): the low-resolution pass itself (VD+LP, and Full's),
+//! the technique's registry and conformance entries (timed stages, counters) and
+//! `gibench reproduce barczak2006`; until then `barczak` is not in the technique registry.
 
 pub mod database;
+pub mod light_draws;
 pub mod lightmap;
 pub mod lightmap_pass;
 pub mod passes;
@@ -52,5 +53,4 @@ pub mod renderer;
 pub mod samples;
 pub mod schedule;
 pub mod setup;
-pub mod subtract_pass;
 pub mod visibility;

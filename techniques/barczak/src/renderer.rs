@@ -1,15 +1,16 @@
-//! The parts wired for one frame after another (Barczak 2006 §4.3–4.5), without the
-//! low-resolution pass and the optimisation levels yet.
+//! The parts wired for one frame after another (Barczak 2006 §4.3–4.5), at the optimisation
+//! levels Full, VD and Naive (the low-resolution pass, for VD+LP and Full's own, is to come).
 //!
 //! Reads: the scene (patches, movers), the harness's G-buffer, uniforms and static BVH, each
 //! frame's mover poses.
-//! Writes: `output` (Rgba16Float indirect irradiance of the light samples): light maps, minus
-//! the occluded partial lights, on patches; PRT on movers.
+//! Writes: `output` (Rgba16Float irradiance of the light samples): on patches, per [`Level`],
+//! light maps minus the occluded partial lights, or the lights drawn with or without lookups;
+//! PRT on movers.
 //!
 //! Per frame: every mover that moved is moved in the visibility database (Table 4-1), the light
 //! maps gain or lose single lights, and the shadow maps the motion touched go out of date; the
-//! schedule re-renders `updates` of them by priority (all on the first frame); the subtraction is
-//! planned (optimised when `optimise`) and drawn; each mover's lighting environment is gathered
+//! schedule re-renders `updates` of them by priority (all on the first frame); the light draws
+//! are planned (optimised when `optimise`) and drawn; each mover's lighting environment is gathered
 //! from the samples its centre sees (ray casts against the static BVH) and drawn by PRT.
 
 use std::sync::Arc;
@@ -26,13 +27,13 @@ use gibench_harness::vpl::Vpl;
 use gibench_harness::{wgpu, Result};
 use glam::{Mat3, Mat4};
 
+use crate::light_draws::{Level, LightDraws};
 use crate::lightmap_pass::{Leaves, LightMapPass};
 use crate::prt::{self, COEFFS};
 use crate::prt_pass::PrtPass;
 use crate::samples::SampleSettings;
 use crate::schedule::ShadowMapSchedule;
 use crate::setup::{prepare, BarczakScene};
-use crate::subtract_pass::SubtractionPass;
 
 /// The renderer's settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -42,8 +43,11 @@ pub struct RendererSettings {
     pub light_map_res: u32,
     /// Lights per subtraction draw (K).
     pub lights_per_draw: u32,
-    /// Merge elements by Figure 4-10's optimiser.
+    /// Merge elements by Figure 4-10's optimiser (at [`Level::Full`] only: the thesis' other
+    /// levels draw each leaf on its own).
     pub optimise: bool,
+    /// What the light draws do (light maps only with [`Level::Full`]).
+    pub level: Level,
     /// Octahedral map edge, texels.
     pub map_size: u32,
     /// Shadow maps re-rendered per frame at most (after the first).
@@ -56,7 +60,8 @@ pub struct RendererSettings {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct FrameCounts {
     pub maps_rendered: u32,
-    pub subtraction_draws: u32,
+    /// Draws of lights over leaves (the thesis' passes).
+    pub light_draws: u32,
     pub elements: u32,
     pub light_map_changes: u32,
 }
@@ -68,7 +73,7 @@ pub struct Renderer {
     atlas: ShadowAtlas,
     raster: AtlasRasteriser,
     light_map: LightMapPass,
-    subtract: SubtractionPass,
+    draws: LightDraws,
     prt: PrtPass,
     schedule: ShadowMapSchedule,
     poses: Vec<Mat4>,
@@ -122,7 +127,7 @@ impl Renderer {
         let raster = AtlasRasteriser::new(gpu, &atlas, uniforms, DrawSet::CastersAndMovers)?;
         let leaves = Arc::new(Leaves::new(gpu, &bz.db));
         let light_map = LightMapPass::new(gpu, uniforms, gbuffer, leaves.clone(), &bz.light_maps)?;
-        let subtract = SubtractionPass::new(
+        let draws = LightDraws::new(
             gpu,
             uniforms,
             gbuffer,
@@ -172,7 +177,7 @@ impl Renderer {
             atlas,
             raster,
             light_map,
-            subtract,
+            draws,
             prt,
             schedule,
             settings,
@@ -244,12 +249,15 @@ impl Renderer {
                 AtlasClear::RenderedSlots,
             );
         }
-        counts.subtraction_draws = self
-            .subtract
-            .plan(gpu, &self.bz.db, self.settings.optimise)?;
-        counts.elements = self.subtract.elements() as u32;
-        self.light_map.encode(encoder, uniforms, &self.output_view);
-        self.subtract
+        let optimise = self.settings.optimise && self.settings.level == Level::Full;
+        counts.light_draws = self
+            .draws
+            .plan(gpu, &self.bz.db, self.settings.level, optimise)?;
+        counts.elements = self.draws.elements() as u32;
+        if self.settings.level == Level::Full {
+            self.light_map.encode(encoder, uniforms, &self.output_view);
+        }
+        self.draws
             .encode(encoder, uniforms, &self.atlas, &self.output_view);
         let samples: Vec<Vpl> = self.lights.iter().map(|(_, v)| *v).collect();
         for (k, bounds) in self.bz.movers.iter().enumerate() {

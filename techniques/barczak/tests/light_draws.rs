@@ -2,15 +2,16 @@
 //! light maps minus the occluded partial lights equal the kit's brute-force gather of every
 //! light with the same shadow maps (Barczak's "Naive") on the patches' pixels, once the light
 //! maps' interpolation error (computed on the CPU) is accounted for; merging elements by the
-//! optimiser changes the image by rounding only and never adds draws.
+//! optimiser changes the image by rounding only and never adds draws; the Naive level equals
+//! the gather, and VD equals Naive but where a shadow map contradicts the classification.
 
 use std::sync::Arc;
 
+use gibench_barczak::light_draws::{Level, LightDraws};
 use gibench_barczak::lightmap::contribution;
 use gibench_barczak::lightmap_pass::{Leaves, LightMapPass};
 use gibench_barczak::samples::SampleSettings;
 use gibench_barczak::setup::prepare;
-use gibench_barczak::subtract_pass::SubtractionPass;
 use gibench_barczak::visibility::LightState;
 use gibench_harness::assets::AssetPaths;
 use gibench_harness::glam::Vec3;
@@ -110,7 +111,7 @@ fn light_maps_minus_occluded_partials_equal_the_brute_force_gather() {
             &bz.light_maps,
         )
         .unwrap();
-        let mut subtract = SubtractionPass::new(
+        let mut subtract = LightDraws::new(
             &gpu,
             &harness.uniforms,
             &harness.gbuffer,
@@ -121,11 +122,18 @@ fn light_maps_minus_occluded_partials_equal_the_brute_force_gather() {
             &atlas,
         )
         .unwrap();
-        // Barczak with and without the pass optimiser.
+        // Barczak Full with and without the pass optimiser, then VD and Naive (which, as the
+        // thesis' levels, draw each leaf on its own).
         let mut images = Vec::new();
         let mut draws = Vec::new();
-        for optimise in [true, false] {
-            draws.push(subtract.plan(&gpu, &bz.db, optimise).unwrap());
+        let runs = [
+            (Level::Full, true),
+            (Level::Full, false),
+            (Level::VisibilityDetermination, false),
+            (Level::Naive, false),
+        ];
+        for (level, optimise) in runs {
+            draws.push(subtract.plan(&gpu, &bz.db, level, optimise).unwrap());
             let t = target(&gpu);
             let view = t.create_view(&Default::default());
             let mut enc = gpu.device.create_command_encoder(&Default::default());
@@ -141,7 +149,9 @@ fn light_maps_minus_occluded_partials_equal_the_brute_force_gather() {
                 &lights,
                 AtlasClear::Whole,
             );
-            maps.encode(&mut enc, &harness.uniforms, &view);
+            if level == Level::Full {
+                maps.encode(&mut enc, &harness.uniforms, &view);
+            }
             subtract.encode(&mut enc, &harness.uniforms, &atlas, &view);
             gpu.queue.submit([enc.finish()]);
             images.push(gibench_harness::image_io::read_rgb_f32(&gpu, &t).unwrap());
@@ -229,6 +239,28 @@ fn light_maps_minus_occluded_partials_equal_the_brute_force_gather() {
         assert!(
             agree * 100 >= compared * 97,
             "{backend}: {agree} of {compared} pixels agree with the brute-force gather"
+        );
+        // Naive is the kit's gather drawn as Barczak draws it: the same lights and lookups.
+        // VD differs from Naive only where a shadow map disagrees with the geometric
+        // classification (an unblocked light taken as visible, a blocked one skipped).
+        let (vd, naive_draws) = (&images[2], &images[3]);
+        let (mut patch, mut same_naive, mut same_vd) = (0, 0, 0);
+        for ((a, b), c) in naive_draws.iter().zip(&naive).zip(vd) {
+            if b.iter().all(|x| *x == 0.0) || a.iter().all(|x| *x == 0.0) {
+                continue;
+            }
+            patch += 1;
+            same_naive += close(*a, *b, 0.01) as usize;
+            same_vd += close(*c, *a, 0.03) as usize;
+        }
+        eprintln!("{backend}: draws Full {} (unmerged {}), VD {}, Naive {}; Naive = gather on {same_naive} of {patch}, VD = Naive on {same_vd}", draws[0], draws[1], draws[2], draws[3]);
+        assert!(
+            same_naive * 1000 >= patch * 995,
+            "{backend}: Naive matches the gather on {same_naive} of {patch} pixels"
+        );
+        assert!(
+            same_vd * 100 >= patch * 98,
+            "{backend}: VD matches Naive on {same_vd} of {patch} pixels"
         );
     }
 }

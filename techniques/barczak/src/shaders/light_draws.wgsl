@@ -1,9 +1,9 @@
-// Barczak 2006 §4.3.2 (second pass), §4.3.4–4.3.5: the shadow-mapped subtraction. Each draw
-// covers the leaves of one optimised element and up to K of the lights partially blocked on
-// them; a fragment where the leaf is what the camera sees sums, over those lights, the
-// contribution of each light its shadow map says is occluded, and the blend subtracts the sum
-// from the light-map pass's irradiance. Needs GpuVpl / vpl_store (group 2, binding 0) and the
-// atlas lookup (group 3) declared before it.
+// Barczak 2006 §4.3.2–4.3.5: lights drawn over patch leaves, up to K per draw. Each draw covers
+// the leaves of one element and up to K lights. `fs_subtract` (after the light-map pass, blended
+// with ReverseSubtract) sums the contributions of the lights its shadow maps find occluded;
+// `fs_add` (blended with Add) sums every light's contribution, times its shadow-map visibility
+// where the light's entry asks for a lookup (high bit set). Needs GpuVpl / vpl_store (group 2,
+// binding 0) and the atlas lookup (group 3) declared before it.
 
 @group(0) @binding(0) var<uniform> camera: View;
 @group(1) @binding(0) var<uniform> view: View;
@@ -14,7 +14,7 @@
 struct DrawLights {
     // x: lights in this draw (at most 16)
     count: vec4<u32>,
-    // The lights' store slots, four per vector.
+    // The lights' store slots, four per vector; the high bit asks for a shadow-map lookup.
     lights: array<vec4<u32>, 4>,
 };
 @group(2) @binding(1) var<uniform> draw_lights: DrawLights;
@@ -48,17 +48,25 @@ fn contribution(v: GpuVpl, p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     return v.flux.rgb / 3.14159265358979 * emit * receive / r2;
 }
 
+const LOOKUP: u32 = 0x80000000u;
+
+// Whether this leaf fragment is what the camera sees (leaves are not the G-buffer's triangles,
+// so depths agree to rounding only).
+fn shown(in: LeafOut) -> bool {
+    let depth = textureLoad(gbuffer_depth, vec2<i32>(in.clip.xy), 0).r;
+    return abs(in.clip.z - depth) <= 1e-4 * depth;
+}
+
 @fragment
-fn fs_leaf(in: LeafOut) -> @location(0) vec4<f32> {
-    let shown = textureLoad(gbuffer_depth, vec2<i32>(in.clip.xy), 0).r;
-    if (abs(in.clip.z - shown) > 1e-4 * shown) {
+fn fs_subtract(in: LeafOut) -> @location(0) vec4<f32> {
+    if (!shown(in)) {
         discard;
     }
     let n = normalize(in.normal);
     var occluded = vec3<f32>(0.0);
     let count = min(draw_lights.count.x, 16u);
     for (var k = 0u; k < count; k++) {
-        let slot = draw_lights.lights[k / 4u][k % 4u];
+        let slot = draw_lights.lights[k / 4u][k % 4u] & ~LOOKUP;
         let v = vpl_store.items[slot];
         let c = contribution(v, in.world, n);
         if (any(c > vec3<f32>(0.0))) {
@@ -66,4 +74,27 @@ fn fs_leaf(in: LeafOut) -> @location(0) vec4<f32> {
         }
     }
     return vec4<f32>(occluded, 0.0);
+}
+
+@fragment
+fn fs_add(in: LeafOut) -> @location(0) vec4<f32> {
+    if (!shown(in)) {
+        discard;
+    }
+    let n = normalize(in.normal);
+    var sum = vec3<f32>(0.0);
+    let count = min(draw_lights.count.x, 16u);
+    for (var k = 0u; k < count; k++) {
+        let entry = draw_lights.lights[k / 4u][k % 4u];
+        let v = vpl_store.items[entry & ~LOOKUP];
+        let c = contribution(v, in.world, n);
+        if (any(c > vec3<f32>(0.0))) {
+            if ((entry & LOOKUP) != 0u) {
+                sum += c * vpl_visibility(v, in.world, n);
+            } else {
+                sum += c;
+            }
+        }
+    }
+    return vec4<f32>(sum, 0.0);
 }

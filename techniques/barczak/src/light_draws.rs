@@ -1,0 +1,383 @@
+//! Lights drawn over the patch leaves, up to K per draw (Barczak 2006 §4.3.2–4.3.5), for each
+//! optimisation level ([`Level`]).
+//!
+//! Reads: the visibility database (each leaf's light states), the light samples in a
+//! [`VplStore`] (slot = light index) and their maps in a [`ShadowAtlas`], the leaves' geometry
+//! ([`Leaves`]), the camera and the G-buffer's depth.
+//! Writes: `target`, at every pixel of a leaf:
+//! * [`Level::Full`] — subtracts the contributions of the leaf's *partial* lights that the shadow
+//!   maps find occluded, after [`super::lightmap_pass`] drew the light maps there (together:
+//!   every light with its visibility);
+//! * [`Level::VisibilityDetermination`] — no light maps: adds the leaf's unblocked lights without
+//!   a lookup and its partial lights with one; blocked lights and lights behind are skipped;
+//! * [`Level::Naive`] — adds every light with a lookup on every leaf (brute force).
+//!
+//! Draws: elements, each a set of leaves with the lights they share (one per leaf, merged by
+//! Figure 4-10's optimiser when `optimise` is on; lights needing lookups and lights not needing
+//! them are separate elements); each element is drawn ⌈lights / K⌉ times, a draw handling up to
+//! K lights (the thesis' X800 had room for 7 per pass; K ≤ 16 here). The per-draw light list is
+//! a uniform at a dynamic offset, as the kit's rasteriser passes its views (portable to GL).
+//! Buffers are sized once for the worst case (Naive without merging), so no frame allocates.
+
+use std::ops::Range;
+use std::sync::Arc;
+
+use bytemuck::{Pod, Zeroable};
+use gibench_harness::gpu::GpuContext;
+use gibench_harness::ir::atlas::ShadowAtlas;
+use gibench_harness::ir::store::VplStore;
+use gibench_harness::passes::{shader_module, FrameUniforms, GBuffer, CAMERA_SLOT, HDR_FORMAT};
+use gibench_harness::{wgpu, Error, Result};
+
+use crate::database::VisibilityDatabase;
+use crate::lightmap_pass::Leaves;
+use crate::passes::{one_per_object, optimise, Element, LightSet};
+use crate::visibility::LightState;
+
+/// Lights one draw handles at most.
+pub const MAX_LIGHTS_PER_DRAW: u32 = 16;
+/// The record entry bit that asks for a shadow-map lookup.
+const LOOKUP: u32 = 0x8000_0000;
+
+/// Barczak's optimisation levels (Figure 5-3) as far as the light draws are concerned (the
+/// low-resolution pass comes on top of Full and VD).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Level {
+    /// Light maps minus the occluded partial lights.
+    Full,
+    /// Unblocked lights without lookups, partial lights with them, no light maps.
+    VisibilityDetermination,
+    /// Every light with a lookup.
+    Naive,
+}
+const RECORD_STRIDE: u64 = 256;
+
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct DrawLights {
+    count: [u32; 4],
+    lights: [u32; 16],
+}
+
+/// See the module docs.
+pub struct LightDraws {
+    k: u32,
+    leaves: Arc<Leaves>,
+    indices: wgpu::Buffer,
+    records: wgpu::Buffer,
+    /// Draws the buffers hold at most.
+    max_draws: u32,
+    store_group: wgpu::BindGroup,
+    gbuffer_group: wgpu::BindGroup,
+    subtract: wgpu::RenderPipeline,
+    add: wgpu::RenderPipeline,
+    /// The last plan's level.
+    level: Level,
+    /// This frame's draws: index range and record.
+    draws: Vec<(Range<u32>, u32)>,
+    /// Elements of the last plan (for the results: passes made).
+    elements: usize,
+}
+
+impl LightDraws {
+    /// The pass over `leaves` for `lights` lights in `store` and `atlas`, `k` lights per draw.
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        gpu: &GpuContext,
+        uniforms: &FrameUniforms,
+        gbuffer: &GBuffer,
+        leaves: Arc<Leaves>,
+        lights: u32,
+        k: u32,
+        store: &VplStore,
+        atlas: &ShadowAtlas,
+    ) -> Result<LightDraws> {
+        if !(1..=MAX_LIGHTS_PER_DRAW).contains(&k) {
+            return Err(Error::param(
+                "lights-per-draw",
+                format!("expected 1..={MAX_LIGHTS_PER_DRAW} (got {k})"),
+            ));
+        }
+        let device = &gpu.device;
+        let tiles = leaves.tiles.len() as u64;
+        // The most any level plans without merging: every leaf, every light, split in two groups
+        // (VD: one more partial draw per leaf at most).
+        let max_draws = (tiles * (lights.div_ceil(k) as u64 + 1)).max(1);
+        let max_indices = (6 * tiles * lights as u64).max(1);
+        let indices = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("barczak element indices"),
+            size: max_indices * 4,
+            usage: wgpu::BufferUsages::INDEX | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let records = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("barczak draw lights"),
+            size: max_draws * RECORD_STRIDE,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let frag = wgpu::ShaderStages::FRAGMENT;
+        let store_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("barczak lights"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: frag,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Storage { read_only: true },
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: frag,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: true,
+                        min_binding_size: wgpu::BufferSize::new(
+                            std::mem::size_of::<DrawLights>() as u64
+                        ),
+                    },
+                    count: None,
+                },
+            ],
+        });
+        let store_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("barczak lights"),
+            layout: &store_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: store.buffer().as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: &records,
+                        offset: 0,
+                        size: wgpu::BufferSize::new(std::mem::size_of::<DrawLights>() as u64),
+                    }),
+                },
+            ],
+        });
+        let source = format!(
+            "{}\n{}\n{}",
+            VplStore::wgsl(2, 0, false),
+            ShadowAtlas::wgsl(3),
+            include_str!("shaders/light_draws.wgsl")
+        );
+        let module = shader_module(device, "barczak light draws", &source);
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("barczak light draws"),
+            bind_group_layouts: &[
+                Some(&uniforms.view_layout),
+                Some(&gbuffer.read_layout),
+                Some(&store_layout),
+                Some(atlas.layout()),
+            ],
+            immediate_size: 0,
+        });
+        let keep = wgpu::BlendComponent {
+            src_factor: wgpu::BlendFactor::Zero,
+            dst_factor: wgpu::BlendFactor::One,
+            operation: wgpu::BlendOperation::Add,
+        };
+        let pipeline = |entry: &str, operation| {
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some("barczak light draws"),
+                layout: Some(&layout),
+                vertex: wgpu::VertexState {
+                    module: &module,
+                    entry_point: Some("vs_leaf"),
+                    compilation_options: Default::default(),
+                    buffers: &[Some(Leaves::layout())],
+                },
+                primitive: wgpu::PrimitiveState::default(),
+                depth_stencil: None,
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &module,
+                    entry_point: Some(entry),
+                    compilation_options: Default::default(),
+                    targets: &[Some(wgpu::ColorTargetState {
+                        format: HDR_FORMAT,
+                        blend: Some(wgpu::BlendState {
+                            color: wgpu::BlendComponent {
+                                src_factor: wgpu::BlendFactor::One,
+                                dst_factor: wgpu::BlendFactor::One,
+                                operation,
+                            },
+                            alpha: keep,
+                        }),
+                        write_mask: wgpu::ColorWrites::ALL,
+                    })],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        let subtract = pipeline("fs_subtract", wgpu::BlendOperation::ReverseSubtract);
+        let add = pipeline("fs_add", wgpu::BlendOperation::Add);
+        gpu.check_errors()?;
+        Ok(LightDraws {
+            k,
+            leaves,
+            indices,
+            records,
+            max_draws: max_draws as u32,
+            store_group,
+            gbuffer_group: gbuffer.read_group.clone(),
+            subtract,
+            add,
+            level: Level::Full,
+            draws: Vec::new(),
+            elements: 0,
+        })
+    }
+
+    /// Plans this frame's draws for `level` from `db` (merging elements when `optimise`) and
+    /// uploads them. Returns the draws planned.
+    pub fn plan(
+        &mut self,
+        gpu: &GpuContext,
+        db: &VisibilityDatabase,
+        level: Level,
+        optimise_passes: bool,
+    ) -> Result<u32> {
+        let lights = db.lights.len() as u32;
+        let per_leaf = |want: &dyn Fn(LightState) -> bool| -> Vec<LightSet> {
+            self.leaves
+                .tiles
+                .iter()
+                .map(|&(r, n)| {
+                    LightSet::from_indices(
+                        (0..lights).filter(|&l| want(db.state(r, n, l as usize))),
+                    )
+                })
+                .collect()
+        };
+        // (elements, whether their lights need lookups)
+        let groups: Vec<(Vec<Element>, bool)> = match level {
+            Level::Full => vec![(
+                one_per_object(&per_leaf(&|s| s == LightState::Partial)),
+                true,
+            )],
+            Level::VisibilityDetermination => vec![
+                (
+                    one_per_object(&per_leaf(&|s| s == LightState::Unblocked)),
+                    false,
+                ),
+                (
+                    one_per_object(&per_leaf(&|s| s == LightState::Partial)),
+                    true,
+                ),
+            ],
+            Level::Naive => vec![(one_per_object(&per_leaf(&|_| true)), true)],
+        };
+        let mut indices: Vec<u32> = Vec::new();
+        let mut records: Vec<u8> = Vec::new();
+        self.draws.clear();
+        self.elements = 0;
+        for (elements, lookup) in groups {
+            let elements = if optimise_passes {
+                optimise(elements, self.k as usize)
+            } else {
+                elements
+            };
+            self.elements += elements.len();
+            for e in &elements {
+                let start = indices.len() as u32;
+                for &tile in &e.objects {
+                    indices.extend(6 * tile..6 * tile + 6);
+                }
+                let range = start..indices.len() as u32;
+                let flag = if lookup { LOOKUP } else { 0 };
+                let lights: Vec<u32> = e.lights.iter().map(|l| l | flag).collect();
+                for chunk in lights.chunks(self.k as usize) {
+                    let mut rec = DrawLights {
+                        count: [chunk.len() as u32, 0, 0, 0],
+                        lights: [0; 16],
+                    };
+                    rec.lights[..chunk.len()].copy_from_slice(chunk);
+                    let record = self.draws.len() as u32;
+                    if record >= self.max_draws || indices.len() as u64 * 4 > self.indices.size() {
+                        return Err(Error::Invalid(format!(
+                            "barczak's light draws need more than the {} draws they were sized for",
+                            self.max_draws
+                        )));
+                    }
+                    let mut bytes = [0u8; RECORD_STRIDE as usize];
+                    bytes[..std::mem::size_of::<DrawLights>()]
+                        .copy_from_slice(bytemuck::bytes_of(&rec));
+                    records.extend_from_slice(&bytes);
+                    self.draws.push((range.clone(), record));
+                }
+            }
+        }
+        if !indices.is_empty() {
+            gpu.queue
+                .write_buffer(&self.indices, 0, bytemuck::cast_slice(&indices));
+            gpu.queue.write_buffer(&self.records, 0, &records);
+        }
+        self.level = level;
+        Ok(self.draws.len() as u32)
+    }
+
+    /// Elements of the last plan.
+    pub fn elements(&self) -> usize {
+        self.elements
+    }
+
+    /// Records the planned draws into `target`: kept for [`Level::Full`] (the light-map pass drew
+    /// it), cleared first otherwise. Returns the draws made.
+    pub fn encode(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        uniforms: &FrameUniforms,
+        atlas: &ShadowAtlas,
+        target: &wgpu::TextureView,
+    ) -> u32 {
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("barczak light draws"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: target,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: if self.level == Level::Full {
+                        wgpu::LoadOp::Load
+                    } else {
+                        wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT)
+                    },
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: None,
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(if self.level == Level::Full {
+            &self.subtract
+        } else {
+            &self.add
+        });
+        pass.set_bind_group(
+            0,
+            uniforms.views.group(),
+            &[uniforms.views.offset(CAMERA_SLOT)],
+        );
+        pass.set_bind_group(1, &self.gbuffer_group, &[]);
+        pass.set_bind_group(3, atlas.group(), &[]);
+        pass.set_vertex_buffer(0, self.leaves.buffer().slice(..));
+        pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
+        for (range, record) in &self.draws {
+            let offset = (*record as u64 * RECORD_STRIDE) as u32;
+            pass.set_bind_group(2, &self.store_group, &[offset]);
+            pass.draw_indexed(range.clone(), 0, 0..1);
+        }
+        self.draws.len() as u32
+    }
+}
