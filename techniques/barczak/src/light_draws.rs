@@ -30,7 +30,7 @@ use gibench_harness::passes::{shader_module, FrameUniforms, GBuffer, CAMERA_SLOT
 use gibench_harness::{wgpu, Error, Result};
 
 use crate::database::VisibilityDatabase;
-use crate::lightmap_pass::Leaves;
+use crate::lightmap_pass::{color_pass, Leaves};
 use crate::passes::{one_per_object, optimise, Element, LightSet};
 use crate::visibility::LightState;
 
@@ -339,26 +339,12 @@ impl LightDraws {
         atlas: &ShadowAtlas,
         target: &wgpu::TextureView,
     ) -> u32 {
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("barczak light draws"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: target,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: if self.level == Level::Full {
-                        wgpu::LoadOp::Load
-                    } else {
-                        wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT)
-                    },
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: None,
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let mut pass = color_pass(
+            encoder,
+            "barczak light draws",
+            target,
+            self.level != Level::Full,
+        );
         pass.set_pipeline(if self.level == Level::Full {
             &self.subtract
         } else {

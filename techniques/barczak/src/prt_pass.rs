@@ -145,22 +145,7 @@ impl PrtPass {
         uniforms: &FrameUniforms,
         target: &wgpu::TextureView,
     ) -> u32 {
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("barczak prt"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: target,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Load,
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: None,
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        let mut pass = crate::lightmap_pass::color_pass(encoder, "barczak prt", target, false);
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(
             0,

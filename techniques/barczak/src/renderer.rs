@@ -21,7 +21,9 @@ use gibench_harness::gpu::GpuContext;
 use gibench_harness::ir::atlas::{AtlasFormat, AtlasSettings, MapKind, ShadowAtlas};
 use gibench_harness::ir::raster::{AtlasClear, AtlasRasteriser};
 use gibench_harness::ir::store::VplStore;
-use gibench_harness::passes::{DrawSet, FrameUniforms, GBuffer, GpuScene, HDR_FORMAT};
+use gibench_harness::passes::{
+    render_target, DrawSet, FrameUniforms, GBuffer, GpuScene, HDR_FORMAT,
+};
 use gibench_harness::scene::Scene;
 use gibench_harness::vpl::Vpl;
 use gibench_harness::{wgpu, Result};
@@ -152,23 +154,7 @@ impl Renderer {
             .collect();
         let prt = PrtPass::new(gpu, uniforms, gbuffer, &transfers)?;
         let schedule = ShadowMapSchedule::new(bz.flux.iter().copied());
-        let [w, h] = gbuffer.size;
-        let output = gpu.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("barczak irradiance"),
-            size: wgpu::Extent3d {
-                width: w,
-                height: h,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: HDR_FORMAT,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-                | wgpu::TextureUsages::TEXTURE_BINDING
-                | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
+        let output = render_target(&gpu.device, "barczak irradiance", gbuffer.size, HDR_FORMAT);
         let output_view = output.create_view(&Default::default());
         Ok(Renderer {
             poses: frame.movers.clone(),

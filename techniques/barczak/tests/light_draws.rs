@@ -15,61 +15,24 @@ use gibench_barczak::setup::prepare;
 use gibench_barczak::visibility::LightState;
 use gibench_harness::assets::AssetPaths;
 use gibench_harness::glam::Vec3;
-use gibench_harness::gpu::{GpuContext, GpuOptions};
 use gibench_harness::ir::accumulate::{Accumulation, IrradianceClamp};
 use gibench_harness::ir::atlas::{AtlasFormat, AtlasSettings, MapKind, ShadowAtlas};
 use gibench_harness::ir::interleave::{FilterSettings, Interleave};
 use gibench_harness::ir::raster::{AtlasClear, AtlasRasteriser};
 use gibench_harness::ir::store::VplStore;
-use gibench_harness::passes::{DrawSet, HDR_FORMAT};
-use gibench_harness::runner::{Harness, RunConfig, TimingMode};
+use gibench_harness::passes::{render_target, DrawSet, HDR_FORMAT};
 use gibench_harness::scene::Scene;
 use gibench_harness::vpl::Vpl;
-use gibench_harness::wgpu;
 
 mod support;
 
 const W: u32 = 96;
 const H: u32 = 72;
 
-fn target(gpu: &GpuContext) -> wgpu::Texture {
-    gpu.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("test irradiance"),
-        size: wgpu::Extent3d {
-            width: W,
-            height: H,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: HDR_FORMAT,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-            | wgpu::TextureUsages::COPY_SRC
-            | wgpu::TextureUsages::TEXTURE_BINDING,
-        view_formats: &[],
-    })
-}
-
 #[test]
 fn light_maps_minus_occluded_partials_equal_the_brute_force_gather() {
     let scene = Scene::load_named("barczak-pillars", &AssetPaths::standard(None)).unwrap();
-    for backend in gibench_harness::gpu::available_backends() {
-        let gpu = GpuContext::new(&GpuOptions {
-            backend: Some(backend.into()),
-            adapter: None,
-        })
-        .unwrap();
-        let config = RunConfig {
-            resolution: [W, H],
-            frames: 1,
-            warmup: 0,
-            first_frame: 0,
-            timing: TimingMode::Stages,
-            seed: 1,
-            shadow_size: 64,
-        };
-        let harness = Harness::new(&gpu, &scene, &config).unwrap();
+    support::each_backend(&scene, [W, H], |backend, gpu, harness| {
         let frame = harness.clock.frame(0);
         harness.uniforms.write(&gpu.queue, &frame);
         let settings = SampleSettings {
@@ -85,10 +48,10 @@ fn light_maps_minus_occluded_partials_equal_the_brute_force_gather() {
             .map(|(i, v)| (i as u32, *v))
             .collect();
         let n = lights.len() as u32;
-        let store = VplStore::new(&gpu, n).unwrap();
+        let store = VplStore::new(gpu, n).unwrap();
         store.write(&gpu.queue, &lights);
         let atlas = ShadowAtlas::new(
-            &gpu,
+            gpu,
             &scene.extent,
             AtlasSettings {
                 kind: MapKind::Octahedral,
@@ -100,11 +63,11 @@ fn light_maps_minus_occluded_partials_equal_the_brute_force_gather() {
         )
         .unwrap();
         let raster =
-            AtlasRasteriser::new(&gpu, &atlas, &harness.uniforms, DrawSet::CastersAndMovers)
+            AtlasRasteriser::new(gpu, &atlas, &harness.uniforms, DrawSet::CastersAndMovers)
                 .unwrap();
-        let leaves = Arc::new(Leaves::new(&gpu, &bz.db));
+        let leaves = Arc::new(Leaves::new(gpu, &bz.db));
         let maps = LightMapPass::new(
-            &gpu,
+            gpu,
             &harness.uniforms,
             &harness.gbuffer,
             leaves.clone(),
@@ -112,7 +75,7 @@ fn light_maps_minus_occluded_partials_equal_the_brute_force_gather() {
         )
         .unwrap();
         let mut subtract = LightDraws::new(
-            &gpu,
+            gpu,
             &harness.uniforms,
             &harness.gbuffer,
             leaves,
@@ -133,15 +96,15 @@ fn light_maps_minus_occluded_partials_equal_the_brute_force_gather() {
             (Level::Naive, false),
         ];
         for (level, optimise) in runs {
-            draws.push(subtract.plan(&gpu, &bz.db, level, optimise).unwrap());
-            let t = target(&gpu);
+            draws.push(subtract.plan(gpu, &bz.db, level, optimise).unwrap());
+            let t = render_target(&gpu.device, "test irradiance", [W, H], HDR_FORMAT);
             let view = t.create_view(&Default::default());
             let mut enc = gpu.device.create_command_encoder(&Default::default());
             harness
                 .gbuffer
                 .encode(&mut enc, &harness.gpu_scene, &harness.uniforms);
             raster.render(
-                &gpu,
+                gpu,
                 &mut enc,
                 &atlas,
                 &harness.gpu_scene,
@@ -154,12 +117,12 @@ fn light_maps_minus_occluded_partials_equal_the_brute_force_gather() {
             }
             subtract.encode(&mut enc, &harness.uniforms, &atlas, &view);
             gpu.queue.submit([enc.finish()]);
-            images.push(gibench_harness::image_io::read_rgb_f32(&gpu, &t).unwrap());
+            images.push(gibench_harness::image_io::read_rgb_f32(gpu, &t).unwrap());
         }
         // The kit's gather of every light with the same maps (1x1 tiles, no filtering, no clamp).
         let output = gibench_harness::passes::indirect_target(&gpu.device, [W, H], true);
         let interleave = Interleave::new(
-            &gpu,
+            gpu,
             &harness.gbuffer,
             (1, 1),
             FilterSettings {
@@ -170,14 +133,14 @@ fn light_maps_minus_occluded_partials_equal_the_brute_force_gather() {
         )
         .unwrap();
         let accumulation =
-            Accumulation::new(&gpu, &interleave, &store, &atlas, IrradianceClamp::OFF).unwrap();
+            Accumulation::new(gpu, &interleave, &store, &atlas, IrradianceClamp::OFF).unwrap();
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         interleave.encode_split(&mut enc);
         accumulation.encode(&mut enc, &interleave, &atlas);
         interleave.encode_combine(&mut enc);
         interleave.encode_filter(&mut enc);
         gpu.queue.submit([enc.finish()]);
-        let naive = gibench_harness::image_io::read_rgb_f32(&gpu, &output).unwrap();
+        let naive = gibench_harness::image_io::read_rgb_f32(gpu, &output).unwrap();
 
         let (opt, plain) = (&images[0], &images[1]);
         assert!(
@@ -207,7 +170,7 @@ fn light_maps_minus_occluded_partials_equal_the_brute_force_gather() {
         // visibility. They differ by the light maps' interpolation (bilinear between texel
         // centres, against the exact sum of the leaf's lit lights at the pixel) and wherever a
         // shadow map disagrees with the geometric classification; the first is computed here.
-        let g = harness.gbuffer.export(&gpu).unwrap();
+        let g = harness.gbuffer.export(gpu).unwrap();
         let (mut compared, mut agree) = (0, 0);
         for (i, p) in g.positions.iter().enumerate() {
             let Some(p) = p else { continue };
@@ -262,5 +225,5 @@ fn light_maps_minus_occluded_partials_equal_the_brute_force_gather() {
             same_vd * 100 >= patch * 98,
             "{backend}: VD matches Naive on {same_vd} of {patch} pixels"
         );
-    }
+    });
 }

@@ -7,10 +7,8 @@ use gibench_barczak::samples::SampleSettings;
 use gibench_barczak::setup::prepare;
 use gibench_harness::assets::AssetPaths;
 use gibench_harness::glam::Vec3;
-use gibench_harness::gpu::{GpuContext, GpuOptions};
-use gibench_harness::runner::{Harness, RunConfig, TimingMode};
+use gibench_harness::passes::{render_target, HDR_FORMAT};
 use gibench_harness::scene::Scene;
-use gibench_harness::wgpu;
 
 mod support;
 
@@ -21,22 +19,7 @@ const RES: u32 = 4;
 #[test]
 fn light_map_pass_draws_the_cpu_light_maps() {
     let scene = Scene::load_named("barczak-pillars", &AssetPaths::standard(None)).unwrap();
-    for backend in gibench_harness::gpu::available_backends() {
-        let gpu = GpuContext::new(&GpuOptions {
-            backend: Some(backend.into()),
-            adapter: None,
-        })
-        .unwrap();
-        let config = RunConfig {
-            resolution: [W, H],
-            frames: 1,
-            warmup: 0,
-            first_frame: 0,
-            timing: TimingMode::Stages,
-            seed: 1,
-            shadow_size: 64,
-        };
-        let harness = Harness::new(&gpu, &scene, &config).unwrap();
+    support::each_backend(&scene, [W, H], |backend, gpu, harness| {
         let frame = harness.clock.frame(0);
         harness.uniforms.write(&gpu.queue, &frame);
         let settings = SampleSettings {
@@ -45,31 +28,16 @@ fn light_map_pass_draws_the_cpu_light_maps() {
             bounces: 2,
         };
         let bz = prepare(&scene, &harness.bvh, &frame, &frame.light, settings, RES).unwrap();
-        let leaves = std::sync::Arc::new(Leaves::new(&gpu, &bz.db));
+        let leaves = std::sync::Arc::new(Leaves::new(gpu, &bz.db));
         let pass = LightMapPass::new(
-            &gpu,
+            gpu,
             &harness.uniforms,
             &harness.gbuffer,
             leaves,
             &bz.light_maps,
         )
         .unwrap();
-        let target = gpu.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("test irradiance"),
-            size: wgpu::Extent3d {
-                width: W,
-                height: H,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: gibench_harness::passes::HDR_FORMAT,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-                | wgpu::TextureUsages::COPY_SRC
-                | wgpu::TextureUsages::TEXTURE_BINDING,
-            view_formats: &[],
-        });
+        let target = render_target(&gpu.device, "test irradiance", [W, H], HDR_FORMAT);
         let view = target.create_view(&Default::default());
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         harness
@@ -77,8 +45,8 @@ fn light_map_pass_draws_the_cpu_light_maps() {
             .encode(&mut enc, &harness.gpu_scene, &harness.uniforms);
         assert_eq!(pass.encode(&mut enc, &harness.uniforms, &view), 1);
         gpu.queue.submit([enc.finish()]);
-        let gpu_e = gibench_harness::image_io::read_rgb_f32(&gpu, &target).unwrap();
-        let g = harness.gbuffer.export(&gpu).unwrap();
+        let gpu_e = gibench_harness::image_io::read_rgb_f32(gpu, &target).unwrap();
+        let g = harness.gbuffer.export(gpu).unwrap();
         let (mut checked, mut agree, mut mover, mut mover_zero) = (0, 0, 0, 0);
         for (i, p) in g.positions.iter().enumerate() {
             let Some(p) = p else { continue };
@@ -112,5 +80,5 @@ fn light_map_pass_draws_the_cpu_light_maps() {
             mover > 20 && mover_zero == mover,
             "{backend}: torus pixels {mover_zero} zero of {mover}"
         );
-    }
+    });
 }

@@ -9,11 +9,11 @@ use gibench_barczak::setup::prepare;
 use gibench_harness::assets::AssetPaths;
 use gibench_harness::bvh::SceneBvh;
 use gibench_harness::glam::{Mat3, Vec3};
-use gibench_harness::gpu::{GpuContext, GpuOptions};
-use gibench_harness::passes::HDR_FORMAT;
-use gibench_harness::runner::{Harness, RunConfig, TimingMode};
+use gibench_harness::passes::{render_target, HDR_FORMAT};
 use gibench_harness::scene::Scene;
 use gibench_harness::wgpu;
+
+mod support;
 
 const W: u32 = 160;
 const H: u32 = 120;
@@ -37,22 +37,7 @@ fn prt_draw_interpolates_the_cpu_vertex_irradiance() {
     let scene = Scene::load_named("barczak-pillars", &AssetPaths::standard(None)).unwrap();
     let mesh = &scene.movers[0].mesh;
     let transfer = prt::transfer(mesh, &SceneBvh::new(mesh), 512, 1e-4);
-    for backend in gibench_harness::gpu::available_backends() {
-        let gpu = GpuContext::new(&GpuOptions {
-            backend: Some(backend.into()),
-            adapter: None,
-        })
-        .unwrap();
-        let config = RunConfig {
-            resolution: [W, H],
-            frames: 1,
-            warmup: 0,
-            first_frame: 0,
-            timing: TimingMode::Stages,
-            seed: 1,
-            shadow_size: 64,
-        };
-        let harness = Harness::new(&gpu, &scene, &config).unwrap();
+    support::each_backend(&scene, [W, H], |backend, gpu, harness| {
         let frame = harness.clock.frame(40);
         harness.uniforms.write(&gpu.queue, &frame);
         let settings = SampleSettings {
@@ -78,29 +63,14 @@ fn prt_draw_interpolates_the_cpu_vertex_irradiance() {
                 .occluded(centre, v.position + v.normal * eps, eps)
         });
         let pass = PrtPass::new(
-            &gpu,
+            gpu,
             &harness.uniforms,
             &harness.gbuffer,
             std::slice::from_ref(&transfer),
         )
         .unwrap();
-        pass.set_lighting(&gpu, 0, &lighting);
-        let target = gpu.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("test irradiance"),
-            size: wgpu::Extent3d {
-                width: W,
-                height: H,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: HDR_FORMAT,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-                | wgpu::TextureUsages::COPY_SRC
-                | wgpu::TextureUsages::TEXTURE_BINDING,
-            view_formats: &[],
-        });
+        pass.set_lighting(gpu, 0, &lighting);
+        let target = render_target(&gpu.device, "test irradiance", [W, H], HDR_FORMAT);
         let view = target.create_view(&Default::default());
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         harness
@@ -130,8 +100,8 @@ fn prt_draw_interpolates_the_cpu_vertex_irradiance() {
             1
         );
         gpu.queue.submit([enc.finish()]);
-        let gpu_e = gibench_harness::image_io::read_rgb_f32(&gpu, &target).unwrap();
-        let g = harness.gbuffer.export(&gpu).unwrap();
+        let gpu_e = gibench_harness::image_io::read_rgb_f32(gpu, &target).unwrap();
+        let g = harness.gbuffer.export(gpu).unwrap();
         // Per vertex, posed.
         let vertex_e: Vec<Vec3> = transfer
             .iter()
@@ -182,5 +152,5 @@ fn prt_draw_interpolates_the_cpu_vertex_irradiance() {
         );
         // The coefficients' count is the thesis' 5th order.
         assert_eq!(transfer[0].len(), COEFFS);
-    }
+    });
 }

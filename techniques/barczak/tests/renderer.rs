@@ -7,9 +7,9 @@ use gibench_barczak::light_draws::Level;
 use gibench_barczak::renderer::{Renderer, RendererSettings};
 use gibench_barczak::samples::SampleSettings;
 use gibench_harness::assets::AssetPaths;
-use gibench_harness::gpu::{GpuContext, GpuOptions};
-use gibench_harness::runner::{Harness, RunConfig, TimingMode};
 use gibench_harness::scene::Scene;
+
+mod support;
 
 const SETTINGS: RendererSettings = RendererSettings {
     samples: SampleSettings {
@@ -29,22 +29,7 @@ const SETTINGS: RendererSettings = RendererSettings {
 #[test]
 fn updated_frames_equal_frames_prepared_from_scratch() {
     let scene = Scene::load_named("barczak-pillars", &AssetPaths::standard(None)).unwrap();
-    for backend in gibench_harness::gpu::available_backends() {
-        let gpu = GpuContext::new(&GpuOptions {
-            backend: Some(backend.into()),
-            adapter: None,
-        })
-        .unwrap();
-        let config = RunConfig {
-            resolution: [96, 72],
-            frames: 1,
-            warmup: 0,
-            first_frame: 0,
-            timing: TimingMode::Stages,
-            seed: 1,
-            shadow_size: 64,
-        };
-        let harness = Harness::new(&gpu, &scene, &config).unwrap();
+    support::each_backend(&scene, [96, 72], |backend, gpu, harness| {
         let render = |r: &mut Renderer, f: u32| {
             let frame = harness.clock.frame(f);
             harness.uniforms.write(&gpu.queue, &frame);
@@ -54,7 +39,7 @@ fn updated_frames_equal_frames_prepared_from_scratch() {
                 .encode(&mut enc, &harness.gpu_scene, &harness.uniforms);
             let counts = r
                 .frame(
-                    &gpu,
+                    gpu,
                     &mut enc,
                     &harness.gpu_scene,
                     &harness.uniforms,
@@ -64,13 +49,13 @@ fn updated_frames_equal_frames_prepared_from_scratch() {
                 .unwrap();
             gpu.queue.submit([enc.finish()]);
             (
-                gibench_harness::image_io::read_rgb_f32(&gpu, r.output()).unwrap(),
+                gibench_harness::image_io::read_rgb_f32(gpu, r.output()).unwrap(),
                 counts,
             )
         };
         let start = harness.clock.frame(0);
         let mut running = Renderer::new(
-            &gpu,
+            gpu,
             &scene,
             &harness.bvh,
             &harness.uniforms,
@@ -85,7 +70,7 @@ fn updated_frames_equal_frames_prepared_from_scratch() {
             changes += counts.light_map_changes;
             let frame = harness.clock.frame(f);
             let mut fresh = Renderer::new(
-                &gpu,
+                gpu,
                 &scene,
                 &harness.bvh,
                 &harness.uniforms,
@@ -118,5 +103,5 @@ fn updated_frames_equal_frames_prepared_from_scratch() {
             assert!(counts.light_draws > 0);
         }
         assert!(changes > 0, "{backend}: the torus changed no light map");
-    }
+    });
 }

@@ -5,6 +5,9 @@
 
 use gibench_barczak::database::{Receiver, ReceiverShape, VisibilityDatabase};
 use gibench_barczak::visibility::{Blocker, PatchTree, PointLight, Shape};
+use gibench_harness::gpu::{GpuContext, GpuOptions};
+use gibench_harness::runner::{Harness, RunConfig, TimingMode};
+use gibench_harness::scene::Scene;
 use glam::Vec3;
 
 /// A 6 × 3 × 6 room: floor (split three times), walls and ceiling (split once), a table top
@@ -201,4 +204,31 @@ pub fn bilinear(texels: &[Vec3], res: u32, s: f32, t: f32) -> Vec3 {
     at(i0, j0)
         .lerp(at(i1, j0), fx)
         .lerp(at(i0, j1).lerp(at(i1, j1), fx), fy)
+}
+
+/// Runs `body` on every portable backend present (Vulkan, GL) with a harness for `scene` at
+/// `size` pixels.
+pub fn each_backend(
+    scene: &Scene,
+    size: [u32; 2],
+    mut body: impl FnMut(&str, &GpuContext, &Harness),
+) {
+    for backend in gibench_harness::gpu::available_backends() {
+        let gpu = GpuContext::new(&GpuOptions {
+            backend: Some(backend.into()),
+            adapter: None,
+        })
+        .unwrap();
+        let config = RunConfig {
+            resolution: size,
+            frames: 1,
+            warmup: 0,
+            first_frame: 0,
+            timing: TimingMode::Stages,
+            seed: 1,
+            shadow_size: 64,
+        };
+        let harness = Harness::new(&gpu, scene, &config).unwrap();
+        body(backend, &gpu, &harness);
+    }
 }
