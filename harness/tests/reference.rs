@@ -351,38 +351,10 @@ fn reference_texture_albedo_is_bilinear_srgb_repeat() {
 fn reference_white_furnace_box() {
     let rho = 0.5f32;
     let size = Vec3::new(4.0, 3.0, 5.0);
-    let mut m = Mesh::default();
     let corner = |x: f32, y: f32, z: f32| Vec3::new(x, y, z) * size;
     // Six inward-facing faces: (corners, inward normal).
-    let faces = [
-        (
-            [(0., 0., 0.), (1., 0., 0.), (1., 0., 1.), (0., 0., 1.)],
-            Vec3::Y,
-        ),
-        (
-            [(0., 1., 0.), (0., 1., 1.), (1., 1., 1.), (1., 1., 0.)],
-            Vec3::NEG_Y,
-        ),
-        (
-            [(0., 0., 0.), (0., 0., 1.), (0., 1., 1.), (0., 1., 0.)],
-            Vec3::X,
-        ),
-        (
-            [(1., 0., 0.), (1., 1., 0.), (1., 1., 1.), (1., 0., 1.)],
-            Vec3::NEG_X,
-        ),
-        (
-            [(0., 0., 0.), (0., 1., 0.), (1., 1., 0.), (1., 0., 0.)],
-            Vec3::Z,
-        ),
-        (
-            [(0., 0., 1.), (1., 0., 1.), (1., 1., 1.), (0., 1., 1.)],
-            Vec3::NEG_Z,
-        ),
-    ];
-    for (c, n) in faces {
-        quad(&mut m, c.map(|(x, y, z)| corner(x, y, z)), n, 0);
-    }
+    let faces = support::unit_box_faces();
+    let m = support::closed_box_mesh(size, 0);
     let s = scene(m, vec![material("grey", Vec3::splat(rho))]);
     let power = 100.0;
     let l = light(

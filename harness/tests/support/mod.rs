@@ -25,11 +25,13 @@ pub fn material(name: &str, color: Vec3) -> Material {
     Material::plain(name, color)
 }
 
-/// A closed box of `size` from the origin: six inward-facing quads of `material`.
-pub fn closed_box_mesh(size: Vec3, material: u32) -> Mesh {
-    let mut m = Mesh::default();
-    let corner = |(x, y, z): (f32, f32, f32)| Vec3::new(x, y, z) * size;
-    let faces = [
+/// A face: four corners (x, y, z) and its normal.
+pub type Face = ([(f32, f32, f32); 4], Vec3);
+
+/// The unit cube's six faces as (corners, inward normal), corners counter-clockwise seen from
+/// inside.
+pub fn unit_box_faces() -> [Face; 6] {
+    [
         (
             [(0., 0., 0.), (1., 0., 0.), (1., 0., 1.), (0., 0., 1.)],
             Vec3::Y,
@@ -54,7 +56,14 @@ pub fn closed_box_mesh(size: Vec3, material: u32) -> Mesh {
             [(0., 0., 1.), (1., 0., 1.), (1., 1., 1.), (0., 1., 1.)],
             Vec3::NEG_Z,
         ),
-    ];
+    ]
+}
+
+/// A closed box of `size` from the origin: six inward-facing quads of `material`.
+pub fn closed_box_mesh(size: Vec3, material: u32) -> Mesh {
+    let mut m = Mesh::default();
+    let corner = |(x, y, z): (f32, f32, f32)| Vec3::new(x, y, z) * size;
+    let faces = unit_box_faces();
     for (c, n) in faces {
         quad(&mut m, c.map(corner), n, material);
     }

@@ -73,6 +73,9 @@ pub struct LightDraws {
     add: wgpu::RenderPipeline,
     /// The last plan's level.
     level: Level,
+    /// The CPU copies of the index and record uploads, reused frame to frame.
+    scratch_indices: Vec<u32>,
+    scratch_records: Vec<u8>,
     /// This frame's draws: index range and record.
     draws: Vec<(Range<u32>, u32)>,
     /// Elements of the last plan (for the results: passes made).
@@ -232,6 +235,8 @@ impl LightDraws {
             subtract,
             add,
             level: Level::Full,
+            scratch_indices: Vec::new(),
+            scratch_records: Vec::new(),
             draws: Vec::new(),
             elements: 0,
         })
@@ -276,8 +281,11 @@ impl LightDraws {
             ],
             Level::Naive => vec![(one_per_object(&per_leaf(&|_| true)), true)],
         };
-        let mut indices: Vec<u32> = Vec::new();
-        let mut records: Vec<u8> = Vec::new();
+        // Scratch kept between frames.
+        let mut indices = std::mem::take(&mut self.scratch_indices);
+        let mut records = std::mem::take(&mut self.scratch_records);
+        indices.clear();
+        records.clear();
         self.draws.clear();
         self.elements = 0;
         for (elements, lookup) in groups {
@@ -321,6 +329,8 @@ impl LightDraws {
                 .write_buffer(&self.indices, 0, bytemuck::cast_slice(&indices));
             gpu.queue.write_buffer(&self.records, 0, &records);
         }
+        self.scratch_indices = indices;
+        self.scratch_records = records;
         self.level = level;
         Ok(self.draws.len() as u32)
     }

@@ -71,7 +71,11 @@ pub struct FrameCounts {
 /// See the module docs.
 pub struct Renderer {
     bz: BarczakScene,
+    /// The light samples by slot, and as a plain list (for the PRT lighting).
     lights: Vec<(u32, Vpl)>,
+    samples: Vec<Vpl>,
+    /// This frame's maps to render (kept between frames: no allocation per frame).
+    render: Vec<(u32, Vpl)>,
     atlas: ShadowAtlas,
     raster: AtlasRasteriser,
     light_map: LightMapPass,
@@ -106,12 +110,7 @@ impl Renderer {
             settings.samples,
             settings.light_map_res,
         )?;
-        let lights: Vec<(u32, Vpl)> = bz
-            .samples
-            .all()
-            .enumerate()
-            .map(|(i, v)| (i as u32, *v))
-            .collect();
+        let lights = bz.samples.slotted();
         let n = lights.len() as u32;
         let store = VplStore::new(gpu, n)?;
         store.write(&gpu.queue, &lights);
@@ -158,6 +157,8 @@ impl Renderer {
         let output_view = output.create_view(&Default::default());
         Ok(Renderer {
             poses: frame.movers.clone(),
+            samples: lights.iter().map(|(_, v)| *v).collect(),
+            render: Vec::with_capacity(lights.len()),
             bz,
             lights,
             atlas,
@@ -214,24 +215,23 @@ impl Renderer {
         if changed {
             self.light_map.upload(gpu, &self.bz.light_maps);
         }
-        let render: Vec<(u32, Vpl)> = if self.first {
+        self.render.clear();
+        if self.first {
             self.first = false;
-            self.lights.clone()
+            self.render.extend_from_slice(&self.lights);
         } else {
-            self.schedule
-                .next_frame(self.settings.updates as usize)
-                .into_iter()
-                .map(|l| self.lights[l as usize])
-                .collect()
-        };
-        if !render.is_empty() {
+            let due = self.schedule.next_frame(self.settings.updates as usize);
+            self.render
+                .extend(due.into_iter().map(|l| self.lights[l as usize]));
+        }
+        if !self.render.is_empty() {
             counts.maps_rendered = self.raster.render(
                 gpu,
                 encoder,
                 &self.atlas,
                 scene,
                 uniforms,
-                &render,
+                &self.render,
                 AtlasClear::RenderedSlots,
             );
         }
@@ -245,7 +245,6 @@ impl Renderer {
         }
         self.draws
             .encode(encoder, uniforms, &self.atlas, &self.output_view);
-        let samples: Vec<Vpl> = self.lights.iter().map(|(_, v)| *v).collect();
         for (k, bounds) in self.bz.movers.iter().enumerate() {
             let model = self.poses[k];
             let (centre, _) = bounds.posed(model);
@@ -257,7 +256,7 @@ impl Renderer {
             )
             .transpose();
             let lift = self.atlas.lift;
-            let lighting = prt::lighting(centre, to_object, &samples, |v| {
+            let lighting = prt::lighting(centre, to_object, &self.samples, |v| {
                 !bvh.occluded(centre, v.position + v.normal * lift, lift)
             });
             self.prt.set_lighting(gpu, k, &lighting);

@@ -50,6 +50,14 @@ impl LightSamples {
     pub fn all(&self) -> impl Iterator<Item = &Vpl> {
         self.direct.iter().chain(&self.indirect)
     }
+
+    /// Both sets with their store slots (slot = light index, as the database numbers them).
+    pub fn slotted(&self) -> Vec<(u32, Vpl)> {
+        self.all()
+            .enumerate()
+            .map(|(i, v)| (i as u32, *v))
+            .collect()
+    }
 }
 
 /// The light samples of `light` in `scene` (see the module docs). Errors name the parameter:

@@ -22,7 +22,6 @@ use gibench_harness::ir::raster::{AtlasClear, AtlasRasteriser};
 use gibench_harness::ir::store::VplStore;
 use gibench_harness::passes::{render_target, DrawSet, HDR_FORMAT};
 use gibench_harness::scene::Scene;
-use gibench_harness::vpl::Vpl;
 
 mod support;
 
@@ -41,12 +40,7 @@ fn light_maps_minus_occluded_partials_equal_the_brute_force_gather() {
             bounces: 2,
         };
         let bz = prepare(&scene, &harness.bvh, &frame, &frame.light, settings, 4).unwrap();
-        let lights: Vec<(u32, Vpl)> = bz
-            .samples
-            .all()
-            .enumerate()
-            .map(|(i, v)| (i as u32, *v))
-            .collect();
+        let lights = bz.samples.slotted();
         let n = lights.len() as u32;
         let store = VplStore::new(gpu, n).unwrap();
         store.write(&gpu.queue, &lights);
