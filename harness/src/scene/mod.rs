@@ -609,6 +609,43 @@ impl Scene {
     pub fn shadow_caster_mesh(&self) -> &Mesh {
         self.shadow_mesh.as_ref().unwrap_or(&self.mesh)
     }
+    /// The patches a light-mapped technique lights and tests against: the recorded
+    /// [`Scene::patches`], or, where the scene records none, one patch per static triangle
+    /// (corners a, b, c and the midpoint of c–a, so the patch is exactly the triangle, planar;
+    /// each its own object, casting shadows, split `levels` times; degenerate triangles
+    /// skipped). Triangles are exact where a source's quads are not planar (the measured
+    /// Cornell box's are not, by up to 3 mm). Errors name the scene when it has more than
+    /// `max_triangles` triangles to make patches of (before any work per patch).
+    pub fn receiver_patches(&self, levels: u32, max_triangles: usize) -> Result<Vec<Patch>> {
+        if !self.patches.is_empty() {
+            return Ok(self.patches.clone());
+        }
+        let n = self.mesh.triangle_count();
+        if n > max_triangles {
+            return Err(crate::Error::Invalid(format!(
+                "scene '{}' records no patches, and one patch per triangle would make {n}, more than the {max_triangles} allowed; use a scene that records patches (barczak-area, barczak-table, barczak-pillars) or a smaller mesh",
+                self.descriptor.name
+            )));
+        }
+        let mut out = Vec::with_capacity(n);
+        for t in 0..n {
+            let [a, b, c] = self.mesh.triangle(t);
+            let cross = (b - a).cross(c - a);
+            if cross.length_squared() <= f32::MIN_POSITIVE {
+                continue;
+            }
+            out.push(Patch {
+                corners: [a, b, c, 0.5 * (a + c)],
+                normal: cross.normalize(),
+                object: t as u32,
+                material: self.mesh.triangle_material(t),
+                levels,
+                casts_shadows: true,
+            });
+        }
+        Ok(out)
+    }
+
     /// Area-weighted mean of the materials' average colours over the static mesh (Keller's
     /// average reflectance ρ̄).
     pub fn average_reflectance(&self) -> Vec3 {

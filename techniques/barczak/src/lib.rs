@@ -46,6 +46,7 @@ pub mod database;
 pub mod light_draws;
 pub mod lightmap;
 pub mod lightmap_pass;
+pub mod lowres;
 pub mod passes;
 pub mod prt;
 pub mod prt_pass;

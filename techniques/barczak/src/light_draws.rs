@@ -26,11 +26,12 @@ use bytemuck::{Pod, Zeroable};
 use gibench_harness::gpu::GpuContext;
 use gibench_harness::ir::atlas::ShadowAtlas;
 use gibench_harness::ir::store::VplStore;
-use gibench_harness::passes::{shader_module, FrameUniforms, GBuffer, CAMERA_SLOT, HDR_FORMAT};
+use gibench_harness::passes::{shader_module, FrameUniforms, GBuffer, CAMERA_SLOT};
 use gibench_harness::{wgpu, Error, Result};
 
 use crate::database::VisibilityDatabase;
 use crate::lightmap_pass::{color_pass, Leaves};
+use crate::lowres::{accumulate, mask_depth, masked_pass, LowRes};
 use crate::passes::{one_per_object, optimise, Element, LightSet};
 use crate::visibility::LightState;
 
@@ -52,6 +53,24 @@ pub enum Level {
 }
 const RECORD_STRIDE: u64 = 256;
 
+/// Where and how a set of draws rasterises.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Raster {
+    /// Full resolution, every pixel of a leaf.
+    Full = 0,
+    /// The low-resolution pass's image (accumulated positively, subtracted by its composite).
+    Low = 1,
+    /// Full resolution, edge pixels only (the low-resolution pass's depth mask).
+    Edges = 2,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct RasterData {
+    counts: [u32; 4],
+    ndc: [f32; 4],
+}
+
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 struct DrawLights {
@@ -69,8 +88,10 @@ pub struct LightDraws {
     max_draws: u32,
     store_group: wgpu::BindGroup,
     gbuffer_group: wgpu::BindGroup,
-    subtract: wgpu::RenderPipeline,
-    add: wgpu::RenderPipeline,
+    /// Per [`Raster`]: subtracting and adding pipelines.
+    pipelines: [[wgpu::RenderPipeline; 2]; 3],
+    /// The two raster entries (full resolution, low resolution), a record apart.
+    _raster: wgpu::Buffer,
     /// The last plan's level.
     level: Level,
     /// The CPU copies of the index and record uploads, reused frame to frame.
@@ -94,6 +115,7 @@ impl LightDraws {
         k: u32,
         store: &VplStore,
         atlas: &ShadowAtlas,
+        lowres: Option<&LowRes>,
     ) -> Result<LightDraws> {
         if !(1..=MAX_LIGHTS_PER_DRAW).contains(&k) {
             return Err(Error::param(
@@ -119,6 +141,27 @@ impl LightDraws {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
+        let raster = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("barczak light draws raster"),
+            size: 2 * RECORD_STRIDE,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let full = RasterData {
+            counts: [1, 0, 0, 0],
+            ndc: [0.0; 4],
+        };
+        let low = lowres.map_or(full, |l| {
+            let [x, y] = l.ndc_offset();
+            RasterData {
+                counts: [l.factor, l.factor / 2, 0, 0],
+                ndc: [x, y, 0.0, 0.0],
+            }
+        });
+        gpu.queue
+            .write_buffer(&raster, 0, bytemuck::bytes_of(&full));
+        gpu.queue
+            .write_buffer(&raster, RECORD_STRIDE, bytemuck::bytes_of(&low));
         let frag = wgpu::ShaderStages::FRAGMENT;
         let store_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("barczak lights"),
@@ -145,6 +188,18 @@ impl LightDraws {
                     },
                     count: None,
                 },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 2,
+                    visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: true,
+                        min_binding_size: wgpu::BufferSize::new(
+                            std::mem::size_of::<RasterData>() as u64
+                        ),
+                    },
+                    count: None,
+                },
             ],
         });
         let store_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -161,6 +216,14 @@ impl LightDraws {
                         buffer: &records,
                         offset: 0,
                         size: wgpu::BufferSize::new(std::mem::size_of::<DrawLights>() as u64),
+                    }),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: &raster,
+                        offset: 0,
+                        size: wgpu::BufferSize::new(std::mem::size_of::<RasterData>() as u64),
                     }),
                 },
             ],
@@ -182,12 +245,7 @@ impl LightDraws {
             ],
             immediate_size: 0,
         });
-        let keep = wgpu::BlendComponent {
-            src_factor: wgpu::BlendFactor::Zero,
-            dst_factor: wgpu::BlendFactor::One,
-            operation: wgpu::BlendOperation::Add,
-        };
-        let pipeline = |entry: &str, operation| {
+        let pipeline = |entry: &str, operation, depth| {
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some("barczak light draws"),
                 layout: Some(&layout),
@@ -198,31 +256,35 @@ impl LightDraws {
                     buffers: &[Some(Leaves::layout())],
                 },
                 primitive: wgpu::PrimitiveState::default(),
-                depth_stencil: None,
+                depth_stencil: depth,
                 multisample: Default::default(),
                 fragment: Some(wgpu::FragmentState {
                     module: &module,
                     entry_point: Some(entry),
                     compilation_options: Default::default(),
-                    targets: &[Some(wgpu::ColorTargetState {
-                        format: HDR_FORMAT,
-                        blend: Some(wgpu::BlendState {
-                            color: wgpu::BlendComponent {
-                                src_factor: wgpu::BlendFactor::One,
-                                dst_factor: wgpu::BlendFactor::One,
-                                operation,
-                            },
-                            alpha: keep,
-                        }),
-                        write_mask: wgpu::ColorWrites::ALL,
-                    })],
+                    targets: &[Some(accumulate(operation))],
                 }),
                 multiview_mask: None,
                 cache: None,
             })
         };
-        let subtract = pipeline("fs_subtract", wgpu::BlendOperation::ReverseSubtract);
-        let add = pipeline("fs_add", wgpu::BlendOperation::Add);
+        use wgpu::BlendOperation::{Add, ReverseSubtract};
+        let edges = || Some(mask_depth(false, wgpu::CompareFunction::Greater));
+        let pipelines = [
+            [
+                pipeline("fs_subtract", ReverseSubtract, None),
+                pipeline("fs_add", Add, None),
+            ],
+            // The low image holds what the composite then subtracts or adds.
+            [
+                pipeline("fs_subtract", Add, None),
+                pipeline("fs_add", Add, None),
+            ],
+            [
+                pipeline("fs_subtract", ReverseSubtract, edges()),
+                pipeline("fs_add", Add, edges()),
+            ],
+        ];
         gpu.check_errors()?;
         Ok(LightDraws {
             k,
@@ -232,8 +294,8 @@ impl LightDraws {
             max_draws: max_draws as u32,
             store_group,
             gbuffer_group: gbuffer.read_group.clone(),
-            subtract,
-            add,
+            pipelines,
+            _raster: raster,
             level: Level::Full,
             scratch_indices: Vec::new(),
             scratch_records: Vec::new(),
@@ -340,8 +402,8 @@ impl LightDraws {
         self.elements
     }
 
-    /// Records the planned draws into `target`: kept for [`Level::Full`] (the light-map pass drew
-    /// it), cleared first otherwise. Returns the draws made.
+    /// Records the planned draws into `target` at full resolution: kept for [`Level::Full`]
+    /// (the light-map pass drew it), cleared first otherwise. Returns the draws made.
     pub fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
@@ -355,11 +417,60 @@ impl LightDraws {
             target,
             self.level != Level::Full,
         );
-        pass.set_pipeline(if self.level == Level::Full {
-            &self.subtract
-        } else {
-            &self.add
-        });
+        self.record(&mut pass, Raster::Full, uniforms, atlas)
+    }
+
+    /// Records the planned draws into `lowres`'s low-resolution image (cleared first), which
+    /// then holds the sum [`Self::encode_edges`] composites. Returns the draws made.
+    pub fn encode_low(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        uniforms: &FrameUniforms,
+        atlas: &ShadowAtlas,
+        lowres: &LowRes,
+    ) -> u32 {
+        let mut pass = color_pass(
+            encoder,
+            "barczak light draws (low resolution)",
+            lowres.low_view(),
+            true,
+        );
+        self.record(&mut pass, Raster::Low, uniforms, atlas)
+    }
+
+    /// Composites `lowres`'s interpolated image into `target` off the edges (subtracted for
+    /// [`Level::Full`], after the light maps; added into a cleared target otherwise) and records
+    /// the planned draws again at full resolution on the edges (after
+    /// [`LowRes::encode_mask`]). Returns the draws made.
+    pub fn encode_edges(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        uniforms: &FrameUniforms,
+        atlas: &ShadowAtlas,
+        target: &wgpu::TextureView,
+        lowres: &LowRes,
+    ) -> u32 {
+        let subtract = self.level == Level::Full;
+        let mut pass = masked_pass(
+            encoder,
+            "barczak light draws (edges)",
+            target,
+            !subtract,
+            lowres.mask_view(),
+        );
+        lowres.composite(&mut pass, subtract);
+        self.record(&mut pass, Raster::Edges, uniforms, atlas)
+    }
+
+    fn record(
+        &self,
+        pass: &mut wgpu::RenderPass,
+        raster: Raster,
+        uniforms: &FrameUniforms,
+        atlas: &ShadowAtlas,
+    ) -> u32 {
+        let subtract = self.level == Level::Full;
+        pass.set_pipeline(&self.pipelines[raster as usize][if subtract { 0 } else { 1 }]);
         pass.set_bind_group(
             0,
             uniforms.views.group(),
@@ -369,9 +480,14 @@ impl LightDraws {
         pass.set_bind_group(3, atlas.group(), &[]);
         pass.set_vertex_buffer(0, self.leaves.buffer().slice(..));
         pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
+        let raster_offset = if raster == Raster::Low {
+            RECORD_STRIDE as u32
+        } else {
+            0
+        };
         for (range, record) in &self.draws {
             let offset = (*record as u64 * RECORD_STRIDE) as u32;
-            pass.set_bind_group(2, &self.store_group, &[offset]);
+            pass.set_bind_group(2, &self.store_group, &[offset, raster_offset]);
             pass.draw_indexed(range.clone(), 0, 0..1);
         }
         self.draws.len() as u32

@@ -1,16 +1,18 @@
 //! The parts wired for one frame after another (Barczak 2006 §4.3–4.5), at the optimisation
-//! levels Full, VD and Naive (the low-resolution pass, for VD+LP and Full's own, is to come).
+//! four optimisation levels of Figure 5-3 ([`Optimisation`]).
 //!
 //! Reads: the scene (patches, movers), the harness's G-buffer, uniforms and static BVH, each
 //! frame's mover poses.
-//! Writes: `output` (Rgba16Float irradiance of the light samples): on patches, per [`Level`],
+//! Writes: `output` (Rgba16Float irradiance of the light samples): on patches, per [`Optimisation`],
 //! light maps minus the occluded partial lights, or the lights drawn with or without lookups;
 //! PRT on movers.
 //!
 //! Per frame: every mover that moved is moved in the visibility database (Table 4-1), the light
 //! maps gain or lose single lights, and the shadow maps the motion touched go out of date; the
 //! schedule re-renders `updates` of them by priority (all on the first frame); the light draws
-//! are planned (optimised when `optimise`) and drawn; each mover's lighting environment is gathered
+//! are planned (optimised at Full) and drawn — with the low-resolution pass at Full and VD+LP
+//! (edges found, the lights drawn at low resolution, interpolated off the edges and drawn
+//! again at full resolution on them); each mover's lighting environment is gathered
 //! from the samples its centre sees (ray casts against the static BVH) and drawn by PRT.
 
 use std::sync::Arc;
@@ -19,6 +21,7 @@ use gibench_harness::anim::FrameState;
 use gibench_harness::bvh::SceneBvh;
 use gibench_harness::gpu::GpuContext;
 use gibench_harness::ir::atlas::{AtlasFormat, AtlasSettings, MapKind, ShadowAtlas};
+use gibench_harness::ir::edges::EdgeSettings;
 use gibench_harness::ir::raster::{AtlasClear, AtlasRasteriser};
 use gibench_harness::ir::store::VplStore;
 use gibench_harness::passes::{
@@ -26,11 +29,12 @@ use gibench_harness::passes::{
 };
 use gibench_harness::scene::Scene;
 use gibench_harness::vpl::Vpl;
-use gibench_harness::{wgpu, Result};
+use gibench_harness::{wgpu, Error, Result};
 use glam::{Mat3, Mat4};
 
 use crate::light_draws::{Level, LightDraws};
 use crate::lightmap_pass::{Leaves, LightMapPass};
+use crate::lowres::LowRes;
 use crate::prt::{self, COEFFS};
 use crate::prt_pass::PrtPass;
 use crate::samples::SampleSettings;
@@ -45,11 +49,13 @@ pub struct RendererSettings {
     pub light_map_res: u32,
     /// Lights per subtraction draw (K).
     pub lights_per_draw: u32,
-    /// Merge elements by Figure 4-10's optimiser (at [`Level::Full`] only: the thesis' other
-    /// levels draw each leaf on its own).
-    pub optimise: bool,
-    /// What the light draws do (light maps only with [`Level::Full`]).
-    pub level: Level,
+    /// Figure 5-3's optimisation level.
+    pub level: Optimisation,
+    /// The low-resolution pass's factor (at [`Optimisation::Full`] and
+    /// [`Optimisation::VdLp`]).
+    pub lowres: u32,
+    /// Its edge detection's step, pixels.
+    pub edge_step: u32,
     /// Octahedral map edge, texels.
     pub map_size: u32,
     /// Shadow maps re-rendered per frame at most (after the first).
@@ -58,11 +64,66 @@ pub struct RendererSettings {
     pub prt_directions: usize,
 }
 
+/// Figure 5-3's optimisation levels.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Optimisation {
+    /// Everything: visibility determination, light maps with the occluded partial lights
+    /// subtracted, the low-resolution pass, the pass optimiser.
+    Full,
+    /// Visibility determination and the low-resolution pass.
+    VdLp,
+    /// Visibility determination only, at full resolution.
+    Vd,
+    /// Brute force: every light with a shadow-map lookup on every leaf, full resolution.
+    Naive,
+}
+
+impl Optimisation {
+    /// Every level, in Figure 5-3's order.
+    pub const ALL: [Optimisation; 4] = [
+        Optimisation::Full,
+        Optimisation::VdLp,
+        Optimisation::Vd,
+        Optimisation::Naive,
+    ];
+    /// The parameter's words.
+    pub const NAMES: [&'static str; 4] = ["full", "vd-lp", "vd", "naive"];
+
+    /// The level named `name` (one of [`Self::NAMES`]).
+    pub fn parse(name: &str) -> Result<Optimisation> {
+        Self::NAMES
+            .iter()
+            .position(|n| *n == name)
+            .map(|i| Self::ALL[i])
+            .ok_or_else(|| {
+                Error::param(
+                    "level",
+                    format!("expected one of {} (got '{name}')", Self::NAMES.join(", ")),
+                )
+            })
+    }
+    pub fn name(self) -> &'static str {
+        Self::NAMES[self as usize]
+    }
+    /// What its light draws do.
+    pub fn draws(self) -> Level {
+        match self {
+            Optimisation::Full => Level::Full,
+            Optimisation::VdLp | Optimisation::Vd => Level::VisibilityDetermination,
+            Optimisation::Naive => Level::Naive,
+        }
+    }
+    /// Whether it has the low-resolution pass.
+    pub fn low_res(self) -> bool {
+        matches!(self, Optimisation::Full | Optimisation::VdLp)
+    }
+}
+
 /// What a frame did.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct FrameCounts {
     pub maps_rendered: u32,
-    /// Draws of lights over leaves (the thesis' passes).
+    /// Draws of lights over leaves (the thesis' passes; the low-resolution pass draws twice).
     pub light_draws: u32,
     pub elements: u32,
     pub light_map_changes: u32,
@@ -80,6 +141,7 @@ pub struct Renderer {
     raster: AtlasRasteriser,
     light_map: LightMapPass,
     draws: LightDraws,
+    lowres: Option<LowRes>,
     prt: PrtPass,
     schedule: ShadowMapSchedule,
     poses: Vec<Mat4>,
@@ -126,6 +188,19 @@ impl Renderer {
             },
         )?;
         let raster = AtlasRasteriser::new(gpu, &atlas, uniforms, DrawSet::CastersAndMovers)?;
+        let lowres = if settings.level.low_res() {
+            Some(LowRes::new(
+                gpu,
+                gbuffer,
+                settings.lowres,
+                EdgeSettings {
+                    step: settings.edge_step,
+                    ..EdgeSettings::default()
+                },
+            )?)
+        } else {
+            None
+        };
         let leaves = Arc::new(Leaves::new(gpu, &bz.db));
         let light_map = LightMapPass::new(gpu, uniforms, gbuffer, leaves.clone(), &bz.light_maps)?;
         let draws = LightDraws::new(
@@ -137,6 +212,7 @@ impl Renderer {
             settings.lights_per_draw,
             &store,
             &atlas,
+            lowres.as_ref(),
         )?;
         let transfers: Vec<Vec<[f32; COEFFS]>> = scene
             .movers
@@ -165,6 +241,7 @@ impl Renderer {
             raster,
             light_map,
             draws,
+            lowres,
             prt,
             schedule,
             settings,
@@ -180,8 +257,28 @@ impl Renderer {
         &self.output
     }
 
-    /// Updates for `frame` and records its passes (the harness has written its uniforms and
-    /// recorded the G-buffer before).
+    /// The irradiance view.
+    pub fn output_view(&self) -> &wgpu::TextureView {
+        &self.output_view
+    }
+
+    /// The settings.
+    pub fn settings(&self) -> &RendererSettings {
+        &self.settings
+    }
+
+    /// The prepared scene.
+    pub fn scene(&self) -> &BarczakScene {
+        &self.bz
+    }
+
+    /// The low-resolution pass, where the level has one.
+    pub fn lowres(&self) -> Option<&LowRes> {
+        self.lowres.as_ref()
+    }
+
+    /// Updates for `frame` and records all its passes into `encoder` (the harness has written
+    /// its uniforms and recorded the G-buffer before): the steps below in order.
     #[allow(clippy::too_many_arguments)]
     pub fn frame(
         &mut self,
@@ -192,6 +289,21 @@ impl Renderer {
         bvh: &SceneBvh,
         frame: &FrameState,
     ) -> Result<FrameCounts> {
+        let mut counts = self.update(gpu, frame)?;
+        counts.maps_rendered = self.encode_shadow_maps(gpu, encoder, scene, uniforms);
+        self.encode_light_maps(encoder, uniforms);
+        self.encode_edges(encoder);
+        counts.light_draws =
+            self.encode_low(encoder, uniforms) + self.encode_lights(encoder, uniforms);
+        self.prt_lighting(gpu, bvh);
+        self.encode_prt(encoder, scene, uniforms);
+        Ok(counts)
+    }
+
+    /// CPU, before the passes: every mover that moved is moved in the visibility database, the
+    /// light maps updated (and uploaded), the shadow maps due chosen and the light draws
+    /// planned. The counts but `maps_rendered` and `light_draws`.
+    pub fn update(&mut self, gpu: &GpuContext, frame: &FrameState) -> Result<FrameCounts> {
         let mut counts = FrameCounts::default();
         let mut changed = false;
         for (k, pose) in frame.movers.iter().enumerate() {
@@ -224,27 +336,81 @@ impl Renderer {
             self.render
                 .extend(due.into_iter().map(|l| self.lights[l as usize]));
         }
-        if !self.render.is_empty() {
-            counts.maps_rendered = self.raster.render(
-                gpu,
-                encoder,
-                &self.atlas,
-                scene,
-                uniforms,
-                &self.render,
-                AtlasClear::RenderedSlots,
-            );
-        }
-        let optimise = self.settings.optimise && self.settings.level == Level::Full;
-        counts.light_draws = self
-            .draws
-            .plan(gpu, &self.bz.db, self.settings.level, optimise)?;
+        let level = self.settings.level;
+        self.draws
+            .plan(gpu, &self.bz.db, level.draws(), level == Optimisation::Full)?;
         counts.elements = self.draws.elements() as u32;
-        if self.settings.level == Level::Full {
+        Ok(counts)
+    }
+
+    /// The shadow maps due this frame (with the movers in them). Returns how many.
+    pub fn encode_shadow_maps(
+        &mut self,
+        gpu: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        scene: &GpuScene,
+        uniforms: &FrameUniforms,
+    ) -> u32 {
+        if self.render.is_empty() {
+            return 0;
+        }
+        self.raster.render(
+            gpu,
+            encoder,
+            &self.atlas,
+            scene,
+            uniforms,
+            &self.render,
+            AtlasClear::RenderedSlots,
+        )
+    }
+
+    /// The light maps into the output (Full only).
+    pub fn encode_light_maps(&self, encoder: &mut wgpu::CommandEncoder, uniforms: &FrameUniforms) {
+        if self.settings.level == Optimisation::Full {
             self.light_map.encode(encoder, uniforms, &self.output_view);
         }
-        self.draws
-            .encode(encoder, uniforms, &self.atlas, &self.output_view);
+    }
+
+    /// The edge detection and its depth mask (levels with the low-resolution pass).
+    pub fn encode_edges(&self, encoder: &mut wgpu::CommandEncoder) {
+        if let Some(lowres) = &self.lowres {
+            lowres.encode_mask(encoder);
+        }
+    }
+
+    /// The light draws at low resolution (levels with the low-resolution pass). Returns the
+    /// draws.
+    pub fn encode_low(&self, encoder: &mut wgpu::CommandEncoder, uniforms: &FrameUniforms) -> u32 {
+        match &self.lowres {
+            Some(lowres) => self
+                .draws
+                .encode_low(encoder, uniforms, &self.atlas, lowres),
+            None => 0,
+        }
+    }
+
+    /// The light draws at full resolution: everywhere, or, with the low-resolution pass, its
+    /// interpolated image off the edges and the draws on them. Returns the draws.
+    pub fn encode_lights(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        uniforms: &FrameUniforms,
+    ) -> u32 {
+        match &self.lowres {
+            Some(lowres) => {
+                self.draws
+                    .encode_edges(encoder, uniforms, &self.atlas, &self.output_view, lowres)
+            }
+            None => self
+                .draws
+                .encode(encoder, uniforms, &self.atlas, &self.output_view),
+        }
+    }
+
+    /// CPU: each mover's lighting environment from the samples its centre sees (ray casts
+    /// against the static BVH), uploaded.
+    pub fn prt_lighting(&mut self, gpu: &GpuContext, bvh: &SceneBvh) {
         for (k, bounds) in self.bz.movers.iter().enumerate() {
             let model = self.poses[k];
             let (centre, _) = bounds.posed(model);
@@ -261,7 +427,15 @@ impl Renderer {
             });
             self.prt.set_lighting(gpu, k, &lighting);
         }
+    }
+
+    /// The movers by PRT.
+    pub fn encode_prt(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        scene: &GpuScene,
+        uniforms: &FrameUniforms,
+    ) {
         self.prt.encode(encoder, scene, uniforms, &self.output_view);
-        Ok(counts)
     }
 }

@@ -6,6 +6,8 @@
 //! and their poses at the first frame, the light's pose, the static BVH.
 //! Writes: [`BarczakScene`].
 //!
+//! * The patches are the scene's recorded ones, or one per triangle where it records none
+//!   (`Scene::receiver_patches`: the Cornell boxes, small glTF scenes).
 //! * Every patch is a receiver, split `levels` times; a patch that casts shadows is also a
 //!   polygon blocker. Patches of one object never shadow each other.
 //! * Every mover is a complex object: its bounding sphere (about its origin, posed) is both a
@@ -15,7 +17,7 @@
 use gibench_harness::anim::{FrameState, LightPose};
 use gibench_harness::bvh::SceneBvh;
 use gibench_harness::scene::Scene;
-use gibench_harness::{Error, Result};
+use gibench_harness::Result;
 use glam::{Mat4, Vec3};
 
 use crate::database::{Receiver, ReceiverShape, VisibilityDatabase};
@@ -51,8 +53,13 @@ pub struct BarczakScene {
     pub first_mover_object: u32,
 }
 
+/// Subdivision levels of the patches made from triangles for a scene that records none.
+pub const TRIANGLE_PATCH_LEVELS: u32 = 2;
+/// Triangles a scene without recorded patches may have (a patch each).
+pub const MAX_TRIANGLE_PATCHES: usize = 4096;
+
 /// Prepares `scene` at `frame` (the movers' poses) with light `light` (see the module docs).
-/// Errors name the scene when it records no patches.
+/// Errors name the scene when it records no patches and has too many triangles to make them.
 pub fn prepare(
     scene: &Scene,
     bvh: &SceneBvh,
@@ -61,12 +68,7 @@ pub fn prepare(
     settings: SampleSettings,
     light_map_res: u32,
 ) -> Result<BarczakScene> {
-    if scene.patches.is_empty() {
-        return Err(Error::Invalid(format!(
-            "barczak lights patches (planar rectangles with their objects), and scene '{}' records none; use a scene that does (barczak-area, barczak-table, barczak-pillars)",
-            scene.descriptor.name
-        )));
-    }
+    let patches = scene.receiver_patches(TRIANGLE_PATCH_LEVELS, MAX_TRIANGLE_PATCHES)?;
     let samples = samples::generate(scene, bvh, light, settings)?;
     let lights: Vec<PointLight> = samples
         .all()
@@ -78,7 +80,7 @@ pub fn prepare(
     let flux: Vec<Vec3> = samples.all().map(|v| v.flux).collect();
     let mut receivers = Vec::new();
     let mut blockers = Vec::new();
-    for p in &scene.patches {
+    for p in &patches {
         receivers.push(Receiver {
             object: p.object,
             shape: ReceiverShape::Patch(PatchTree::new(p.object, p.corners, p.normal, p.levels)),
@@ -90,7 +92,7 @@ pub fn prepare(
             });
         }
     }
-    let first_mover_object = scene.patches.iter().map(|p| p.object).max().unwrap_or(0) + 1;
+    let first_mover_object = patches.iter().map(|p| p.object).max().unwrap_or(0) + 1;
     let mut movers = Vec::new();
     for (k, m) in scene.movers.iter().enumerate() {
         let (lo, hi) = m.mesh.bounds();

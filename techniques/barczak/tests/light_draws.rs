@@ -77,6 +77,7 @@ fn light_maps_minus_occluded_partials_equal_the_brute_force_gather() {
             7,
             &store,
             &atlas,
+            None,
         )
         .unwrap();
         // Barczak Full with and without the pass optimiser, then VD and Naive (which, as the

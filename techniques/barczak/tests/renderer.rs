@@ -3,8 +3,7 @@
 //! of a renderer prepared from scratch at that frame — the database, light-map, shadow-map and
 //! PRT updates together.
 
-use gibench_barczak::light_draws::Level;
-use gibench_barczak::renderer::{Renderer, RendererSettings};
+use gibench_barczak::renderer::{Optimisation, Renderer, RendererSettings};
 use gibench_barczak::samples::SampleSettings;
 use gibench_harness::assets::AssetPaths;
 use gibench_harness::scene::Scene;
@@ -19,8 +18,9 @@ const SETTINGS: RendererSettings = RendererSettings {
     },
     light_map_res: 4,
     lights_per_draw: 7,
-    optimise: true,
-    level: Level::Full,
+    level: Optimisation::Full,
+    lowres: 2,
+    edge_step: 3,
     map_size: 64,
     updates: 1000,
     prt_directions: 256,

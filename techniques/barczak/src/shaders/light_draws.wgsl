@@ -19,6 +19,17 @@ struct DrawLights {
 };
 @group(2) @binding(1) var<uniform> draw_lights: DrawLights;
 
+// Where the draw rasterises: full resolution (factor 1) or the low-resolution pass's (its
+// pixel p shows the G-buffer's pixel factor * p + sample, the projection shifted by ndc so that
+// the pixel centres fall on those pixels' centres; lowres.rs).
+struct Raster {
+    // x: factor, y: sample
+    counts: vec4<u32>,
+    // xy: NDC shift
+    ndc: vec4<f32>,
+};
+@group(2) @binding(2) var<uniform> raster: Raster;
+
 struct LeafOut {
     @builtin(position) clip: vec4<f32>,
     @location(0) world: vec3<f32>,
@@ -29,6 +40,7 @@ struct LeafOut {
 fn vs_leaf(@location(0) position: vec3<f32>, @location(2) normal: vec3<f32>) -> LeafOut {
     var out: LeafOut;
     out.clip = camera.view_proj * vec4<f32>(position, 1.0);
+    out.clip = vec4<f32>(out.clip.xy + raster.ndc.xy * out.clip.w, out.clip.zw);
     out.world = position;
     out.normal = normal;
     return out;
@@ -50,10 +62,11 @@ fn contribution(v: GpuVpl, p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
 
 const LOOKUP: u32 = 0x80000000u;
 
-// Whether this leaf fragment is what the camera sees (leaves are not the G-buffer's triangles,
-// so depths agree to rounding only).
+// Whether this leaf fragment is what the camera sees at its G-buffer pixel (leaves are not the
+// G-buffer's triangles, so depths agree to rounding only).
 fn shown(in: LeafOut) -> bool {
-    let depth = textureLoad(gbuffer_depth, vec2<i32>(in.clip.xy), 0).r;
+    let pixel = vec2<u32>(in.clip.xy) * raster.counts.x + raster.counts.y;
+    let depth = textureLoad(gbuffer_depth, vec2<i32>(pixel), 0).r;
     return abs(in.clip.z - depth) <= 1e-4 * depth;
 }
 
