@@ -254,8 +254,9 @@ pub(crate) struct RunArgs {
     /// With --quality, compare every measured frame (per-frame error and lag plots).
     #[arg(long)]
     quality_all: bool,
-    /// The reference component the indirect irradiance is compared with: one-bounce or
-    /// multi-bounce (default: each technique's declared component, see `gibench list`).
+    /// The reference component the indirect irradiance is compared with: one-bounce,
+    /// multi-bounce, or direct (for a technique's direct light samples: `barczak set=direct`)
+    /// (default: each technique's declared component, see `gibench list`).
     #[arg(long)]
     quality_reference: Option<String>,
     /// Also write an HTML page of the run (`{scene}-report.html`, or `{stem}.html` for a

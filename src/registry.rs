@@ -3,7 +3,7 @@
 
 use gibench_harness::technique::TechniqueInfo;
 
-static ALL: [TechniqueInfo; 7] = [
+static ALL: [TechniqueInfo; 8] = [
     gibench_direct::INFO,
     gibench_keller::FULL,
     gibench_keller::INCREMENTAL,
@@ -11,6 +11,7 @@ static ALL: [TechniqueInfo; 7] = [
     gibench_ism::INFO,
     gibench_ism::INFO_CLASSIC,
     gibench_gaitatzes::INFO,
+    gibench_barczak::INFO,
 ];
 
 /// All registered techniques.

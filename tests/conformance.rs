@@ -82,7 +82,7 @@ fn conform_on(gpu: &GpuContext, scene_name: &str, failures: &mut Vec<String>) {
             None => {
                 let bounces = match component {
                     IndirectComponent::OneBounce => 1,
-                    IndirectComponent::MultiBounce => 8,
+                    IndirectComponent::MultiBounce | IndirectComponent::Direct => 8,
                 };
                 let r = render_reference(
                     &scene,

@@ -26,6 +26,9 @@ pub enum IndirectComponent {
     OneBounce,
     /// All bounces up to the reference's bounce count.
     MultiBounce,
+    /// The primary light's direct irradiance (for a technique's direct light samples: Barczak's
+    /// `set=direct`).
+    Direct,
 }
 
 impl IndirectComponent {
@@ -33,9 +36,10 @@ impl IndirectComponent {
         match s {
             "one-bounce" => Ok(IndirectComponent::OneBounce),
             "multi-bounce" => Ok(IndirectComponent::MultiBounce),
+            "direct" => Ok(IndirectComponent::Direct),
             _ => Err(Error::param(
                 "quality-reference",
-                format!("expected one-bounce or multi-bounce (got '{s}')"),
+                format!("expected one-bounce, multi-bounce or direct (got '{s}')"),
             )),
         }
     }
@@ -43,6 +47,7 @@ impl IndirectComponent {
         match self {
             IndirectComponent::OneBounce => "one-bounce",
             IndirectComponent::MultiBounce => "multi-bounce",
+            IndirectComponent::Direct => "direct",
         }
     }
     /// The component's image.
@@ -50,6 +55,7 @@ impl IndirectComponent {
         match self {
             IndirectComponent::OneBounce => &r.one_bounce,
             IndirectComponent::MultiBounce => &r.multi_bounce,
+            IndirectComponent::Direct => &r.direct,
         }
     }
 }
@@ -83,10 +89,14 @@ impl QualityConfig {
         self.component.unwrap_or(IndirectComponent::OneBounce)
     }
 
-    /// The reference settings actually rendered: one bounce suffices for the one-bounce component.
+    /// The reference settings actually rendered: one bounce suffices for the one-bounce and
+    /// direct components.
     pub fn reference_settings(&self) -> ReferenceSettings {
         let mut s = self.reference;
-        if self.component() == IndirectComponent::OneBounce {
+        if matches!(
+            self.component(),
+            IndirectComponent::OneBounce | IndirectComponent::Direct
+        ) {
             s.bounces = 1;
         }
         s

@@ -64,6 +64,48 @@ pub struct RendererSettings {
     pub prt_directions: usize,
 }
 
+/// What the renderer prepares on the CPU once per scene (§4.1, §4.3, §4.4): the scene's light
+/// samples, visibility database and light maps, and each mover's PRT transfer.
+#[derive(Clone, Debug)]
+pub struct Prepared {
+    pub bz: BarczakScene,
+    /// Per mover, per vertex.
+    pub transfers: Vec<Vec<[f32; COEFFS]>>,
+}
+
+impl Prepared {
+    /// Prepares `scene` at `frame` (light and mover poses).
+    pub fn new(
+        scene: &Scene,
+        bvh: &SceneBvh,
+        frame: &FrameState,
+        settings: &RendererSettings,
+    ) -> Result<Prepared> {
+        let bz = prepare(
+            scene,
+            bvh,
+            frame,
+            &frame.light,
+            settings.samples,
+            settings.light_map_res,
+        )?;
+        let lift = 1e-4 * scene.extent.diagonal;
+        let transfers = scene
+            .movers
+            .iter()
+            .map(|m| {
+                prt::transfer(
+                    &m.mesh,
+                    &SceneBvh::new(&m.mesh),
+                    settings.prt_directions,
+                    lift,
+                )
+            })
+            .collect();
+        Ok(Prepared { bz, transfers })
+    }
+}
+
 /// Figure 5-3's optimisation levels.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Optimisation {
@@ -164,14 +206,21 @@ impl Renderer {
         frame: &FrameState,
         settings: RendererSettings,
     ) -> Result<Renderer> {
-        let bz = prepare(
-            scene,
-            bvh,
-            frame,
-            &frame.light,
-            settings.samples,
-            settings.light_map_res,
-        )?;
+        let prepared = Prepared::new(scene, bvh, frame, &settings)?;
+        Renderer::with(gpu, scene, uniforms, gbuffer, frame, settings, prepared)
+    }
+
+    /// The GPU parts for a scene prepared by [`Prepared::new`] at `frame`.
+    pub fn with(
+        gpu: &GpuContext,
+        scene: &Scene,
+        uniforms: &FrameUniforms,
+        gbuffer: &GBuffer,
+        frame: &FrameState,
+        settings: RendererSettings,
+        prepared: Prepared,
+    ) -> Result<Renderer> {
+        let Prepared { bz, transfers } = prepared;
         let lights = bz.samples.slotted();
         let n = lights.len() as u32;
         let store = VplStore::new(gpu, n)?;
@@ -214,19 +263,6 @@ impl Renderer {
             &atlas,
             lowres.as_ref(),
         )?;
-        let transfers: Vec<Vec<[f32; COEFFS]>> = scene
-            .movers
-            .iter()
-            .map(|m| {
-                let lift = 1e-4 * scene.extent.diagonal;
-                prt::transfer(
-                    &m.mesh,
-                    &SceneBvh::new(&m.mesh),
-                    settings.prt_directions,
-                    lift,
-                )
-            })
-            .collect();
         let prt = PrtPass::new(gpu, uniforms, gbuffer, &transfers)?;
         let schedule = ShadowMapSchedule::new(bz.flux.iter().copied());
         let output = render_target(&gpu.device, "barczak irradiance", gbuffer.size, HDR_FORMAT);

@@ -70,8 +70,8 @@ pub fn generate(
 ) -> Result<LightSamples> {
     if settings.direct + settings.indirect == 0 {
         return Err(Error::param(
-            "direct-samples",
-            "direct-samples and indirect-samples are both 0: nothing would light the scene",
+            "vpls",
+            "no direct and no indirect samples: nothing would light the scene",
         ));
     }
     if settings.indirect > 0 && settings.bounces == 0 {
@@ -85,9 +85,9 @@ pub fn generate(
     } else {
         let Some((half_u, half_v)) = light.area_half_extents() else {
             return Err(Error::param(
-                "direct-samples",
+                "set",
                 format!(
-                    "direct light samples are points on an area light; the scene's light is {:?} (use direct-samples=0)",
+                    "direct light samples (set=direct) are points on an area light; the scene's light is {:?} (use set=indirect)",
                     light.kind
                 ),
             ));

@@ -132,7 +132,7 @@ fn bad_settings_name_the_parameter() {
     .unwrap_err()
     .to_string();
     assert!(
-        err.contains("direct-samples") && err.contains("area light"),
+        err.contains("set=direct") && err.contains("area light"),
         "{err}"
     );
     let err = generate(
@@ -147,7 +147,7 @@ fn bad_settings_name_the_parameter() {
     )
     .unwrap_err()
     .to_string();
-    assert!(err.contains("direct-samples"), "{err}");
+    assert!(err.contains("vpls"), "{err}");
     let err = generate(
         &scene,
         &bvh,
