@@ -431,3 +431,79 @@ fn reproduce_all_refuses_bad_input_before_any_work() {
         assert!(!out.exists(), "{args:?} wrote {out:?}");
     }
 }
+
+/// `reproduce barczak2006` writes Figures 5-2 to 5-6 as SVG plots with their tables (every
+/// light count, level, light-sample set and update case a row; the quality runs kept out of
+/// the figures' rows), prints the Full/Naive ratio at the largest light count, and its direct
+/// light samples match the reference's direct light in energy.
+#[test]
+fn barczak2006_writes_five_figures_and_their_tables() {
+    let tmp = tempfile::tempdir().unwrap();
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_gibench"))
+        .args([
+            "reproduce",
+            "barczak2006",
+            "--quick",
+            "--frames",
+            "1",
+            "--quiet",
+            "--out",
+        ])
+        .arg(tmp.path())
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    // The ratio, for both light-sample sets, at --quick's largest light count.
+    for set in ["indirect", "direct"] {
+        let line = format!("barczak2006: {set} samples at 300 lights: Full ");
+        assert!(stdout.contains(&line), "no '{line}' in\n{stdout}");
+    }
+    assert!(stdout.contains("than Naive"), "{stdout}");
+    let rows = |stem: &str| -> Vec<Vec<String>> {
+        let text = std::fs::read_to_string(tmp.path().join(format!("{stem}.csv"))).unwrap();
+        text.lines()
+            .skip(1)
+            .map(|l| l.split(',').map(String::from).collect())
+            .collect()
+    };
+    // 3 rooms × 3 light counts; 2 sets × 4 levels × 3; 4 cases × (static + 4 update counts);
+    // 4 cases × 4; the bunny in the pillar room's 4; the two sets' quality.
+    for (stem, n) in [
+        ("barczak-fig5-2", 9),
+        ("barczak-fig5-3", 24),
+        ("barczak-fig5-4", 20),
+        ("barczak-fig5-5", 16),
+        ("barczak-fig5-6", 4),
+        ("barczak-quality", 2),
+    ] {
+        assert_eq!(rows(stem).len(), n, "{stem}");
+        for ext in ["md", "tex"] {
+            assert!(tmp.path().join(format!("{stem}.{ext}")).is_file());
+        }
+        if stem != "barczak-quality" {
+            let svg = std::fs::read_to_string(tmp.path().join(format!("{stem}.svg"))).unwrap();
+            assert!(svg.contains("<svg"), "{stem}.svg");
+        }
+        let md = std::fs::read_to_string(tmp.path().join(format!("{stem}.md"))).unwrap();
+        if stem != "barczak-quality" {
+            assert!(
+                md.contains("The thesis (ATI Radeon X800 XT") && md.contains("Ours shows: "),
+                "{stem}: {md}"
+            );
+        }
+    }
+    let levels: Vec<String> = rows("barczak-fig5-3")
+        .iter()
+        .map(|r| r[1].clone())
+        .collect();
+    for level in ["full", "vd-lp", "vd", "naive"] {
+        assert_eq!(levels.iter().filter(|l| *l == level).count(), 6, "{level}");
+    }
+    // The direct samples against the reference's direct light: bias (the last column but one;
+    // the reference's label holds commas) within 5 %.
+    let quality = rows("barczak-quality");
+    let direct = quality.iter().find(|r| r[0] == "direct").unwrap();
+    let bias: f64 = direct[direct.len() - 2].parse().unwrap();
+    assert!(bias.abs() < 0.05, "direct bias {bias}");
+}

@@ -25,7 +25,7 @@ use gibench_harness::output::OutputSet;
 use gibench_harness::report;
 use gibench_harness::{Error, Result};
 
-use super::{gaitatzes2010, ism2008, laine2007, out_dir, PaperModule, ReproduceArgs};
+use super::{barczak2006, gaitatzes2010, ism2008, laine2007, out_dir, PaperModule, ReproduceArgs};
 use crate::{Bars, Job};
 
 /// How a target is produced.
@@ -261,6 +261,12 @@ pub const TARGETS: &[Target] = &[
         dir: "gaitatzes/quality",
         what: "",
         kind: Kind::Paper(&gaitatzes2010::MODULE),
+    },
+    Target {
+        name: "barczak2006",
+        dir: "barczak2006",
+        what: "",
+        kind: Kind::Paper(&barczak2006::MODULE),
     },
     Target {
         name: "gaitatzes-grid",

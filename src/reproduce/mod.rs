@@ -7,11 +7,14 @@
 //!   light propagation volumes.
 //! * [`ism2008`]: the imperfect-shadow-map breakdown of the Kautz course slides (Ritschel et
 //!   al. 2008), ISM against classic maps on the same VPLs.
+//! * [`barczak2006`]: Barczak 2006, Figures 5-2 to 5-6 (frame rate against lights and
+//!   optimisation levels, and against shadow-map updates with moving objects), plots and tables.
 //! * [`all`]: every paper table, figure and sweep (`gibench reproduce all`), and the sweeps
 //!   that are gibench commands (Keller's and Laine's tile, VPL and clamp sweeps, the lag and
 //!   quality runs, the reference) as targets of their own.
 
 pub mod all;
+pub mod barczak2006;
 pub mod gaitatzes2010;
 pub mod ism2008;
 pub mod laine2007;
@@ -30,7 +33,7 @@ use gibench_harness::{Error, Result};
 pub struct ReproduceArgs {
     /// What to regenerate: `all` (every target below), or one target: laine-table1,
     /// laine-table2, laine-tables (both from one set of runs), laine-management,
-    /// laine-dispersion, ism-breakdown, gaitatzes-table1, gaitatzes-quality, or a sweep or run target (`gibench reproduce all --list` lists them).
+    /// laine-dispersion, ism-breakdown, gaitatzes-table1, gaitatzes-quality, barczak2006, or a sweep or run target (`gibench reproduce all --list` lists them).
     pub target: String,
     /// Small sizes for machines without a GPU (each target says which).
     #[arg(long)]
