@@ -16,7 +16,8 @@
 //! Figure 4-10's optimiser when `optimise` is on; lights needing lookups and lights not needing
 //! them are separate elements); each element is drawn ⌈lights / K⌉ times, a draw handling up to
 //! K lights (the thesis' X800 had room for 7 per pass; K ≤ 16 here). The per-draw light list is
-//! a uniform at a dynamic offset, as the kit's rasteriser passes its views (portable to GL).
+//! a read-only storage buffer at a dynamic offset (not a uniform: lavapipe compiles a shader variant per
+//! draw for uniforms that control flow reads; see `passes::params_entry`), portable to GL.
 //! Buffers are sized once for the worst case (Naive without merging), so no frame allocates.
 
 use std::ops::Range;
@@ -138,13 +139,13 @@ impl LightDraws {
         let records = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("barczak draw lights"),
             size: max_draws * RECORD_STRIDE,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
         let raster = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("barczak light draws raster"),
             size: 2 * RECORD_STRIDE,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
         let full = RasterData {
@@ -180,7 +181,7 @@ impl LightDraws {
                     binding: 1,
                     visibility: frag,
                     ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
+                        ty: wgpu::BufferBindingType::Storage { read_only: true },
                         has_dynamic_offset: true,
                         min_binding_size: wgpu::BufferSize::new(
                             std::mem::size_of::<DrawLights>() as u64
@@ -192,7 +193,7 @@ impl LightDraws {
                     binding: 2,
                     visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
                     ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
+                        ty: wgpu::BufferBindingType::Storage { read_only: true },
                         has_dynamic_offset: true,
                         min_binding_size: wgpu::BufferSize::new(
                             std::mem::size_of::<RasterData>() as u64

@@ -17,7 +17,7 @@ struct DrawLights {
     // The lights' store slots, four per vector; the high bit asks for a shadow-map lookup.
     lights: array<vec4<u32>, 4>,
 };
-@group(2) @binding(1) var<uniform> draw_lights: DrawLights;
+@group(2) @binding(1) var<storage, read> draw_lights: DrawLights;
 
 // Where the draw rasterises: full resolution (factor 1) or the low-resolution pass's (its
 // pixel p shows the G-buffer's pixel factor * p + sample, the projection shifted by ndc so that
@@ -28,7 +28,7 @@ struct Raster {
     // xy: NDC shift
     ndc: vec4<f32>,
 };
-@group(2) @binding(2) var<uniform> raster: Raster;
+@group(2) @binding(2) var<storage, read> raster: Raster;
 
 struct LeafOut {
     @builtin(position) clip: vec4<f32>,
