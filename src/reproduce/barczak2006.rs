@@ -651,7 +651,7 @@ fn fig5_3(out: &Path, runs: &[RunResult], paper: &serde_json::Value) -> Result<T
         rows,
         notes: vec![
             thesis(paper, "5-3"),
-            format!("Ours shows: {}.", shows.join(" ")),
+            format!("Ours shows: {}.", shows.join("; ")),
             format!(
                 "{} full: light maps minus the occluded partial lights, drawn at low resolution (factor 2, edges redrawn), elements merged by the pass optimiser (K = 7 lights per draw); \
                  vd-lp: visibility determination and the low-resolution pass; vd: visibility determination at full resolution; naive: every light with a shadow-map lookup on every patch. \
