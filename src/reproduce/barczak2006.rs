@@ -34,7 +34,6 @@ use gibench_harness::quality::{IndirectComponent, QualityConfig};
 use gibench_harness::reference::ReferenceSettings;
 use gibench_harness::report::{self, Cell, Table};
 use gibench_harness::results::RunResult;
-use gibench_harness::runner::{RunConfig, TimingMode};
 use gibench_harness::scene::{Scene, SceneDescriptor};
 use gibench_harness::session::{RunSpec, TechniqueRun};
 use gibench_harness::technique::TechniqueInfo;
@@ -289,19 +288,7 @@ fn spec<'s>(args: &ReproduceArgs, scene: &'s Scene, set: Set) -> Result<RunSpec<
     Ok(RunSpec {
         scene,
         runs,
-        config: RunConfig {
-            resolution: s.resolution,
-            frames,
-            warmup: s.warmup,
-            first_frame: 0,
-            timing: if quality.is_some() {
-                TimingMode::Stages
-            } else {
-                TimingMode::Both
-            },
-            seed: 1,
-            shadow_size: if args.quick { 256 } else { 1024 },
-        },
+        config: super::paper_config(args, s.resolution, frames, s.warmup, quality.is_some()),
         // The quality runs at the size the reference affords (as every quality target).
         quality,
         cache: Default::default(),
@@ -368,15 +355,7 @@ pub fn reproduce(
         .zip(&descs)
         .map(|(scene, (_, set))| spec(args, scene, *set))
         .collect::<Result<Vec<_>>>()?;
-    for s in &specs {
-        s.validate()?;
-    }
-    let mut opened = None;
-    let gpu = super::gpu_or_open(gpu, args, &mut opened)?;
-    let mut runs = Vec::new();
-    for s in &specs {
-        runs.extend(crate::execute_with_bar(bars, gpu, s)?);
-    }
+    let runs = super::run_specs(&specs, args, gpu, bars)?;
     let out = super::out_dir(args, "barczak2006");
     let movers: Vec<(String, usize)> = scenes
         .iter()

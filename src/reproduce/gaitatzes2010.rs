@@ -21,7 +21,6 @@ use gibench_harness::quality::{IndirectComponent, QualityConfig};
 use gibench_harness::reference::ReferenceSettings;
 use gibench_harness::report::{self, Cell, Table};
 use gibench_harness::results::RunResult;
-use gibench_harness::runner::{RunConfig, TimingMode};
 use gibench_harness::scene::Scene;
 use gibench_harness::session::{RunSpec, TechniqueRun};
 use gibench_harness::technique::TechniqueInfo;
@@ -213,19 +212,7 @@ fn spec<'s>(
     Ok(RunSpec {
         scene,
         runs,
-        config: RunConfig {
-            resolution: res,
-            frames,
-            warmup,
-            first_frame: 0,
-            timing: if compared {
-                TimingMode::Stages
-            } else {
-                TimingMode::Both
-            },
-            seed: 1,
-            shadow_size: if args.quick { 256 } else { 1024 },
-        },
+        config: super::paper_config(args, res, frames, warmup, compared),
         quality,
         cache: Default::default(),
         out: runs_folder(args),
@@ -251,15 +238,7 @@ pub fn reproduce(
         .zip(&loaded)
         .map(|((_, it), scene)| spec(target, args, scene, *it))
         .collect::<Result<Vec<_>>>()?;
-    for s in &specs {
-        s.validate()?;
-    }
-    let mut opened = None;
-    let gpu = super::gpu_or_open(gpu, args, &mut opened)?;
-    let mut runs = Vec::new();
-    for s in &specs {
-        runs.extend(crate::execute_with_bar(bars, gpu, s)?);
-    }
+    let runs = super::run_specs(&specs, args, gpu, bars)?;
     let table = if target == "gaitatzes-quality" {
         (quality_table(&runs)?, "gaitatzes-quality")
     } else {

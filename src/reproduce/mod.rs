@@ -134,6 +134,52 @@ pub fn gpu_or_open<'a>(
     }
 }
 
+/// Validates every spec, then runs them one after another on `gpu` (or the adapter `args` asks
+/// for) under `bars`: a paper target's runs, all checked before any starts.
+pub fn run_specs(
+    specs: &[gibench_harness::session::RunSpec],
+    args: &ReproduceArgs,
+    gpu: Option<&GpuContext>,
+    bars: &crate::Bars,
+) -> Result<Vec<RunResult>> {
+    for s in specs {
+        s.validate()?;
+    }
+    let mut opened = None;
+    let gpu = gpu_or_open(gpu, args, &mut opened)?;
+    let mut runs = Vec::new();
+    for s in specs {
+        runs.extend(crate::execute_with_bar(bars, gpu, s)?);
+    }
+    Ok(runs)
+}
+
+/// A paper target's run configuration: per-stage timing only for runs compared with the
+/// reference (stage and frame timing otherwise), seed 1, the direct light's map 256² with
+/// `--quick` and 1024² (Laine's) without.
+pub fn paper_config(
+    args: &ReproduceArgs,
+    resolution: [u32; 2],
+    frames: u32,
+    warmup: u32,
+    compared: bool,
+) -> gibench_harness::runner::RunConfig {
+    use gibench_harness::runner::{RunConfig, TimingMode};
+    RunConfig {
+        resolution,
+        frames,
+        warmup,
+        first_frame: 0,
+        timing: if compared {
+            TimingMode::Stages
+        } else {
+            TimingMode::Both
+        },
+        seed: 1,
+        shadow_size: if args.quick { 256 } else { 1024 },
+    }
+}
+
 /// A stage's table figure in `r` (flushed wall time, else GPU timestamps), if it has it.
 pub fn ms(r: &RunResult, stage: &str) -> Option<f64> {
     r.stage(stage).and_then(|s| s.best_ms())

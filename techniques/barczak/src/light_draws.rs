@@ -31,8 +31,8 @@ use gibench_harness::passes::{shader_module, FrameUniforms, GBuffer, CAMERA_SLOT
 use gibench_harness::{wgpu, Error, Result};
 
 use crate::database::VisibilityDatabase;
-use crate::lightmap_pass::{color_pass, Leaves};
-use crate::lowres::{accumulate, mask_depth, masked_pass, LowRes};
+use crate::lightmap_pass::{color_pass, target_pass, Leaves};
+use crate::lowres::{accumulate, mask_depth, LowRes};
 use crate::passes::{one_per_object, optimise, Element, LightSet};
 use crate::visibility::LightState;
 
@@ -452,12 +452,12 @@ impl LightDraws {
         lowres: &LowRes,
     ) -> u32 {
         let subtract = self.level == Level::Full;
-        let mut pass = masked_pass(
+        let mut pass = target_pass(
             encoder,
             "barczak light draws (edges)",
             target,
             !subtract,
-            lowres.mask_view(),
+            Some(lowres.mask_view()),
         );
         lowres.composite(&mut pass, subtract);
         self.record(&mut pass, Raster::Edges, uniforms, atlas)

@@ -100,6 +100,18 @@ pub(crate) fn color_pass<'e>(
     view: &wgpu::TextureView,
     clear: bool,
 ) -> wgpu::RenderPass<'e> {
+    target_pass(encoder, label, view, clear, None)
+}
+
+/// [`color_pass`] with a read-only depth attachment `depth` when given (the low-resolution
+/// pass's edge mask).
+pub(crate) fn target_pass<'e>(
+    encoder: &'e mut wgpu::CommandEncoder,
+    label: &str,
+    view: &wgpu::TextureView,
+    clear: bool,
+    depth: Option<&wgpu::TextureView>,
+) -> wgpu::RenderPass<'e> {
     encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
         label: Some(label),
         color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -115,7 +127,11 @@ pub(crate) fn color_pass<'e>(
                 store: wgpu::StoreOp::Store,
             },
         })],
-        depth_stencil_attachment: None,
+        depth_stencil_attachment: depth.map(|view| wgpu::RenderPassDepthStencilAttachment {
+            view,
+            depth_ops: None,
+            stencil_ops: None,
+        }),
         timestamp_writes: None,
         occlusion_query_set: None,
         multiview_mask: None,

@@ -294,38 +294,3 @@ pub(crate) fn accumulate(operation: wgpu::BlendOperation) -> wgpu::ColorTargetSt
         write_mask: wgpu::ColorWrites::ALL,
     }
 }
-
-/// A render pass into `target` (cleared to zero first or kept) with the edge mask's depth
-/// read-only: the composite and the full-resolution edge draws.
-pub(crate) fn masked_pass<'e>(
-    encoder: &'e mut wgpu::CommandEncoder,
-    label: &str,
-    target: &wgpu::TextureView,
-    clear: bool,
-    mask: &wgpu::TextureView,
-) -> wgpu::RenderPass<'e> {
-    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-        label: Some(label),
-        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-            view: target,
-            depth_slice: None,
-            resolve_target: None,
-            ops: wgpu::Operations {
-                load: if clear {
-                    wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT)
-                } else {
-                    wgpu::LoadOp::Load
-                },
-                store: wgpu::StoreOp::Store,
-            },
-        })],
-        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-            view: mask,
-            depth_ops: None,
-            stencil_ops: None,
-        }),
-        timestamp_writes: None,
-        occlusion_query_set: None,
-        multiview_mask: None,
-    })
-}

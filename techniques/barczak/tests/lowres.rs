@@ -45,7 +45,6 @@ fn the_low_resolution_pass_interpolates_off_edges_and_redraws_them() {
     let scene = Scene::load_named("barczak-pillars", &AssetPaths::standard(None)).unwrap();
     support::each_backend(&scene, [W, H], |backend, gpu, harness| {
         let frame = harness.clock.frame(0);
-        harness.uniforms.write(&gpu.queue, &frame);
         let render = |level| -> (Renderer, Vec<[f32; 3]>, FrameCounts) {
             let mut r = Renderer::new(
                 gpu,
@@ -57,22 +56,7 @@ fn the_low_resolution_pass_interpolates_off_edges_and_redraws_them() {
                 settings(level),
             )
             .unwrap();
-            let mut enc = gpu.device.create_command_encoder(&Default::default());
-            harness
-                .gbuffer
-                .encode(&mut enc, &harness.gpu_scene, &harness.uniforms);
-            let counts = r
-                .frame(
-                    gpu,
-                    &mut enc,
-                    &harness.gpu_scene,
-                    &harness.uniforms,
-                    &harness.bvh,
-                    &frame,
-                )
-                .unwrap();
-            gpu.queue.submit([enc.finish()]);
-            let image = gibench_harness::image_io::read_rgb_f32(gpu, r.output()).unwrap();
+            let (image, counts) = support::render_frame(gpu, harness, &mut r, 0);
             (r, image, counts)
         };
         let (lp, lp_image, lp_counts) = render(Optimisation::VdLp);

@@ -30,29 +30,7 @@ const SETTINGS: RendererSettings = RendererSettings {
 fn updated_frames_equal_frames_prepared_from_scratch() {
     let scene = Scene::load_named("barczak-pillars", &AssetPaths::standard(None)).unwrap();
     support::each_backend(&scene, [96, 72], |backend, gpu, harness| {
-        let render = |r: &mut Renderer, f: u32| {
-            let frame = harness.clock.frame(f);
-            harness.uniforms.write(&gpu.queue, &frame);
-            let mut enc = gpu.device.create_command_encoder(&Default::default());
-            harness
-                .gbuffer
-                .encode(&mut enc, &harness.gpu_scene, &harness.uniforms);
-            let counts = r
-                .frame(
-                    gpu,
-                    &mut enc,
-                    &harness.gpu_scene,
-                    &harness.uniforms,
-                    &harness.bvh,
-                    &frame,
-                )
-                .unwrap();
-            gpu.queue.submit([enc.finish()]);
-            (
-                gibench_harness::image_io::read_rgb_f32(gpu, r.output()).unwrap(),
-                counts,
-            )
-        };
+        let render = |r: &mut Renderer, f: u32| support::render_frame(gpu, harness, r, f);
         let start = harness.clock.frame(0);
         let mut running = Renderer::new(
             gpu,

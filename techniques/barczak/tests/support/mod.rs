@@ -232,3 +232,34 @@ pub fn each_backend(
         body(backend, &gpu, &harness);
     }
 }
+
+/// Frame `f` rendered by `r` after the harness's G-buffer (the harness's uniforms written for
+/// the frame), its output read back, and what the frame did.
+pub fn render_frame(
+    gpu: &GpuContext,
+    harness: &Harness,
+    r: &mut gibench_barczak::renderer::Renderer,
+    f: u32,
+) -> (Vec<[f32; 3]>, gibench_barczak::renderer::FrameCounts) {
+    let frame = harness.clock.frame(f);
+    harness.uniforms.write(&gpu.queue, &frame);
+    let mut enc = gpu.device.create_command_encoder(&Default::default());
+    harness
+        .gbuffer
+        .encode(&mut enc, &harness.gpu_scene, &harness.uniforms);
+    let counts = r
+        .frame(
+            gpu,
+            &mut enc,
+            &harness.gpu_scene,
+            &harness.uniforms,
+            &harness.bvh,
+            &frame,
+        )
+        .unwrap();
+    gpu.queue.submit([enc.finish()]);
+    (
+        gibench_harness::image_io::read_rgb_f32(gpu, r.output()).unwrap(),
+        counts,
+    )
+}
