@@ -337,15 +337,19 @@ impl Renderer {
     }
 
     /// CPU, before the passes: every mover that moved is moved in the visibility database, the
-    /// light maps updated (and uploaded), the shadow maps due chosen and the light draws
-    /// planned. The counts but `maps_rendered` and `light_draws`.
+    /// light maps updated (and uploaded), the shadow maps due chosen and, when a mover moved (or
+    /// on the first frame), the light draws planned again. The counts but `maps_rendered` and
+    /// `light_draws`.
     pub fn update(&mut self, gpu: &GpuContext, frame: &FrameState) -> Result<FrameCounts> {
         let mut counts = FrameCounts::default();
         let mut changed = false;
+        // The plan depends only on the database: redone when a mover moved (and first).
+        let mut replan = self.first;
         for (k, pose) in frame.movers.iter().enumerate() {
             if pose.abs_diff_eq(self.poses[k], 0.0) {
                 continue;
             }
+            replan = true;
             let delta = *pose * self.poses[k].inverse();
             let object = self.bz.first_mover_object + k as u32;
             let update = self
@@ -372,9 +376,11 @@ impl Renderer {
             self.render
                 .extend(due.into_iter().map(|l| self.lights[l as usize]));
         }
-        let level = self.settings.level;
-        self.draws
-            .plan(gpu, &self.bz.db, level.draws(), level == Optimisation::Full)?;
+        if replan {
+            let level = self.settings.level;
+            self.draws
+                .plan(gpu, &self.bz.db, level.draws(), level == Optimisation::Full)?;
+        }
         counts.elements = self.draws.elements() as u32;
         Ok(counts)
     }
