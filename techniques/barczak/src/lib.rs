@@ -1,8 +1,9 @@
-//! `barczak` (in progress): Barczak 2006, "Interactive Illumination Using Large Sets of Point
+//! `barczak`: Barczak 2006, "Interactive Illumination Using Large Sets of Point
 //! Lights" (M.S. thesis, University of Maryland) — light-mapped, visibility-culled instant
 //! radiosity with moving objects.
 //!
-//! What exists so far, each part tested on the CPU:
+//! The parts, each tested on its own (the CPU ones against brute force, the GPU ones against the
+//! CPU):
 //!
 //! * [`visibility`] — §4.3.1: occlusion pyramids from patches (and complex objects' bounding
 //!   spheres) to each light, polygon and sphere blockers, lights classified unblocked / partial /

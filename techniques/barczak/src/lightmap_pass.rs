@@ -7,7 +7,7 @@
 //! the leaf's light map, bilinear between texel centres and clamped inside the leaf; zero
 //! elsewhere. One draw for all leaves.
 //!
-//! The subtraction of occluded partial lights (the second pass) is still to come.
+//! The subtraction of occluded partial lights (the second pass) is [`crate::light_draws`].
 
 use bytemuck::{Pod, Zeroable};
 use gibench_harness::gpu::GpuContext;
