@@ -298,11 +298,6 @@ impl Renderer {
         &self.output_view
     }
 
-    /// The settings.
-    pub fn settings(&self) -> &RendererSettings {
-        &self.settings
-    }
-
     /// The prepared scene.
     pub fn scene(&self) -> &BarczakScene {
         &self.bz

@@ -72,7 +72,8 @@ fn the_low_resolution_pass_interpolates_off_edges_and_redraws_them() {
         let close = |a: [f32; 3], b: [f32; 3], rel: f32| {
             (0..3).all(|c| (a[c] - b[c]).abs() <= rel * a[c].abs().max(b[c].abs()) + 1e-3 * top)
         };
-        let (lw, lh) = (W / 2, H / 2);
+        let [lw, lh] = lowres.size;
+        assert_eq!([lw, lh], [W / 2, H / 2]);
 
         // 1. Low pixels against their sample pixels (those showing a patch: movers are drawn by
         // PRT, after).
