@@ -16,7 +16,14 @@ How:
      render, image writing), then one timed Mitsuba render (CPU = time.process_time, all
      threads, around mi.render plus the evaluation it defers, so load and compilation are
      outside). The ratio is taken per alternation; min/median/max are reported.
-  3. gibench's JSON sidecar gives `seconds`, the wall time of its render call (BVH build
+  3. Raw rays (`--rays N`, default 262144; 0 skips): `gibench export-scene --rays N` also
+     writes N closest-hit rays (from primary hits, cosine-distributed like the reference's path
+     segments) and N shadow segments to the light; per alternation `gibench raycast` casts both
+     sets through the reference's BVH across all cores (its own CPU time of every thread during
+     each cast), then Mitsuba casts the same rays with ray_intersect_preliminary and ray_test
+     (Embree; process CPU time around the call and its evaluation, after a warm-up cast). The
+     agreement of the answers (blocked or not; hit distance within 10^-3) is reported.
+  4. gibench's JSON sidecar gives `seconds`, the wall time of its render call (BVH build
      included, scene load and image writing excluded). It is used for a second, render-only
      wall-clock ratio against Mitsuba's render wall time; the primary number stays the CPU one.
 
@@ -34,9 +41,13 @@ Caveats (read before quoting a ratio):
   * gibench's CPU time includes its process start, scene load and output writing; Mitsuba's
     excludes everything but the render. This favours Mitsuba a little; the render-wall ratio
     shows the size of the effect.
+  * Raw rays: gibench's closest_hit returns a full hit record (normals, uv, material), Mitsuba's
+    ray_intersect_preliminary only the distance, primitive and barycentrics; Mitsuba casts all
+    rays as one vectorised wavefront (Embree's packet or stream traversal under Dr.Jit), gibench
+    one ray at a time per thread.
   * Both use every core of the machine; run on an otherwise idle machine.
 """
-import argparse, glob, json, os, re, resource, statistics, subprocess, sys, tempfile, time
+import argparse, array, glob, json, os, re, resource, statistics, subprocess, sys, tempfile, time
 from pathlib import Path
 
 INSTALL = """Mitsuba 3 is not usable here; to install it:
@@ -160,10 +171,77 @@ def spread(values):
     return {"median": statistics.median(values), "min": min(values), "max": max(values)}
 
 
+def read_rays(mi, path):
+    """A ray file of `gibench export-scene --rays` as one Mitsuba Ray3f (origin, direction,
+    maxt; seven little-endian float32 per ray) and the ray count."""
+    a = array.array("f")
+    a.frombytes(Path(path).read_bytes())
+    if sys.byteorder != "little":
+        a.byteswap()
+    col = lambda k: mi.Float(a[k::7])
+    ray = mi.Ray3f(mi.Point3f(col(0), col(1), col(2)), mi.Vector3f(col(3), col(4), col(5)))
+    ray.maxt = col(6)
+    return ray, len(a) // 7
+
+
+def mitsuba_cast(dr, scene, ray, shadow):
+    """Wall and CPU seconds of one cast of every ray (ray_test or ray_intersect_preliminary,
+    evaluated and synchronised inside), and its per-ray result."""
+    wall, cpu = time.perf_counter(), time.process_time()
+    if shadow:
+        out = scene.ray_test(ray)
+    else:
+        out = scene.ray_intersect_preliminary(ray, coherent=False).t
+    dr.eval(out)
+    dr.sync_thread()
+    return {"wall_s": time.perf_counter() - wall, "cpu_s": time.process_time() - cpu}, out
+
+
+def agreement(dr, gib_dir, closest_t, shadow_hit, n):
+    """Fractions of rays on which gibench and Mitsuba agree: shadow rays blocked or not;
+    closest-hit rays both missing, or both hitting at distances within 10^-3 (relative)."""
+    g = array.array("f")
+    g.frombytes((Path(gib_dir) / "closest-t.bin").read_bytes())
+    m = list(closest_t)
+    big = 1e30
+    same_t = sum(1 for a, b in zip(g, m)
+                 if (a > big and b > big) or (a <= big and b <= big and abs(a - b) <= 1e-3 * max(a, 1e-3)))
+    gs = (Path(gib_dir) / "shadow-hit.bin").read_bytes()
+    same_s = sum(1 for a, b in zip(gs, list(shadow_hit)) if bool(a) == bool(b))
+    return {"closest_same": same_t / n, "shadow_same": same_s / n}
+
+
+def compare_rays(args, mi, dr, name, scene, export, tmp):
+    """Raw ray throughput on the same rays: `gibench raycast` against Mitsuba's (Embree's)
+    ray_intersect_preliminary and ray_test, alternated `--repeats` times."""
+    closest, n = read_rays(mi, export / "rays-closest.bin")
+    shadow, _ = read_rays(mi, export / "rays-shadow.bin")
+    warm = {"closest": mitsuba_cast(dr, scene, closest, False)[0],
+            "shadow": mitsuba_cast(dr, scene, shadow, True)[0]}
+    runs = []
+    for i in range(args.repeats):
+        out = Path(tmp) / f"raycast{i}"
+        run([args.gibench, "raycast", "--rays", str(export), "--repeats", "1", "--out", str(out)])
+        g = json.loads((out / "raycast.json").read_text())["passes"][0]
+        mc, t = mitsuba_cast(dr, scene, closest, False)
+        ms, hit = mitsuba_cast(dr, scene, shadow, True)
+        one = {"gibench": g, "mitsuba": {"closest": mc, "shadow": ms}}
+        for kind, m in (("closest", mc), ("shadow", ms)):
+            one[f"{kind}_gibench_rays_per_cpu_s"] = n / g[f"{kind}_cpu_s"]
+            one[f"{kind}_mitsuba_rays_per_cpu_s"] = n / m["cpu_s"]
+            one[f"{kind}_ratio_cpu"] = one[f"{kind}_gibench_rays_per_cpu_s"] / one[f"{kind}_mitsuba_rays_per_cpu_s"]
+        print(f"  {name} rays #{i + 1}: closest ratio {one['closest_ratio_cpu']:.3f}, "
+              f"shadow ratio {one['shadow_ratio_cpu']:.3f}", flush=True)
+        runs.append(one)
+    agree = agreement(dr, out, t, hit, n)
+    summary = {k: spread([r[k] for r in runs]) for k in runs[0] if k.endswith(("_s", "_cpu"))}
+    return {"rays": n, "mitsuba_warmup": warm, "runs": runs, "agreement": agree, "summary": summary}
+
+
 def compare_scene(args, mi, dr, name, w, h, tmp):
     export = Path(tmp) / "export"
     run([args.gibench, "export-scene", "--scene", name, "--frame", "0",
-         "--resolution", f"{w}x{h}", "--out", str(export)])
+         "--resolution", f"{w}x{h}", "--rays", str(args.rays), "--out", str(export)])
     meta = json.loads((export / "scene.json").read_text())
     load = time.perf_counter()
     scene = mi.load_dict(scene_dict(mi, meta, export, args.spp))
@@ -172,6 +250,7 @@ def compare_scene(args, mi, dr, name, w, h, tmp):
     # so a 1-spp warm-up leaves the compilation inside the first timed render: warm up at 2.
     warm_spp = min(args.spp, 2)
     warmup = dict(mitsuba_render(mi, dr, scene, warm_spp), spp=warm_spp)
+    rays = compare_rays(args, mi, dr, name, scene, export, tmp) if args.rays > 0 else None
     samples, runs = w * h * args.spp, []
     for i in range(args.repeats):
         g = gibench_render(args, name, w, h, Path(tmp) / f"ref{i}")
@@ -192,7 +271,8 @@ def compare_scene(args, mi, dr, name, w, h, tmp):
     if all("ratio_render_wall" in r for r in runs):
         summary["ratio_render_wall"] = spread([r["ratio_render_wall"] for r in runs])
     return {"scene": name, "triangles": meta.get("triangles"), "light_kind": meta["light"]["kind"],
-            "mitsuba_load_s": load, "mitsuba_warmup": warmup, "runs": runs, "summary": summary}
+            "mitsuba_load_s": load, "mitsuba_warmup": warmup, "runs": runs, "summary": summary,
+            "raw_rays": rays}
 
 
 def main():
@@ -204,6 +284,8 @@ def main():
     p.add_argument("--out", default="results/perf")
     p.add_argument("--gibench", default="target/release/gibench")
     p.add_argument("--variant", default="llvm_ad_rgb")
+    p.add_argument("--rays", type=int, default=262144,
+                   help="closest-hit and shadow rays of the raw throughput comparison (0: none)")
     args = p.parse_args()
     w, h = (int(v) for v in args.resolution.lower().split("x"))
     llvm = newest_llvm() if args.variant.startswith("llvm") else None
@@ -225,6 +307,9 @@ def main():
                              "RUSAGE_CHILDREN); its sidecar 'seconds' (render call incl. BVH "
                              "build, wall) gives ratio_render_wall",
               "mitsuba_cpu": "time.process_time around mi.render + dr.eval + dr.sync_thread"}
+    git = subprocess.run(["git", "describe", "--always", "--dirty", "--abbrev=7"],
+                         capture_output=True, text=True, cwd=Path(__file__).resolve().parent)
+    common["gibench_git_commit"] = git.stdout.strip() or None
     out = Path(args.out)
     results = []
     for name in [s.strip() for s in args.scenes.split(",") if s.strip()]:
@@ -236,7 +321,7 @@ def main():
         results.append(r)
     rng = lambda s: f"{s['median']:.3f} [{s['min']:.3f}–{s['max']:.3f}]"
     lines = [f"# gibench reference vs Mitsuba {mi.__version__} ({args.variant}, drjit "
-             f"{dr.__version__})", "",
+             f"{dr.__version__}), gibench commit {common['gibench_git_commit']}", "",
              f"{w}x{h}, {args.spp} spp, {BOUNCES} indirect bounces (Mitsuba max_depth "
              f"{MAX_DEPTH}, no Russian roulette), {os.cpu_count()} CPUs, {args.repeats} "
              "alternations; samples = width x height x spp.", "",
@@ -253,6 +338,27 @@ def main():
               "(BVH build included) against Mitsuba's render wall time.", "",
               f"Light: {LIGHT_NOTE}", "", "Per sample gibench traces 16 rays (+2 per pixel), "
               f"Mitsuba 19 (max_depth {MAX_DEPTH}); see scripts/compare_mitsuba.py for caveats."]
+    if args.rays > 0:
+        lines += ["", "## Raw ray throughput on the same rays", "",
+                  f"{args.rays:,} closest-hit and {args.rays:,} shadow rays per scene (`gibench "
+                  "export-scene --rays`: from primary hits, cosine-distributed like the "
+                  "reference's path segments, and segments to the light), each caster over all "
+                  f"cores, {args.repeats} alternations. gibench: `SceneBvh::closest_hit` (full hit "
+                  "record) and `any_hit` (`gibench raycast`, CPU of every thread during the cast); "
+                  "Mitsuba: `ray_intersect_preliminary` and `ray_test` (Embree), CPU of the "
+                  "process during the cast, after a warm-up cast.", "",
+                  "| scene | rays | gibench closest rays/CPU-s | Mitsuba closest rays/CPU-s | "
+                  "closest ratio, median [min–max] | gibench shadow rays/CPU-s | Mitsuba shadow "
+                  "rays/CPU-s | shadow ratio, median [min–max] | agreement closest / shadow |",
+                  "|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
+        for r in results:
+            q = r["raw_rays"]
+            s = q["summary"]
+            lines.append(f"| {r['scene']} | {q['rays']:,} | {s['closest_gibench_rays_per_cpu_s']['median']:,.0f}"
+                         f" | {s['closest_mitsuba_rays_per_cpu_s']['median']:,.0f} | {rng(s['closest_ratio_cpu'])}"
+                         f" | {s['shadow_gibench_rays_per_cpu_s']['median']:,.0f}"
+                         f" | {s['shadow_mitsuba_rays_per_cpu_s']['median']:,.0f} | {rng(s['shadow_ratio_cpu'])}"
+                         f" | {q['agreement']['closest_same']:.4f} / {q['agreement']['shadow_same']:.4f} |")
     (out / "mitsuba.md").write_text("\n".join(lines) + "\n")
     print(f"wrote {out}/mitsuba.md and mitsuba-<scene>.json")
     return 0

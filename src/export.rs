@@ -1,7 +1,8 @@
 //! `gibench export-scene`: one frame of a scene as plain files another renderer can load — a
 //! binary PLY of the frame's triangles per material (world space, movers placed) and
-//! `scene.json` with the camera, the light and each material's albedo. Used by
-//! `scripts/compare_mitsuba.py` to render the reference's scene in Mitsuba 3.
+//! `scene.json` with the camera, the light and each material's albedo; with `--rays N` also the
+//! ray sets of [`crate::rays`]. Used by `scripts/compare_mitsuba.py` to render the reference's
+//! scene in Mitsuba 3 and to cast the same rays there.
 
 use std::path::PathBuf;
 
@@ -28,6 +29,10 @@ pub(crate) struct ExportArgs {
     /// Extra directory searched first for scene assets.
     #[arg(long)]
     assets: Option<PathBuf>,
+    /// Also write this many closest-hit and this many shadow rays for `gibench raycast` and
+    /// another ray caster (`rays-closest.bin`, `rays-shadow.bin`; see `src/rays.rs`).
+    #[arg(long, default_value_t = 0)]
+    rays: u32,
 }
 
 /// One material's triangles: their corners, the triangles as indices into them, and the map
@@ -89,7 +94,18 @@ pub(crate) fn export_scene(args: &ExportArgs) -> Result<()> {
         }
         tris.push(tri);
     }
+    let rays = if args.rays > 0 {
+        Some(crate::rays::make_rays(
+            &scene, &frame, resolution, args.rays,
+        )?)
+    } else {
+        None
+    };
     let set = OutputSet::begin("out", &args.out)?;
+    if let Some((closest, shadow)) = &rays {
+        gibench_harness::error::write_atomic(&args.out.join(crate::rays::CLOSEST), closest)?;
+        gibench_harness::error::write_atomic(&args.out.join(crate::rays::SHADOW), shadow)?;
+    }
     let mut materials = Vec::new();
     for (k, ((positions, tris, _), material)) in groups.iter().zip(&scene.materials).enumerate() {
         if tris.is_empty() {
@@ -105,7 +121,8 @@ pub(crate) fn export_scene(args: &ExportArgs) -> Result<()> {
     let c = &frame.camera;
     let l = &frame.light;
     let json = serde_json::json!({
-        "scene": desc.name, "frame": args.frame, "resolution": resolution,
+        "scene": desc.name, "scene_argument": args.scene, "frame": args.frame, "resolution": resolution,
+        "rays": args.rays,
         "triangles": mesh.indices.len() / 3,
         "camera": {
             "origin": c.position.to_array(), "target": c.target.to_array(), "up": c.up.to_array(),

@@ -2,6 +2,7 @@
 //! frames and timing harness, and render their per-stage timing tables.
 
 mod export;
+mod rays;
 mod registry;
 mod reproduce;
 
@@ -60,6 +61,9 @@ enum Command {
     /// Write one frame of a scene as PLY meshes per material and a JSON of its camera, light
     /// and albedos, for another renderer (`scripts/compare_mitsuba.py`).
     ExportScene(export::ExportArgs),
+    /// Time the reference's BVH on the rays of `export-scene --rays N` (closest hit and shadow
+    /// rays, wall and CPU time), for `scripts/compare_mitsuba.py --rays`.
+    Raycast(rays::RaycastArgs),
 }
 
 #[derive(Args)]
@@ -302,6 +306,7 @@ fn main() -> ExitCode {
         Some(Command::Compare(args)) => compare_cmd(&args),
         Some(Command::Instructions(args)) => instructions_cmd(&args),
         Some(Command::ExportScene(args)) => export::export_scene(&args),
+        Some(Command::Raycast(args)) => rays::raycast(&args),
         Some(Command::Reproduce(args)) => reproduce::reproduce(&args),
     };
     match outcome {

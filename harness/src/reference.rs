@@ -294,7 +294,7 @@ fn basis(n: Vec3) -> (Vec3, Vec3) {
 
 /// Cosine-weighted direction around unit `n` from `u` in [0, 1)² (concentric disk mapping,
 /// which keeps strata compact).
-fn cosine_direction(n: Vec3, u: Vec2) -> Vec3 {
+pub fn cosine_direction(n: Vec3, u: Vec2) -> Vec3 {
     let a = 2.0 * u - Vec2::ONE;
     let (r, phi) = if a.x == 0.0 && a.y == 0.0 {
         (0.0, 0.0)

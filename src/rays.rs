@@ -1,0 +1,279 @@
+//! Raw ray throughput of the reference's BVH on a fixed set of rays that another ray caster can
+//! trace too (`scripts/compare_mitsuba.py --rays`: Mitsuba 3, i.e. Embree).
+//!
+//! `gibench export-scene --rays N` writes two ray files beside the scene: `rays-closest.bin`,
+//! N rays like the reference's path segments (from a primary hit, offset by the reference's ε
+//! along the geometric normal, cosine-distributed about the shading normal; closest hit), and
+//! `rays-shadow.bin`, N segments from those origins to the light (any hit). Each ray is seven
+//! little-endian `f32`: origin xyz, direction xyz, t_max (t_min is 0; a shadow ray's direction
+//! is the whole segment, t_max just below 1; a closest-hit ray's t_max is +∞).
+//!
+//! `gibench raycast --rays DIR` loads the same frame (scene and frame from `DIR/scene.json`),
+//! builds the reference's BVH and casts both sets `--repeats` times across all cores, timing
+//! each pass by wall clock and by the CPU time of every thread; it writes `raycast.json` and,
+//! for checking agreement with the other caster, `closest-t.bin` (one `f32` distance per
+//! closest-hit ray, +∞ for a miss) and `shadow-hit.bin` (one byte per shadow ray, 1 = blocked).
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use clap::Args;
+use gibench_harness::anim::FrameClock;
+use gibench_harness::assets::AssetPaths;
+use gibench_harness::calibrate::process_cpu_ms;
+use gibench_harness::glam::{Vec2, Vec3};
+use gibench_harness::output::OutputSet;
+use gibench_harness::reference::{camera_ray, cosine_direction, ReferenceTracer};
+use gibench_harness::scene::descriptor::LightKind;
+use gibench_harness::scene::{Scene, SceneDescriptor};
+use gibench_harness::{Error, Result};
+use rayon::prelude::*;
+
+/// File of the closest-hit rays.
+pub(crate) const CLOSEST: &str = "rays-closest.bin";
+/// File of the shadow rays.
+pub(crate) const SHADOW: &str = "rays-shadow.bin";
+/// Bytes per ray: seven `f32`.
+const RAY_BYTES: usize = 28;
+
+/// One ray as stored.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Ray {
+    origin: Vec3,
+    dir: Vec3,
+    t_max: f32,
+}
+
+/// A uniform number in [0, 1) from `k` (SplitMix64's finaliser; the rays need only be fixed
+/// and well spread, not the reference's sampler).
+fn uniform(k: u64) -> f32 {
+    let mut z = k.wrapping_add(0x9e37_79b9_7f4a_7c15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^= z >> 31;
+    (z >> 40) as f32 / (1u64 << 24) as f32
+}
+
+/// The two ray sets of `count` rays each for `frame` of `scene` seen at `resolution`: the
+/// reference's BVH and ε, its camera rays and its cosine sampling (see the module docs).
+pub(crate) fn make_rays(
+    scene: &Scene,
+    frame: &gibench_harness::anim::FrameState,
+    resolution: [u32; 2],
+    count: u32,
+) -> Result<(Vec<u8>, Vec<u8>)> {
+    let tracer = ReferenceTracer::new(scene, frame);
+    let (bvh, eps) = (tracer.bvh(), tracer.epsilon());
+    let [w, h] = resolution;
+    // The primary hits, in pixel order: (point, geometric normal, shading normal).
+    let hits: Vec<(Vec3, Vec3, Vec3)> = (0..w * h)
+        .into_par_iter()
+        .filter_map(|i| {
+            let (origin, dir) = camera_ray(frame, resolution, i % w, i / w);
+            let hit = bvh.closest_hit(origin, dir, 0.0, f32::INFINITY)?;
+            Some((hit.position, hit.geometric_normal, hit.shading_normal))
+        })
+        .collect();
+    if hits.is_empty() {
+        return Err(Error::param(
+            "rays",
+            "no pixel of the frame sees the scene, so there is nowhere to start rays from",
+        ));
+    }
+    let light = &frame.light;
+    let far = 2.0 * scene.extent.diagonal;
+    let mut closest = Vec::with_capacity(count as usize * RAY_BYTES);
+    let mut shadow = Vec::with_capacity(count as usize * RAY_BYTES);
+    for k in 0..count as u64 {
+        let (p, ng, ns) = hits[(uniform(3 * k) * hits.len() as f32) as usize % hits.len()];
+        let u = Vec2::new(uniform(3 * k + 1), uniform(3 * k + 2));
+        let mut dir = cosine_direction(ns, u);
+        if dir.dot(ng) <= 0.0 {
+            dir = cosine_direction(ng, u);
+        }
+        let origin = p + ng * eps;
+        let to_light = match light.kind {
+            LightKind::Sun => -light.direction.normalize_or(Vec3::NEG_Y) * far,
+            _ => light.position - origin,
+        };
+        for (out, ray) in [
+            (
+                &mut closest,
+                Ray {
+                    origin,
+                    dir,
+                    t_max: f32::INFINITY,
+                },
+            ),
+            (
+                &mut shadow,
+                Ray {
+                    origin,
+                    dir: to_light,
+                    t_max: 1.0 - 1e-4,
+                },
+            ),
+        ] {
+            for c in ray.origin.to_array().into_iter().chain(ray.dir.to_array()) {
+                out.extend_from_slice(&c.to_le_bytes());
+            }
+            out.extend_from_slice(&ray.t_max.to_le_bytes());
+        }
+    }
+    Ok((closest, shadow))
+}
+
+/// Reads a ray file, refusing one whose size is not a whole, non-zero number of rays.
+fn read_rays(path: &Path) -> Result<Vec<Ray>> {
+    let bytes = std::fs::read(path)
+        .map_err(|e| Error::param("rays", format!("cannot read {}: {e}", path.display())))?;
+    if bytes.is_empty() || bytes.len() % RAY_BYTES != 0 {
+        return Err(Error::param(
+            "rays",
+            format!(
+                "{}: {} bytes is not a whole number of rays ({RAY_BYTES} bytes each, at least one)",
+                path.display(),
+                bytes.len()
+            ),
+        ));
+    }
+    let f = |b: &[u8], i: usize| {
+        f32::from_le_bytes([b[4 * i], b[4 * i + 1], b[4 * i + 2], b[4 * i + 3]])
+    };
+    Ok(bytes
+        .chunks_exact(RAY_BYTES)
+        .map(|b| Ray {
+            origin: Vec3::new(f(b, 0), f(b, 1), f(b, 2)),
+            dir: Vec3::new(f(b, 3), f(b, 4), f(b, 5)),
+            t_max: f(b, 6),
+        })
+        .collect())
+}
+
+#[derive(Args)]
+pub(crate) struct RaycastArgs {
+    /// Folder written by `export-scene --rays N` (`scene.json`, `rays-closest.bin`,
+    /// `rays-shadow.bin`); the scene and frame are the ones it records.
+    #[arg(long)]
+    rays: PathBuf,
+    /// Timed passes over each ray set.
+    #[arg(long, default_value_t = 3)]
+    repeats: u32,
+    /// Output directory (`raycast.json`, `closest-t.bin`, `shadow-hit.bin`).
+    #[arg(long)]
+    out: PathBuf,
+    /// Extra directory searched first for scene assets.
+    #[arg(long)]
+    assets: Option<PathBuf>,
+}
+
+/// Wall and CPU (every thread) seconds of `f`, and its result.
+fn timed<T>(f: impl FnOnce() -> T) -> (T, f64, Option<f64>) {
+    let (c0, t0) = (process_cpu_ms(), Instant::now());
+    let out = f();
+    let wall = t0.elapsed().as_secs_f64();
+    let cpu = c0.zip(process_cpu_ms()).map(|(a, b)| (b - a) * 1e-3);
+    (out, wall, cpu)
+}
+
+pub(crate) fn raycast(args: &RaycastArgs) -> Result<()> {
+    if args.repeats == 0 {
+        return Err(Error::param("repeats", "must be at least 1"));
+    }
+    let meta_path = args.rays.join("scene.json");
+    let meta: serde_json::Value = std::fs::read(&meta_path)
+        .map_err(|e| Error::param("rays", format!("cannot read {}: {e}", meta_path.display())))
+        .and_then(|b| {
+            serde_json::from_slice(&b).map_err(|e| {
+                Error::param("rays", format!("{}: not JSON: {e}", meta_path.display()))
+            })
+        })?;
+    let field = |name: &str| {
+        meta.get(name).ok_or_else(|| {
+            Error::param(
+                "rays",
+                format!("{}: no field '{name}'", meta_path.display()),
+            )
+        })
+    };
+    let scene_arg = field("scene_argument")?
+        .as_str()
+        .ok_or_else(|| {
+            Error::param(
+                "rays",
+                format!("{}: 'scene_argument' is not a string", meta_path.display()),
+            )
+        })?
+        .to_string();
+    let frame_index = field("frame")?
+        .as_u64()
+        .and_then(|f| u32::try_from(f).ok())
+        .ok_or_else(|| {
+            Error::param(
+                "rays",
+                format!("{}: 'frame' is not a frame number", meta_path.display()),
+            )
+        })?;
+    let closest = read_rays(&args.rays.join(CLOSEST))?;
+    let shadow = read_rays(&args.rays.join(SHADOW))?;
+    crate::writable_dir("out", &args.out)?;
+    let desc = SceneDescriptor::resolve(&scene_arg)?;
+    let scene = Scene::load(&desc, &AssetPaths::standard(args.assets.as_deref()))?;
+    let frame = FrameClock::new(&desc).frame(frame_index);
+    let (tracer, build_wall, _) = timed(|| ReferenceTracer::new(&scene, &frame));
+    let bvh = tracer.bvh();
+    let mut passes = Vec::new();
+    let mut last = None;
+    for _ in 0..args.repeats {
+        let (t, cw, cc) = timed(|| {
+            closest
+                .par_iter()
+                .with_min_len(256)
+                .map(|r| {
+                    bvh.closest_hit(r.origin, r.dir, 0.0, r.t_max)
+                        .map_or(f32::INFINITY, |h| h.t)
+                })
+                .collect::<Vec<f32>>()
+        });
+        let (s, sw, sc) = timed(|| {
+            shadow
+                .par_iter()
+                .with_min_len(256)
+                .map(|r| bvh.any_hit(r.origin, r.dir, 0.0, r.t_max))
+                .collect::<Vec<bool>>()
+        });
+        passes.push(serde_json::json!({
+            "closest_wall_s": cw, "closest_cpu_s": cc, "shadow_wall_s": sw, "shadow_cpu_s": sc,
+        }));
+        last = Some((t, s));
+    }
+    let (t, s) = last.expect("at least one pass");
+    let set = OutputSet::begin("out", &args.out)?;
+    let t_bytes: Vec<u8> = t.iter().flat_map(|x| x.to_le_bytes()).collect();
+    gibench_harness::error::write_atomic(&args.out.join("closest-t.bin"), &t_bytes)?;
+    let s_bytes: Vec<u8> = s.iter().map(|&b| b as u8).collect();
+    gibench_harness::error::write_atomic(&args.out.join("shadow-hit.bin"), &s_bytes)?;
+    let json = serde_json::json!({
+        "scene": desc.name, "frame": frame_index, "git_commit": gibench_harness::runner::git_commit(),
+        "threads": rayon::current_num_threads(),
+        "tree_triangles": bvh.tree_triangle_count(), "bvh_build_wall_s": build_wall,
+        "closest_rays": closest.len(), "closest_hits": t.iter().filter(|x| x.is_finite()).count(),
+        "shadow_rays": shadow.len(), "shadow_blocked": s.iter().filter(|&&b| b).count(),
+        "passes": passes,
+        "notes": "closest: SceneBvh::closest_hit (the full hit record: distance, barycentrics, \
+                  normals, uv, material); shadow: SceneBvh::any_hit. CPU: every thread of the \
+                  process during the pass (rayon over all cores).",
+    });
+    let bytes = serde_json::to_vec_pretty(&json).map_err(|e| Error::Invalid(e.to_string()))?;
+    gibench_harness::error::write_atomic(&args.out.join("raycast.json"), &bytes)?;
+    set.publish()?;
+    eprintln!(
+        "raycast: {} closest-hit and {} shadow rays on '{}', {} passes: wrote {}",
+        closest.len(),
+        shadow.len(),
+        desc.name,
+        args.repeats,
+        args.out.join("raycast.json").display()
+    );
+    Ok(())
+}
