@@ -3,12 +3,14 @@
 //! delete + insert, the largest empty circle, the Voronoi areas; Laine's whole VPL management
 //! per frame, spot and omni; VPL generation (Keller's light paths); the reference path tracer
 //! (one path per pixel); ISM's point pool — and one whole frame of each registered technique on the Cornell box
-//! (GPU, flushed per frame).
+//! (GPU, flushed per frame). Laine's management and the reference, whose work runs across cores,
+//! are also measured by CPU time (every thread of the process: `…-cpu/…`), beside wall time.
 //!
 //! `cargo bench` runs them; `cargo bench -- rays` runs a subset; `cargo test --benches` (CI)
 //! runs each once as a test.
 
-use criterion::{criterion_group, criterion_main, Criterion};
+use criterion::measurement::{Measurement, ValueFormatter};
+use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use gibench_harness::assets::AssetPaths;
 use gibench_harness::glam::Vec3;
 use gibench_harness::gpu::{GpuContext, GpuOptions};
@@ -18,6 +20,81 @@ use gibench_harness::scene::Scene;
 
 #[path = "../src/registry.rs"]
 mod registry;
+
+/// A criterion measurement: the CPU time of every thread of the process, in nanoseconds (where
+/// the platform has no such clock it reads 0 and the bench says so).
+struct ProcessCpuTime;
+
+impl Measurement for ProcessCpuTime {
+    type Intermediate = f64;
+    type Value = f64;
+
+    fn start(&self) -> f64 {
+        gibench_harness::calibrate::process_cpu_ms().unwrap_or(0.0)
+    }
+
+    fn end(&self, start: f64) -> f64 {
+        (self.start() - start) * 1e6
+    }
+
+    fn add(&self, a: &f64, b: &f64) -> f64 {
+        a + b
+    }
+
+    fn zero(&self) -> f64 {
+        0.0
+    }
+
+    fn to_f64(&self, v: &f64) -> f64 {
+        *v
+    }
+
+    fn formatter(&self) -> &dyn ValueFormatter {
+        &CpuFormatter
+    }
+}
+
+/// Formats CPU nanoseconds as "ns/µs/ms/s (CPU)".
+struct CpuFormatter;
+
+impl ValueFormatter for CpuFormatter {
+    fn scale_values(&self, typical: f64, values: &mut [f64]) -> &'static str {
+        let (factor, unit) = if typical < 1e3 {
+            (1.0, "ns CPU")
+        } else if typical < 1e6 {
+            (1e-3, "µs CPU")
+        } else if typical < 1e9 {
+            (1e-6, "ms CPU")
+        } else {
+            (1e-9, "s CPU")
+        };
+        for v in values {
+            *v *= factor;
+        }
+        unit
+    }
+
+    fn scale_throughputs(
+        &self,
+        _: f64,
+        throughput: &Throughput,
+        values: &mut [f64],
+    ) -> &'static str {
+        let per = match *throughput {
+            Throughput::Bytes(n) | Throughput::BytesDecimal(n) | Throughput::Bits(n) => n as f64,
+            Throughput::Elements(n) => n as f64,
+            Throughput::ElementsAndBytes { elements, .. } => elements as f64,
+        };
+        for v in values {
+            *v = per * 1e9 / *v;
+        }
+        "per CPU-second"
+    }
+
+    fn scale_for_machines(&self, _: &mut [f64]) -> &'static str {
+        "ns CPU"
+    }
+}
 
 fn rays(c: &mut Criterion) {
     let assets = AssetPaths::standard(None);
@@ -135,6 +212,16 @@ fn point_pool(c: &mut Criterion) {
 
 /// The reference path tracer: one path per pixel (8 bounces) over a 64x48 image of Cornell.
 fn reference_paths(c: &mut Criterion) {
+    reference_paths_by(c, "reference");
+}
+
+fn reference_paths_cpu(c: &mut Criterion<ProcessCpuTime>) {
+    reference_paths_by(c, "reference-cpu");
+}
+
+/// The reference path tracer, one 8-bounce path per pixel of a 64x48 Cornell frame, as bench
+/// group `group` under measurement `M`.
+fn reference_paths_by<M: Measurement + 'static>(c: &mut Criterion<M>, group: &str) {
     let scene =
         Scene::load_named("cornell", &AssetPaths::standard(None)).expect("cornell is generated");
     let frame = gibench_harness::anim::FrameClock::new(&scene.descriptor).frame(0);
@@ -143,7 +230,7 @@ fn reference_paths(c: &mut Criterion) {
         bounces: 8,
         seed: 0,
     };
-    c.bench_function("reference/1-path-per-pixel-64x48/cornell", |b| {
+    c.bench_function(&format!("{group}/1-path-per-pixel-64x48/cornell"), |b| {
         b.iter(|| gibench_harness::reference::render_reference(&scene, &frame, [64, 48], &settings))
     });
 }
@@ -152,6 +239,15 @@ fn reference_paths(c: &mut Criterion) {
 /// and omni, at 256 and 1024 VPLs, with the light moving along Sibenik's path (Cornell if
 /// Sibenik is not on the asset path).
 fn laine_management(c: &mut Criterion) {
+    laine_management_by(c, "laine-management");
+}
+
+fn laine_management_cpu(c: &mut Criterion<ProcessCpuTime>) {
+    laine_management_by(c, "laine-management-cpu");
+}
+
+/// [`laine_management`] as bench group `group` under measurement `M`.
+fn laine_management_by<M: Measurement + 'static>(c: &mut Criterion<M>, group: &str) {
     use gibench_harness::scene::descriptor::LightKind;
     let assets = AssetPaths::standard(None);
     let scene = Scene::load_named("sibenik", &assets)
@@ -167,7 +263,7 @@ fn laine_management(c: &mut Criterion) {
             m.step(&scene, &bvh, clock.frame(0).light);
             let mut frame = 1;
             let name = format!(
-                "laine-management/{}-{vpls}/{}",
+                "{group}/{}-{vpls}/{}",
                 format!("{kind:?}").to_lowercase(),
                 desc.name
             );
@@ -223,4 +319,9 @@ criterion_group! {
     config = Criterion::default().sample_size(20);
     targets = rays, domains, laine_management, vpl_generation, point_pool, reference_paths, frames
 }
-criterion_main!(benches);
+criterion_group! {
+    name = cpu_benches;
+    config = Criterion::default().with_measurement(ProcessCpuTime).sample_size(20);
+    targets = laine_management_cpu, reference_paths_cpu
+}
+criterion_main!(benches, cpu_benches);
