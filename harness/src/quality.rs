@@ -103,13 +103,17 @@ impl QualityConfig {
     }
 
     /// Label stored in the results, e.g. "one-bounce, 256 spp, seed 1".
+    /// The bounces are named only for the multi-bounce component (the others' names say it).
     pub fn label(&self) -> String {
         let s = self.reference_settings();
+        let bounces = match self.component() {
+            IndirectComponent::MultiBounce => format!("{} bounces, ", s.bounces),
+            IndirectComponent::OneBounce | IndirectComponent::Direct => String::new(),
+        };
         format!(
-            "{}, {} spp, {} bounces, seed {}",
+            "{}, {} spp, {bounces}seed {}",
             self.component().name(),
             s.spp,
-            s.bounces,
             s.seed
         )
     }
