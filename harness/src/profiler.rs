@@ -215,18 +215,24 @@ impl Profiler {
         }
     }
 
-    /// Runs a CPU stage and times it by wall clock.
+    /// Runs a CPU stage and times it by wall clock, and by CPU time: in stages mode that of
+    /// every thread of the process (the queue is idle between flushes, so that is the stage's
+    /// own work, across cores when it runs in parallel); in frame mode, where earlier frames'
+    /// GPU work may run beside it, the calling thread's.
     pub fn cpu_stage<R>(&mut self, name: &str, work: impl FnOnce() -> R) -> R {
         let idx = self.series_index(name, StageKind::Cpu);
-        let c0 = crate::calibrate::thread_cpu_ms();
+        let clock = match self.mode {
+            ProfileMode::Stages => crate::calibrate::process_cpu_ms,
+            ProfileMode::Frame => crate::calibrate::thread_cpu_ms,
+        };
+        let c0 = clock();
         let t0 = Instant::now();
         let r = work();
         if self.mode == ProfileMode::Frame {
             self.slow_down(name);
         }
         let ms = t0.elapsed().as_secs_f64() * 1e3 + self.added_ms(name);
-        if let (Some(c0), Some(c1), true) = (c0, crate::calibrate::thread_cpu_ms(), self.recording)
-        {
+        if let (Some(c0), Some(c1), true) = (c0, clock(), self.recording) {
             self.series[idx].cpu.push(c1 - c0);
         }
         self.record_wall(idx, ms);
