@@ -32,12 +32,8 @@ fn rays(path: &Path) -> Vec<[f32; 7]> {
         .collect()
 }
 
-#[test]
-fn exported_rays_are_what_the_docs_say_and_raycast_answers_them() {
-    let tmp = tempfile::tempdir().unwrap();
-    let (export, cast) = (tmp.path().join("export"), tmp.path().join("cast"));
-    let n = 2000;
-    let e = export.to_str().unwrap();
+/// `export-scene --scene cornell --rays n --out dir`.
+fn export_cornell(dir: &Path, n: usize) {
     ok(&[
         "export-scene",
         "--scene",
@@ -45,8 +41,17 @@ fn exported_rays_are_what_the_docs_say_and_raycast_answers_them() {
         "--rays",
         &n.to_string(),
         "--out",
-        e,
+        dir.to_str().unwrap(),
     ]);
+}
+
+#[test]
+fn exported_rays_are_what_the_docs_say_and_raycast_answers_them() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (export, cast) = (tmp.path().join("export"), tmp.path().join("cast"));
+    let n = 2000;
+    let e = export.to_str().unwrap();
+    export_cornell(&export, n);
     let meta: serde_json::Value =
         serde_json::from_slice(&std::fs::read(export.join("scene.json")).unwrap()).unwrap();
     let light: Vec<f32> = meta["light"]["position"]
@@ -126,15 +131,7 @@ fn bad_ray_folders_are_refused_by_name_and_write_nothing() {
     let tmp = tempfile::tempdir().unwrap();
     let export = tmp.path().join("export");
     let e = export.to_str().unwrap();
-    ok(&[
-        "export-scene",
-        "--scene",
-        "cornell",
-        "--rays",
-        "10",
-        "--out",
-        e,
-    ]);
+    export_cornell(&export, 10);
     let fails = |args: &[&str], expect: &[&str]| {
         let out = tmp.path().join("cast");
         let mut all = args.to_vec();
