@@ -1015,6 +1015,31 @@ impl SamplingDomain {
         self.largest_empty_circle().map_or(0.0, |(_, r)| r)
     }
 
+    /// The area of disc site `v`'s Voronoi region when it lies inside the unit disc: the
+    /// polygon of the circumcentres (`centres`, per face index) of the faces around `v`, each
+    /// in the disc (the region is convex, so then all of it is). `None` for a site on the
+    /// triangulation's hull (an unbounded region) or one whose region reaches the rim.
+    fn disc_inner_cell_area(&self, v: FixedVertexHandle, centres: &[Option<DVec2>]) -> Option<f64> {
+        let mut first = None;
+        let mut prev = DVec2::ZERO;
+        let mut twice = 0.0;
+        for e in self.tri.vertex(v).out_edges() {
+            let face = e.face();
+            face.as_inner()?;
+            let c = centres[face.fix().index()]?;
+            if c.length_squared() > 1.0 {
+                return None;
+            }
+            match first {
+                None => first = Some(c),
+                Some(_) => twice += prev.perp_dot(c),
+            }
+            prev = c;
+        }
+        twice += prev.perp_dot(first?);
+        Some(0.5 * twice.abs())
+    }
+
     /// The Voronoi region of disc site `v` ∩ the square [−2, 2]², counter-clockwise: the
     /// square clipped by the bisector of each Delaunay neighbour in turn.
     fn disc_cell<'s>(&self, v: FixedVertexHandle, scratch: &'s mut DiscCellScratch) -> &'s [DVec2] {
@@ -1179,9 +1204,11 @@ impl SamplingDomain {
     /// paper sets the VPL intensities before scaling them to the light's power.
     ///
     /// * Disc: the region clipped to the unit disc; the areas sum to π. Exact up to rounding:
-    ///   each cell is the square [−2, 2]² clipped by the bisectors of the site's Delaunay
-    ///   neighbours, and its intersection with the disc is summed analytically over its edges
-    ///   (triangle (0, a, b) ∩ disc: triangle pieces inside, circular sectors outside).
+    ///   a site off the hull whose faces' circumcentres all lie in the disc has the polygon of
+    ///   those circumcentres as its cell (shoelace area); any other cell is the square
+    ///   [−2, 2]² clipped by the bisectors of the site's Delaunay neighbours, its intersection
+    ///   with the disc summed analytically over its edges (triangle (0, a, b) ∩ disc: triangle
+    ///   pieces inside, circular sectors outside).
     /// * Sphere: the spherical area on the unit sphere; the areas sum to 4π. Each cell is the
     ///   spherical polygon of the circumcentres of the site's triangles in order, summed as a
     ///   fan of signed spherical triangles from the site (Van Oosterom–Strackee / l'Huilier);
@@ -1193,20 +1220,31 @@ impl SamplingDomain {
     /// In no particular order.
     pub fn voronoi_areas(&self) -> Vec<(u64, f64)> {
         match self.kind {
-            // One cell per site, in site order.
-            DomainKind::Disc => map_sites(
-                self.tri.num_vertices(),
-                DiscCellScratch::default,
-                |scratch, i| {
-                    let v = FixedVertexHandle::from_index(i);
-                    let poly = self.disc_cell(v, scratch);
-                    let n = poly.len();
-                    let area: f64 = (0..n)
-                        .map(|k| disc_triangle_area(poly[k], poly[(k + 1) % n]))
-                        .sum();
-                    (self.site_id(i), area)
-                },
-            ),
+            // One cell per site, in site order: from the circumcentres of its faces where the
+            // cell lies inside the disc, by clipping otherwise.
+            DomainKind::Disc => {
+                let centres: Vec<Option<DVec2>> = self
+                    .tri
+                    .all_faces()
+                    .map(|f| f.as_inner().and_then(|f| self.disc_face_centre(f.fix())))
+                    .collect();
+                map_sites(
+                    self.tri.num_vertices(),
+                    DiscCellScratch::default,
+                    |scratch, i| {
+                        let v = FixedVertexHandle::from_index(i);
+                        if let Some(area) = self.disc_inner_cell_area(v, &centres) {
+                            return (self.site_id(i), area);
+                        }
+                        let poly = self.disc_cell(v, scratch);
+                        let n = poly.len();
+                        let area: f64 = (0..n)
+                            .map(|k| disc_triangle_area(poly[k], poly[(k + 1) % n]))
+                            .sum();
+                        (self.site_id(i), area)
+                    },
+                )
+            }
             DomainKind::Sphere => self.sphere_voronoi_areas(),
         }
     }
