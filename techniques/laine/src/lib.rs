@@ -244,18 +244,46 @@ impl Manager {
         let (extent, eps) = (&scene.extent, scene.extent.ray_epsilon);
         let mut deleted = 0;
         // 1. Validity, and the surviving VPLs' sampling points from the new light position.
-        let capacity = self.vpls.len() + self.misses.len() + self.max_lights as usize;
-        let mut domain = SamplingDomain::with_capacity(kind, capacity);
-        let mut kept = Vec::with_capacity(self.vpls.len());
-        // The validity rays, across cores (one per VPL, independent); then the domain in order.
+        // The validity rays, across cores (one per VPL, independent); likewise whether each
+        // missed sampling point (fixed relative to the light) still misses.
         let valid: Vec<bool> = self
             .vpls
             .par_iter()
             .map(|m| still_valid(bvh, &light, &m.vpl, eps))
             .collect();
-        for (m, valid) in self.vpls.drain(..).zip(valid) {
-            let sample = light.sample_of_point(m.vpl.position, extent);
-            if valid && domain.insert(m.id, sample.as_dvec3()).is_ok() {
+        let still_missing: Vec<bool> = self
+            .misses
+            .par_iter()
+            .map(|(_, sample)| {
+                let (origin, dir) = light.ray_of_sample(*sample, extent);
+                bvh.closest_hit(origin, dir, eps, f32::INFINITY).is_none()
+            })
+            .collect();
+        // The domain of the valid VPLs' new sampling points, then the misses that still
+        // miss, in that order: one bulk load (the points all moved with the light).
+        let samples: Vec<Vec3> = self
+            .vpls
+            .iter()
+            .map(|m| light.sample_of_point(m.vpl.position, extent))
+            .collect();
+        let mut sites = Vec::with_capacity(self.vpls.len() + self.misses.len());
+        // Per VPL and per miss, its index in `sites` if it is a candidate.
+        let mut add = |id: u64, sample: Vec3, ok: bool| {
+            ok.then(|| {
+                sites.push((id, sample.as_dvec3()));
+                sites.len() - 1
+            })
+        };
+        let site_of_vpl: Vec<Option<usize>> = (self.vpls.iter().zip(&samples).zip(&valid))
+            .map(|((m, s), ok)| add(m.id, *s, *ok))
+            .collect();
+        let site_of_miss: Vec<Option<usize>> = (self.misses.iter().zip(&still_missing))
+            .map(|((id, s), ok)| add(*id, *s, *ok))
+            .collect();
+        let (mut domain, accepted) = SamplingDomain::from_sites(kind, &sites);
+        let mut kept = Vec::with_capacity(self.vpls.len());
+        for ((m, sample), site) in self.vpls.drain(..).zip(samples).zip(site_of_vpl) {
+            if site.is_some_and(|k| accepted[k]) {
                 kept.push(Managed {
                     vpl: Vpl { sample, ..m.vpl },
                     ..m
@@ -267,18 +295,9 @@ impl Manager {
         }
         self.vpls = kept;
         // Missed sampling points stay (fixed relative to the light) while their ray still misses.
-        let still_missing: Vec<bool> = self
-            .misses
-            .par_iter()
-            .map(|(_, sample)| {
-                let (origin, dir) = light.ray_of_sample(*sample, extent);
-                bvh.closest_hit(origin, dir, eps, f32::INFINITY).is_none()
-            })
-            .collect();
-        let mut still_missing = still_missing.into_iter();
-        self.misses.retain(|(id, sample)| {
-            still_missing.next() == Some(true) && domain.insert(*id, sample.as_dvec3()).is_ok()
-        });
+        let mut site_of_miss = site_of_miss.into_iter();
+        self.misses
+            .retain(|_| site_of_miss.next().flatten().is_some_and(|k| accepted[k]));
         // 2. Deletion of redundant VPLs until recalc-min slots are free.
         while (self.free_slots.len() as u32) < self.recalc_min {
             let Some(id) = domain.deletion_candidate() else {

@@ -675,3 +675,81 @@ fn hinted_inserts_build_the_same_triangulation() {
         }
     }
 }
+
+/// Triangles as id triples, each rotated to start at its smallest id, sorted: the same set
+/// whatever order the triangulation numbers faces and corners in.
+fn canonical_triangles(d: &SamplingDomain) -> Vec<[u64; 3]> {
+    let mut t = d.triangles();
+    for tri in &mut t {
+        let k = (0..3).min_by_key(|&k| tri[k]).unwrap();
+        tri.rotate_left(k);
+    }
+    t.sort_unstable();
+    t
+}
+
+/// `from_sites` (the per-frame bulk load of the management) accepts and refuses exactly the
+/// sites that inserting them in order does — repeated ids, non-finite and (sphere) zero
+/// points, points equal to an earlier one (sphere: to the pole site, or projecting onto a
+/// projected site) — and builds the same Delaunay triangulation, largest empty circle,
+/// deletion candidate and Voronoi areas.
+#[test]
+fn bulk_built_domain_equals_the_inserted_one() {
+    for kind in [DomainKind::Disc, DomainKind::Sphere] {
+        for random in [true, false] {
+            let pts = point_set(kind, 300, random);
+            let mut sites: Vec<(u64, DVec3)> = pts
+                .iter()
+                .enumerate()
+                .map(|(i, p)| (i as u64 * 3 + 1, *p))
+                .collect();
+            // Every fifth disc point pushed outside the disc (moved onto the rim).
+            if kind == DomainKind::Disc {
+                for s in sites.iter_mut().step_by(5) {
+                    s.1 *= 2.0;
+                }
+            }
+            let first = sites[0];
+            sites.push((4, sites[7].1)); // an earlier site's point (the pole's on the sphere: 0)
+                                         // The first site's point again (on the sphere scaled: the pole, normalised).
+            let again = match kind {
+                DomainKind::Disc => first.1,
+                DomainKind::Sphere => first.1 * 3.0,
+            };
+            sites.push((5, again));
+            sites.push((sites[9].0, DVec3::new(0.01, 0.02, 0.5))); // a repeated id
+            sites.push((8, DVec3::new(f64::NAN, 0.0, 0.0)));
+            sites.push((11, DVec3::new(0.0, f64::INFINITY, 0.0)));
+            sites.push((14, DVec3::ZERO)); // the disc's centre; no point on the sphere
+            sites.push((17, DVec3::new(0.02, -0.03, 0.9)));
+            sites.insert(40, (2, sites[12].1)); // a duplicate before later sites
+            let mut inserted = SamplingDomain::new(kind);
+            let want: Vec<bool> = sites
+                .iter()
+                .map(|&(id, p)| inserted.insert(id, p).is_ok())
+                .collect();
+            assert!(want.iter().filter(|a| !**a).count() >= 6, "{kind:?}");
+            let (bulk, got) = SamplingDomain::from_sites(kind, &sites);
+            assert_eq!(got, want, "{kind:?} random {random}");
+            assert_eq!(bulk.len(), inserted.len());
+            let mut a = bulk.points();
+            let mut b = inserted.points();
+            a.sort_by_key(|p| p.0);
+            b.sort_by_key(|p| p.0);
+            assert_eq!(a, b);
+            assert_eq!(canonical_triangles(&bulk), canonical_triangles(&inserted));
+            let (cb, rb) = bulk.largest_empty_circle().unwrap();
+            let (ci, ri) = inserted.largest_empty_circle().unwrap();
+            assert!((cb - ci).length() < 1e-12 && (rb - ri).abs() < 1e-12);
+            assert_eq!(bulk.deletion_candidate(), inserted.deletion_candidate());
+            let mut va = bulk.voronoi_areas();
+            let mut vb = inserted.voronoi_areas();
+            va.sort_by_key(|p| p.0);
+            vb.sort_by_key(|p| p.0);
+            for ((ia, x), (ib, y)) in va.iter().zip(&vb) {
+                assert_eq!(ia, ib);
+                assert!((x - y).abs() < 1e-12, "{kind:?} site {ia}: {x} vs {y}");
+            }
+        }
+    }
+}
