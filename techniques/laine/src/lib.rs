@@ -21,7 +21,8 @@
 //! Deviations (also in the README): the sphere is triangulated on its surface (stereographic
 //! projection into `spade`) instead of with a 3D tetrahedralisation, as the paper's §6 asks for;
 //! the sampling points are re-derived from the VPLs' positions each frame and the triangulation
-//! rebuilt (the paper updates it incrementally; both give the same triangulation); the first
+//! rebuilt by one bulk load (the paper updates it incrementally; both give the same
+//! triangulation); the first
 //! frame fills all `vpls` slots (the paper does not describe start-up); intensities are
 //! normalised by the domain's area, and a sampling point whose ray left the scene stays in the
 //! domain (fixed relative to the light, re-tested each frame) so that its share of the power
