@@ -98,14 +98,24 @@ fn laine_management_records_spot_and_omni_at_256_and_1024() {
                 let get = |k: &str| stats[k].as_f64().unwrap_or(f64::NAN);
                 assert_eq!(stats["count"].as_u64(), Some(4), "{light}-{vpls}: {rec}");
                 assert!(get("median") > 0.0, "{light}-{vpls}: {rec}");
-                assert!(
-                    get("min") <= get("median") && get("median") <= get("max"),
-                    "{rec}"
-                );
             }
             assert!(
                 rec["fill_frame_wall_ms"].as_f64().unwrap_or(0.0) > 0.0,
                 "{rec}"
+            );
+            // The VPLs each timed frame managed: at most `vpls`, and most of them (the spot
+            // light's count drains as its rim points are invalidated: about 0.8 of the slots on
+            // the Cornell box after four frames; a sampling point whose ray misses makes no
+            // VPL), so each row times the VPL count it names.
+            let used = &rec["vpls_used"];
+            let (mean, min) = (
+                used["mean"].as_f64().unwrap(),
+                used["min"].as_f64().unwrap(),
+            );
+            assert_eq!(used["count"].as_u64(), Some(4), "{rec}");
+            assert!(
+                mean <= vpls as f64 && min >= 0.6 * vpls as f64,
+                "{light}-{vpls}: {used}"
             );
         }
     }

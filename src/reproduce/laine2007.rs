@@ -487,7 +487,8 @@ fn management(args: &ReproduceArgs) -> Result<Table> {
         for vpls in [256u32, 1024] {
             let mut m = gibench_laine::Manager::new(vpls, 4, 8);
             // Wall and CPU time (every thread of the process: the rays and Voronoi areas run
-            // across cores) of one step.
+            // across cores) of one step; then (untimed) the VPLs lighting the frame.
+            let mut used = Vec::with_capacity(frames as usize);
             let mut step = |f: u32| {
                 let light = clock.frame(f).light;
                 let c = gibench_harness::calibrate::process_cpu_ms();
@@ -495,10 +496,14 @@ fn management(args: &ReproduceArgs) -> Result<Table> {
                 m.step(&scene, &bvh, light);
                 let wall = t.elapsed().as_secs_f64() * 1e3;
                 let cpu = c.zip(gibench_harness::calibrate::process_cpu_ms());
+                if f > 0 {
+                    used.push(m.vpls().len() as f64);
+                }
                 (wall, cpu.map(|(a, b)| b - a))
             };
             let (fill, fill_cpu) = step(0);
             let (times, cpu): (Vec<f64>, Vec<Option<f64>>) = (1..=frames).map(&mut step).unzip();
+            let used = Stats::of(&used);
             let s = Stats::of(&times);
             let cpu: Option<Vec<f64>> = cpu.into_iter().collect();
             let c = cpu.as_deref().map(Stats::of);
@@ -507,6 +512,8 @@ fn management(args: &ReproduceArgs) -> Result<Table> {
                 Cell::text("gibench"),
                 Cell::text(&label),
                 Cell::Num(Some(vpls as f64), 0),
+                Cell::Num(Some(used.mean), 1),
+                Cell::Num(Some(used.min), 0),
                 Cell::Ms(Some(s.median)),
                 Cell::Ms(c.map(|c| c.median)),
                 Cell::Ms(Some(s.p99)),
@@ -517,6 +524,7 @@ fn management(args: &ReproduceArgs) -> Result<Table> {
                 format!("{label}-{vpls}"),
                 serde_json::json!({
                     "wall_ms": s, "cpu_ms": c, "fill_frame_wall_ms": fill, "fill_frame_cpu_ms": fill_cpu,
+                    "vpls_used": used,
                 }),
             );
         }
@@ -525,6 +533,8 @@ fn management(args: &ReproduceArgs) -> Result<Table> {
             Cell::text("Laine et al. 2007, §6 (Athlon 64, one core, CGAL)"),
             Cell::text(format!("{kind:?}").to_lowercase()),
             Cell::Num(Some(256.0), 0),
+            Cell::Num(None, 1),
+            Cell::Num(None, 0),
             Cell::text(format!("{}–{}", range[0], range[1])),
             Cell::Ms(None),
             Cell::Ms(None),
@@ -541,7 +551,7 @@ fn management(args: &ReproduceArgs) -> Result<Table> {
     gibench_harness::error::write_atomic(&out(args).join("laine-management.json"), &bytes)?;
     Ok(Table {
         title: format!("VPL management per frame on the CPU ({name}, {frames} frames, recalcMin 4, recalcMax 8)"),
-        columns: ["source", "light", "VPLs", "median ms", "median CPU ms", "p99 ms", "max ms", "fill frame ms"]
+        columns: ["source", "light", "VPLs", "VPLs used mean", "VPLs used min", "median ms", "median CPU ms", "p99 ms", "max ms", "fill frame ms"]
             .map(String::from)
             .into(),
         rows,
@@ -550,7 +560,9 @@ fn management(args: &ReproduceArgs) -> Result<Table> {
                 "gibench: validity rays, deletion, creation rays and Voronoi intensities of `laine`'s manager per frame \
                  after the first: wall time (median, p99, max) and CPU time of every thread (median; the validity and \
                  miss rays, and the Voronoi areas from 512 VPLs, run across the machine's {} cores, the triangulation and the \
-                 largest-empty-circle search on one). Fill frame: the first frame, which creates every VPL (wall). The \
+                 largest-empty-circle search on one). VPLs used: the VPLs lighting each frame after the first (a \
+                 sampling point whose ray misses makes none; deletions free recalcMin slots each frame). Fill frame: \
+                 the first frame, which creates every VPL (wall). The \
                  sphere is triangulated on its surface (no 3D tetrahedralisation).",
                 std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1)
             ),
