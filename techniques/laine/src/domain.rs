@@ -4,7 +4,8 @@
 //! `u64` id (e.g. the VPL's id), together with their Delaunay triangulation, maintained
 //! incrementally with [`spade`] (`insert` and `remove` update it; nothing is rebuilt per
 //! query), or built at once from a list of sites ([`SamplingDomain::from_sites`], a bulk load:
-//! what the management does each frame, when every point has moved with the light). Points use the convention of [`gibench_harness::vpl::Vpl::sample`]:
+//! what the management does each frame, when every point has moved with the light). Points use
+//! the convention of [`gibench_harness::vpl::Vpl::sample`]:
 //!
 //! * [`DomainKind::Disc`] (spot lights, Figure 3a/b): `(x, y, 0)` on the unit disc;
 //! * [`DomainKind::Sphere`] (omni lights, Figure 3c): a unit direction.
@@ -423,8 +424,8 @@ impl SamplingDomain {
     /// refused exactly as [`insert`](Self::insert) would, called on the sites in order (a
     /// repeated id, an invalid point or a point equal to an earlier accepted one is refused),
     /// and the accepted ones are triangulated by spade's bulk load (a sweep over the points
-    /// sorted by distance from their centroid, about twice as fast as inserting 1024 points one
-    /// by one). The Delaunay triangulation of points in general position is unique, so the
+    /// sorted by distance from their centroid; measured about 0.6 ms for 1024 points here
+    /// against about 0.8 ms inserting them one by one). The Delaunay triangulation of points in general position is unique, so the
     /// triangles, empty circles and Voronoi cells are the ones the insertions give; only the
     /// internal numbering differs. Returns the domain and, per site, whether it was accepted.
     pub fn from_sites(kind: DomainKind, sites: &[(u64, DVec3)]) -> (Self, Vec<bool>) {
