@@ -329,16 +329,46 @@ fn clip_half_plane(poly: &[DVec2], m: DVec2, d: DVec2, out: &mut Vec<DVec2>) {
 /// count all of it).
 const PARALLEL_SITES: usize = 512;
 
-/// A disc point as stored: `point.z` dropped, a point outside the unit disc moved radially onto
-/// its circle; its spade position and its domain point.
-fn disc_site(point: DVec3) -> (Point2<f64>, DVec3) {
-    let mut p = point.truncate();
-    let len2 = p.length_squared();
-    if len2 > 1.0 {
-        p /= len2.sqrt();
+/// How a point enters a domain of `kind` whose sphere pole is `pole`
+/// ([`SamplingDomain::insert`]'s rules, shared with [`SamplingDomain::from_sites`]):
+/// `Ok(Some((spade position, stored point)))` for a planar site — disc: `point.z` dropped and a
+/// point outside the unit disc moved radially onto its circle; sphere: normalised and projected
+/// from the pole —, `Ok(None)` for the first sphere point (it becomes the pole, stored
+/// normalised: `point / point.length()`), or why it is refused (not finite; on the sphere zero, or
+/// the pole's point).
+fn stored_site(
+    kind: DomainKind,
+    pole: Option<&Pole>,
+    point: DVec3,
+) -> Result<Option<(Point2<f64>, DVec3)>, DomainError> {
+    if !point.is_finite() {
+        return Err(DomainError::InvalidPoint);
     }
-    let pos = spade::mitigate_underflow(Point2::new(p.x, p.y));
-    (pos, DVec3::new(pos.x, pos.y, 0.0))
+    match kind {
+        DomainKind::Disc => {
+            let mut p = point.truncate();
+            let len2 = p.length_squared();
+            if len2 > 1.0 {
+                p /= len2.sqrt();
+            }
+            let pos = spade::mitigate_underflow(Point2::new(p.x, p.y));
+            Ok(Some((pos, DVec3::new(pos.x, pos.y, 0.0))))
+        }
+        DomainKind::Sphere => {
+            let len = point.length();
+            if len == 0.0 || !len.is_finite() {
+                return Err(DomainError::InvalidPoint);
+            }
+            let x = point / len;
+            let Some(pole) = pole else {
+                return Ok(None);
+            };
+            if (x - pole.point).length_squared() < 1e-24 {
+                return Err(DomainError::DuplicatePoint(pole.id));
+            }
+            Ok(Some((pole.project(x), x)))
+        }
+    }
 }
 
 /// `f(scratch, i)` for every site index `i < n`, in order: across cores (one `init()` scratch
@@ -435,28 +465,18 @@ impl SamplingDomain {
         let mut ids: IdMap<()> = IdMap::with_capacity_and_hasher(sites.len(), Default::default());
         let mut positions: HashMap<[u64; 2], ()> = HashMap::with_capacity(sites.len());
         for (k, &(id, point)) in sites.iter().enumerate() {
-            if ids.contains_key(&id) || !point.is_finite() {
+            if ids.contains_key(&id) {
                 continue;
             }
-            let (pos, point) = match kind {
-                DomainKind::Disc => disc_site(point),
-                DomainKind::Sphere => {
-                    let len = point.length();
-                    if len == 0.0 || !len.is_finite() {
-                        continue;
-                    }
-                    let x = point / len;
-                    let Some(pole) = d.pole else {
-                        d.pole = Some(Pole::new(id, x));
-                        ids.insert(id, ());
-                        accepted[k] = true;
-                        continue;
-                    };
-                    if (x - pole.point).length_squared() < 1e-24 {
-                        continue;
-                    }
-                    (pole.project(x), x)
+            let (pos, point) = match stored_site(kind, d.pole.as_ref(), point) {
+                Ok(Some(site)) => site,
+                Ok(None) => {
+                    d.pole = Some(Pole::new(id, point / point.length()));
+                    ids.insert(id, ());
+                    accepted[k] = true;
+                    continue;
                 }
+                Err(_) => continue,
             };
             // Equal positions are what spade's `locate_vertex` calls a duplicate.
             let key = [pos.x, pos.y].map(|c| if c == 0.0 { 0 } else { c.to_bits() });
@@ -468,15 +488,15 @@ impl SamplingDomain {
             planar.push(Site { pos, point, id });
         }
         let n = planar.len();
-        d.tri = match DelaunayTriangulation::bulk_load(planar.clone()) {
+        d.tri = match DelaunayTriangulation::bulk_load(planar) {
             Ok(t) => t,
             Err(_) => {
-                // Positions are finite and distinct; fall back to insertion all the same.
-                let mut t = DelaunayTriangulation::with_capacity(n, 3 * n, 2 * n + 1);
-                for s in planar {
-                    let _ = t.insert(s);
-                }
-                t
+                // Positions are finite and distinct, so spade accepts them; should it not,
+                // the insertions give the same domain.
+                let mut d = Self::with_capacity(kind, sites.len());
+                let accepted = sites.iter().map(|&(id, p)| d.insert(id, p).is_ok());
+                let accepted = accepted.collect();
+                return (d, accepted);
             }
         };
         d.slots = IdMap::with_capacity_and_hasher(n + 1, Default::default());
@@ -560,28 +580,11 @@ impl SamplingDomain {
         if self.slots.contains_key(&id) {
             return Err(DomainError::DuplicateId(id));
         }
-        if !point.is_finite() {
-            return Err(DomainError::InvalidPoint);
-        }
-        let (pos, point) = match self.kind {
-            DomainKind::Disc => disc_site(point),
-            DomainKind::Sphere => {
-                let len = point.length();
-                if len == 0.0 || !len.is_finite() {
-                    return Err(DomainError::InvalidPoint);
-                }
-                let x = point / len;
-                let Some(pole) = self.pole else {
-                    self.pole = Some(Pole::new(id, x));
-                    self.slots.insert(id, Slot::Pole);
-                    self.lec_mut().valid = false;
-                    return Ok(());
-                };
-                if (x - pole.point).length_squared() < 1e-24 {
-                    return Err(DomainError::DuplicatePoint(pole.id));
-                }
-                (pole.project(x), x)
-            }
+        let Some((pos, point)) = stored_site(self.kind, self.pole.as_ref(), point)? else {
+            self.pole = Some(Pole::new(id, point / point.length()));
+            self.slots.insert(id, Slot::Pole);
+            self.lec_mut().valid = false;
+            return Ok(());
         };
         let site = Site { pos, point, id };
         let incremental = self.tri.num_inner_faces() > 0;
