@@ -1,15 +1,17 @@
-//! CPU ray casting over the static geometry with an `obvhs` compressed wide BVH: closest-hit
+//! CPU ray casting over the static geometry with a four-wide BVH (`wide`, collapsed from an
+//! `obvhs` PLOC tree): closest-hit
 //! (triangle, barycentrics, position, normals, material) and any-hit (occlusion) queries. The
 //! techniques use it to place and validate VPLs; the reference renderer traces paths with it.
 
 use std::time::Duration;
 
 use glam::{Vec2, Vec3, Vec3A};
-use obvhs::cwbvh::builder::build_cwbvh_from_tris;
-use obvhs::cwbvh::CwBvh;
-use obvhs::ray::{Ray, RayHit};
+use obvhs::bvh2::builder::build_bvh2_from_tris;
 use obvhs::triangle::Triangle;
 use obvhs::BvhBuildParams;
+
+mod wide;
+use wide::WideBvh;
 
 use crate::scene::Mesh;
 
@@ -38,11 +40,7 @@ pub struct Hit {
 /// never hits.
 pub struct SceneBvh {
     /// `None` for a mesh without triangles.
-    bvh: Option<CwBvh>,
-    /// Per primitive slot of the tree (the id its traversal reports), in that order: the
-    /// triangle's first corner and edges and its mesh triangle — what the traversal's
-    /// intersection callback reads, contiguous.
-    leaves: Vec<Leaf>,
+    bvh: Option<WideBvh>,
     /// The mesh triangle of each triangle built into the tree.
     built: Vec<u32>,
     /// Corner positions per triangle, in mesh order.
@@ -55,30 +53,32 @@ pub struct SceneBvh {
     materials: Vec<u32>,
 }
 
-/// A triangle as the intersection test reads it: the first corner, the edges to the other two
-/// (computed once, exactly as the test would), and its index in the mesh.
+/// A triangle as the scalar intersection test reads it: the first corner and the edges to the
+/// other two. The tree stores the same values four to a group.
+#[cfg(test)]
 #[derive(Clone, Copy, Debug)]
 struct Leaf {
     v0: Vec3,
     e1: Vec3,
     e2: Vec3,
-    triangle: u32,
 }
 
+#[cfg(test)]
 impl Leaf {
-    fn new(t: &[Vec3; 3], triangle: u32) -> Leaf {
+    fn new(t: &[Vec3; 3]) -> Leaf {
         Leaf {
             v0: t[0],
             e1: t[1] - t[0],
             e2: t[2] - t[0],
-            triangle,
         }
     }
 }
 
 /// Möller–Trumbore: `(t, u, v)` of the hit of `origin + t·dir` with triangle `tri` for `t` in
 /// the open interval `(t_min, t_max)`, where `(u, v)` weight corners 1 and 2. Both sides hit.
-#[inline]
+/// The tree's four-lane test (`wide::intersect4`) does these operations in this order; the
+/// tests compare the tree against this one.
+#[cfg(test)]
 fn intersect(
     tri: &Leaf,
     origin: Vec3,
@@ -166,21 +166,17 @@ impl SceneBvh {
                     }
                 })
                 .collect();
+            // One triangle per BVH2 leaf: the wide tree groups them four to a leaf itself.
+            let params = BvhBuildParams {
+                max_prims_per_leaf: 1,
+                ..BvhBuildParams::medium_build()
+            };
             let mut build_time = Duration::ZERO;
-            build_cwbvh_from_tris(&obvhs_tris, BvhBuildParams::medium_build(), &mut build_time)
-        });
-        let leaves = bvh.as_ref().map_or(Vec::new(), |b| {
-            b.primitive_indices
-                .iter()
-                .map(|&k| {
-                    let triangle = built[k as usize];
-                    Leaf::new(&tris[triangle as usize], triangle)
-                })
-                .collect()
+            let bvh2 = build_bvh2_from_tris(&obvhs_tris, params, &mut build_time);
+            WideBvh::from_bvh2(&bvh2, &obvhs_tris, &built)
         });
         SceneBvh {
             bvh,
-            leaves,
             built,
             tris,
             normals,
@@ -210,13 +206,6 @@ impl SceneBvh {
             && t_max > t_min
     }
 
-    fn ray(origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> Ray {
-        // `-0.0 + 0.0 == +0.0`: obvhs's traversal mis-handles negative-zero direction components
-        // (e.g. `-Vec3::Y` is (−0, −1, −0)) and would miss everything.
-        let dir = dir + Vec3::ZERO;
-        Ray::new(Vec3A::from(origin), Vec3A::from(dir), t_min, t_max)
-    }
-
     /// Closest hit along `origin + t·dir` for `t` in `(t_min, t_max)` (a negative `t_min` acts
     /// as 0). Both sides of every triangle are hit. Non-finite or zero rays hit nothing.
     pub fn closest_hit(&self, origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> Option<Hit> {
@@ -225,19 +214,7 @@ impl SceneBvh {
         if !Self::usable(origin, dir, t_min, t_max) {
             return None;
         }
-        let mut best: Option<(u32, f32, f32, f32)> = None;
-        let mut hit = RayHit::none();
-        bvh.ray_traverse(Self::ray(origin, dir, t_min, t_max), &mut hit, |ray, id| {
-            let leaf = &self.leaves[id];
-            match intersect(leaf, origin, dir, t_min, ray.tmax) {
-                Some((t, u, v)) => {
-                    best = Some((leaf.triangle, t, u, v));
-                    t
-                }
-                None => f32::INFINITY,
-            }
-        });
-        let (tri, t, u, v) = best?;
+        let (tri, t, u, v) = bvh.closest(origin, dir, t_min, t_max)?;
         let i = tri as usize;
         let w = 1.0 - u - v;
         let [p0, p1, p2] = self.tris[i];
@@ -284,10 +261,7 @@ impl SceneBvh {
         if !Self::usable(origin, dir, t_min, t_max) {
             return false;
         }
-        !bvh.ray_traverse_miss(Self::ray(origin, dir, t_min, t_max), |_, id| {
-            intersect(&self.leaves[id], origin, dir, t_min, t_max)
-                .map_or(f32::INFINITY, |(t, _, _)| t)
-        })
+        bvh.any(origin, dir, t_min, t_max)
     }
 }
 
@@ -349,7 +323,7 @@ mod tests {
         (0..mesh.triangle_count())
             .filter_map(|t| {
                 intersect(
-                    &Leaf::new(&mesh.triangle(t), t as u32),
+                    &Leaf::new(&mesh.triangle(t)),
                     origin,
                     dir,
                     0.0,
@@ -466,6 +440,147 @@ mod tests {
             );
         }
         assert!(hits > 500, "{hits}");
+    }
+
+    /// Brute force over every triangle: the smallest `t` in `(t_min, t_max)` with the
+    /// triangles hit at exactly that `t`, and `(u, v)` of the first of them.
+    fn brute_force_all(
+        mesh: &Mesh,
+        origin: Vec3,
+        dir: Vec3,
+        t_min: f32,
+        t_max: f32,
+    ) -> Option<(f32, Vec<u32>)> {
+        let hits: Vec<(f32, u32)> = (0..mesh.triangle_count())
+            .filter_map(|t| {
+                intersect(&Leaf::new(&mesh.triangle(t)), origin, dir, t_min, t_max)
+                    .map(|(d, _, _)| (d, t as u32))
+            })
+            .collect();
+        let t = hits.iter().map(|h| h.0).min_by(f32::total_cmp)?;
+        Some((t, hits.iter().filter(|h| h.0 == t).map(|h| h.1).collect()))
+    }
+
+    /// A soup of triangles of every size and orientation (some axis-aligned, so boxes of zero
+    /// thickness): the tree's closest hit is bit for bit the smallest `t` of the scalar test over
+    /// every triangle, with that triangle's barycentrics, for rays with random intervals; its
+    /// any-hit agrees. Catches a traversal that culls a box it enters (a wrong near/far plane,
+    /// a stack entry dropped while still nearer than the best hit) or a lane test that rounds
+    /// differently from the scalar one.
+    fn check_against_brute_force(
+        mesh: &Mesh,
+        rays: usize,
+        rng: &mut Rng,
+        mut ray: impl FnMut(&mut Rng) -> (Vec3, Vec3),
+    ) -> usize {
+        let bvh = SceneBvh::new(mesh);
+        let mut hits = 0;
+        for i in 0..rays {
+            let (origin, mut dir) = ray(rng);
+            if i % 7 == 0 {
+                // Axis-parallel rays (zero direction components, some negative zero).
+                dir = [Vec3::X, -Vec3::Y, Vec3::new(-0.0, 0.0, 1.0)][i % 3];
+            }
+            let (t_min, t_max) = if i % 3 == 0 {
+                (rng.next() * 20.0, 20.0 + rng.next() * 80.0)
+            } else {
+                (0.0, f32::INFINITY)
+            };
+            let expected = brute_force_all(mesh, origin, dir, t_min, t_max);
+            let got = bvh.closest_hit(origin, dir, t_min, t_max);
+            match (&expected, got) {
+                (None, None) => {}
+                (Some((t, tris)), Some(h)) => {
+                    hits += 1;
+                    assert_eq!(h.t, *t, "ray {i}: t");
+                    assert!(
+                        tris.contains(&h.triangle),
+                        "ray {i}: {} not in {tris:?}",
+                        h.triangle
+                    );
+                    let (_, u, v) = intersect(
+                        &Leaf::new(&mesh.triangle(h.triangle as usize)),
+                        origin,
+                        dir,
+                        t_min,
+                        t_max,
+                    )
+                    .unwrap();
+                    assert_eq!(h.barycentrics, Vec2::new(u, v), "ray {i}: barycentrics");
+                }
+                (e, g) => panic!("ray {i} {origin} {dir}: brute force {e:?}, tree {g:?}"),
+            }
+            assert_eq!(
+                expected.is_some(),
+                bvh.any_hit(origin, dir, t_min, t_max),
+                "ray {i}: any-hit"
+            );
+        }
+        hits
+    }
+
+    fn push_triangle(mesh: &mut Mesh, corners: [Vec3; 3]) {
+        let base = mesh.positions.len() as u32;
+        mesh.positions.extend(corners);
+        mesh.normals.extend([Vec3::Z; 3]);
+        mesh.materials.extend([0; 3]);
+        mesh.indices.extend([base, base + 1, base + 2]);
+    }
+
+    #[test]
+    fn tree_matches_brute_force_on_a_triangle_soup() {
+        let mut rng = Rng(0x2545_f491_4f6c_dd1d);
+        let mut mesh = Mesh::default();
+        for i in 0..3000 {
+            let size = [0.3, 3.0, 30.0][i % 3] * rng.next();
+            let c = Vec3::new(rng.next(), rng.next(), rng.next()) * 100.0;
+            let mut corners = [0, 1, 2].map(|_| c + rng.unit_vector() * size);
+            if i % 5 == 0 {
+                // Flat in one axis: a box of zero thickness.
+                let axis = i % 3;
+                for p in &mut corners {
+                    p[axis] = c[axis];
+                }
+            }
+            push_triangle(&mut mesh, corners);
+        }
+        let hits = check_against_brute_force(&mesh, 4000, &mut rng, |rng| {
+            let origin = Vec3::new(rng.next(), rng.next(), rng.next()) * 120.0 - 10.0;
+            (origin, rng.unit_vector())
+        });
+        assert!(hits > 1500, "{hits}");
+    }
+
+    /// Triangles across the x axis at distances growing geometrically (up to 2¹²⁶) nest each
+    /// box in the next: a tree 45 levels deep, whose traversal outgrows the stack's fixed part
+    /// and must still find every hit.
+    #[test]
+    fn deep_trees_are_traversed_completely() {
+        let mut mesh = Mesh::default();
+        for i in 0..250 {
+            let x = 2f32.powf(0.5 * i as f32);
+            push_triangle(
+                &mut mesh,
+                [
+                    Vec3::new(x, -1.0, -1.0),
+                    Vec3::new(x, 1.0, -1.0),
+                    Vec3::new(x, 0.0, 1.0),
+                ],
+            );
+        }
+        let bvh = SceneBvh::new(&mesh);
+        let stack = bvh.bvh.as_ref().unwrap().stack_len();
+        assert!(
+            stack > wide::FIXED_STACK,
+            "the tree is not deep: {stack} entries"
+        );
+        let mut rng = Rng(7);
+        let hits = check_against_brute_force(&mesh, 600, &mut rng, |rng| {
+            let origin = Vec3::new(-1.0, rng.next() - 0.5, rng.next() - 0.5);
+            // Along the axis, so that the ray enters every box on the way.
+            (origin, Vec3::X)
+        });
+        assert!(hits > 300, "{hits}");
     }
 
     #[test]
