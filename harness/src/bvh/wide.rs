@@ -1,9 +1,10 @@
-//! A four-wide BVH for single-ray CPU traversal: each node holds its four children's boxes as
-//! lanes (x/y/z minima and maxima, one `Vec4` each), and each leaf is a group of up to four
-//! triangles stored the same way (first corner and edges, one `Vec4` per coordinate), so one
-//! SIMD step tests four boxes or four triangles. Built by collapsing `obvhs`'s binary PLOC tree:
-//! every subtree of at most four triangles becomes one leaf group, and a node takes in its
-//! largest children's children until it has four.
+//! An eight-wide BVH for single-ray CPU traversal: each node holds its eight children's boxes
+//! as lanes (x/y/z minima and maxima, one row of eight each), and each leaf is a group of up to
+//! eight triangles stored the same way (first corner and edges), so one step tests eight boxes
+//! or eight triangles: one AVX instruction per operation where the CPU has AVX2 (checked at
+//! run time), two four-lane ones (SSE2, NEON) elsewhere. Built by collapsing `obvhs`'s binary
+//! PLOC tree: every subtree of at most eight triangles becomes one leaf group, and a node takes
+//! in its largest children's children until it has eight.
 //!
 //! The triangle test is Möller–Trumbore with the scalar test's operations in the scalar test's
 //! order (`super::intersect`), so each lane gives bit for bit the scalar answer; box tests widen
@@ -17,31 +18,36 @@ use obvhs::triangle::Triangle;
 const LEAF: u32 = 1 << 31;
 const EMPTY: u32 = u32::MAX;
 
-/// Stack entries a traversal keeps on the call stack (enough for a tree 31 levels deep);
-/// deeper trees get a heap stack per ray.
-pub(super) const FIXED_STACK: usize = 94;
+/// Stack entries a traversal keeps on the call stack (enough for a tree 9 levels deep, as
+/// Sibenik's 80k triangles make); deeper trees use a per-thread stack on the heap.
+pub(super) const FIXED_STACK: usize = 64;
 
 /// Exit distances are scaled by `1 + 2γ₃` (γₙ = nε/(1 − nε), ε = 2⁻²⁴) to bound the slab test's
 /// rounding.
 const ROBUST: f32 = 1.0 + 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
 
-/// Four children: their boxes as lanes (min x, y, z, max x, y, z) and their codes. An absent
-/// child has an empty box (min +∞, max −∞), which no ray enters.
+/// Children per node.
+const W: usize = 8;
+/// Triangles per leaf group.
+const G: usize = 8;
+
+/// Up to eight children: their boxes as lanes (min x, y, z, max x, y, z) and their codes. An
+/// absent child has an empty box (min +∞, max −∞), which no ray enters.
 #[derive(Clone, Copy)]
-#[repr(C, align(64))]
+#[repr(C, align(32))]
 struct Node {
-    planes: [Vec4; 6],
-    child: [u32; 4],
+    planes: [[f32; W]; 6],
+    child: [u32; W],
 }
 
-/// Up to four triangles as lanes: first corner, edge to corner 1, edge to corner 2. An unused
+/// Up to eight triangles as lanes: first corner, edge to corner 1, edge to corner 2. An unused
 /// lane has zero edges (determinant 0: never hit).
 #[derive(Clone, Copy)]
 #[repr(C, align(16))]
 struct Group {
-    v0: [Vec4; 3],
-    e1: [Vec4; 3],
-    e2: [Vec4; 3],
+    v0: [[f32; G]; 3],
+    e1: [[f32; G]; 3],
+    e2: [[f32; G]; 3],
 }
 
 /// The tree: nodes, leaf groups and each group lane's mesh triangle.
@@ -51,88 +57,268 @@ pub(super) struct WideBvh {
     nodes: Vec<Node>,
     groups: Vec<Group>,
     /// Mesh triangle of each group lane (`u32::MAX` for unused lanes).
-    ids: Vec<[u32; 4]>,
-    /// Stack entries a traversal can need: three per level below the root, plus one.
+    ids: Vec<[u32; G]>,
+    /// Stack entries a traversal can need: `W − 1` per level below the root, plus one.
     stack_len: usize,
+    /// Whether the CPU has AVX2 (x86-64): box tests then take eight lanes in one step.
+    avx2: bool,
 }
 
-/// A ray prepared for box tests: origin and reciprocal direction splatted across lanes, and
-/// which plane (min or max) each axis enters through.
-struct BoxRay {
+/// A ray prepared for a node's box tests: origin and reciprocal direction splatted across
+/// lanes, and which plane (min or max) each axis enters through. One implementation per
+/// instruction set; the traversal is written once over this.
+trait BoxRay {
+    fn new(origin: Vec3, dir: Vec3) -> Self;
+
+    /// Entry distances of the node's children and the mask of those the ray enters within
+    /// `[t_min, t_max]`, the exit (or `t_max`) widened by `ROBUST`: a triangle at `t < t_max`
+    /// inside a box is never culled by the entry distance's rounding.
+    fn enter(&self, node: &Node, t_min: f32, t_max: f32) -> ([f32; W], u32);
+
+    /// The lanes of `group` that the ray hits for `t` in `(t_min, t_max)`, and each lane's
+    /// `(t, u, v)`: the arithmetic of `super::intersect`, lane by lane.
+    fn hit(&self, group: &Group, t_min: f32, t_max: f32) -> (u32, [[f32; G]; 3]);
+}
+
+/// Reciprocal direction with zero components made tiny ones of the same sign (large, finite
+/// reciprocals: no 0·∞ in the slab test), and the entry and exit planes per axis (min is
+/// plane `k`, max `k + 3`).
+fn slab_setup(dir: Vec3) -> (Vec3, [usize; 3], [usize; 3]) {
+    let safe = |d: f32| {
+        if d.abs() < 1e-30 {
+            1e-30f32.copysign(d)
+        } else {
+            d
+        }
+    };
+    let inv = Vec3::new(1.0 / safe(dir.x), 1.0 / safe(dir.y), 1.0 / safe(dir.z));
+    let near = [0, 1, 2].map(|k| if inv[k] < 0.0 { k + 3 } else { k });
+    let far = near.map(|p| (p + 3) % 6);
+    (inv, near, far)
+}
+
+/// Two four-lane halves (SSE2 on x86-64, NEON on ARM, scalar elsewhere).
+struct Halves {
+    o: Vec3,
+    d: Vec3,
     origin: [Vec4; 3],
     inv_dir: [Vec4; 3],
     near: [usize; 3],
     far: [usize; 3],
 }
 
-impl BoxRay {
-    fn new(origin: Vec3, dir: Vec3) -> BoxRay {
-        // A zero component becomes a tiny one of the same sign, so its reciprocal is large and
-        // finite (no 0·∞ in the slab test) and the ray enters through the plane that sign says.
-        let safe = |d: f32| {
-            if d.abs() < 1e-30 {
-                1e-30f32.copysign(d)
-            } else {
-                d
-            }
-        };
-        let inv = Vec3::new(1.0 / safe(dir.x), 1.0 / safe(dir.y), 1.0 / safe(dir.z));
-        let planes = |k: usize, neg: bool| if neg { (k + 3, k) } else { (k, k + 3) };
-        let (nx, fx) = planes(0, inv.x < 0.0);
-        let (ny, fy) = planes(1, inv.y < 0.0);
-        let (nz, fz) = planes(2, inv.z < 0.0);
-        BoxRay {
-            origin: [
-                Vec4::splat(origin.x),
-                Vec4::splat(origin.y),
-                Vec4::splat(origin.z),
-            ],
-            inv_dir: [Vec4::splat(inv.x), Vec4::splat(inv.y), Vec4::splat(inv.z)],
-            near: [nx, ny, nz],
-            far: [fx, fy, fz],
+impl BoxRay for Halves {
+    fn new(origin: Vec3, dir: Vec3) -> Self {
+        let (inv, near, far) = slab_setup(dir);
+        Halves {
+            o: origin,
+            d: dir,
+            origin: [0, 1, 2].map(|k| Vec4::splat(origin[k])),
+            inv_dir: [0, 1, 2].map(|k| Vec4::splat(inv[k])),
+            near,
+            far,
         }
     }
 
-    /// Entry distances of the four children and the mask of those the ray enters within
-    /// `[t_min, t_max]`, the exit (or `t_max`) widened by `ROBUST`: a triangle at `t < t_max`
-    /// inside a box is never culled by the entry distance's rounding.
     #[inline(always)]
-    fn enter(&self, node: &Node, t_min: Vec4, t_max: Vec4) -> (Vec4, u32) {
-        let p = &node.planes;
-        let slab = |k: usize, plane: usize| (p[plane] - self.origin[k]) * self.inv_dir[k];
-        let near = slab(0, self.near[0])
-            .max(slab(1, self.near[1]))
-            .max(slab(2, self.near[2]).max(t_min));
-        let far = slab(0, self.far[0])
-            .min(slab(1, self.far[1]))
-            .min(slab(2, self.far[2]).min(t_max))
-            * ROBUST;
-        (near, near.cmple(far).bitmask())
+    fn enter(&self, node: &Node, t_min: f32, t_max: f32) -> ([f32; W], u32) {
+        let mut out = [0.0; W];
+        let mut mask = 0;
+        for half in 0..2 {
+            let slab = |k: usize, plane: usize| {
+                let p = Vec4::from_slice(&node.planes[plane][4 * half..]);
+                (p - self.origin[k]) * self.inv_dir[k]
+            };
+            let near = slab(0, self.near[0])
+                .max(slab(1, self.near[1]))
+                .max(slab(2, self.near[2]).max(Vec4::splat(t_min)));
+            let far = slab(0, self.far[0])
+                .min(slab(1, self.far[1]))
+                .min(slab(2, self.far[2]).min(Vec4::splat(t_max)))
+                * ROBUST;
+            near.write_to_slice(&mut out[4 * half..]);
+            mask |= near.cmple(far).bitmask() << (4 * half);
+        }
+        (out, mask)
+    }
+
+    #[inline(always)]
+    fn hit(&self, g: &Group, t_min: f32, t_max: f32) -> (u32, [[f32; G]; 3]) {
+        let mut out = [[0.0; G]; 3];
+        let mut mask = 0;
+        for half in 0..G / 4 {
+            let lanes = |rows: &[[f32; G]; 3]| rows.map(|r| Vec4::from_slice(&r[4 * half..]));
+            let (m, t, u, v) = intersect4(
+                [lanes(&g.v0), lanes(&g.e1), lanes(&g.e2)],
+                self.o,
+                self.d,
+                t_min,
+                t_max,
+            );
+            for (o, x) in out.iter_mut().zip([t, u, v]) {
+                x.write_to_slice(&mut o[4 * half..]);
+            }
+            mask |= m << (4 * half);
+        }
+        (mask, out)
     }
 }
 
-/// The lanes of `group` that the ray hits for `t` in `(t_min, t_max)`, and each lane's
-/// `(t, u, v)`; the arithmetic of `super::intersect`, four lanes at once.
+/// Eight lanes at once with AVX (used when the CPU has AVX2).
+#[cfg(target_arch = "x86_64")]
+mod avx {
+    use super::{slab_setup, BoxRay, Group, Node, G, ROBUST, W};
+    use glam::Vec3;
+    use std::arch::x86_64::*;
+
+    pub(super) struct Avx {
+        origin: [__m256; 3],
+        dir: [__m256; 3],
+        inv_dir: [__m256; 3],
+        near: [usize; 3],
+        far: [usize; 3],
+    }
+
+    impl BoxRay for Avx {
+        #[inline(always)]
+        fn new(origin: Vec3, dir: Vec3) -> Self {
+            let (inv, near, far) = slab_setup(dir);
+            // SAFETY: `Avx` is only made inside `WideBvh`'s AVX2 entry points, which run
+            // after the CPU was checked for AVX2.
+            unsafe {
+                Avx {
+                    origin: [
+                        _mm256_set1_ps(origin.x),
+                        _mm256_set1_ps(origin.y),
+                        _mm256_set1_ps(origin.z),
+                    ],
+                    dir: [
+                        _mm256_set1_ps(dir.x),
+                        _mm256_set1_ps(dir.y),
+                        _mm256_set1_ps(dir.z),
+                    ],
+                    inv_dir: [
+                        _mm256_set1_ps(inv.x),
+                        _mm256_set1_ps(inv.y),
+                        _mm256_set1_ps(inv.z),
+                    ],
+                    near,
+                    far,
+                }
+            }
+        }
+
+        #[inline(always)]
+        fn enter(&self, node: &Node, t_min: f32, t_max: f32) -> ([f32; W], u32) {
+            // SAFETY: as in `new`; the loads read whole `[f32; 8]` rows of the node.
+            unsafe {
+                let slab = |k: usize, plane: usize| {
+                    let p = _mm256_loadu_ps(node.planes[plane].as_ptr());
+                    _mm256_mul_ps(_mm256_sub_ps(p, self.origin[k]), self.inv_dir[k])
+                };
+                let near = _mm256_max_ps(
+                    _mm256_max_ps(slab(0, self.near[0]), slab(1, self.near[1])),
+                    _mm256_max_ps(slab(2, self.near[2]), _mm256_set1_ps(t_min)),
+                );
+                let far = _mm256_mul_ps(
+                    _mm256_min_ps(
+                        _mm256_min_ps(slab(0, self.far[0]), slab(1, self.far[1])),
+                        _mm256_min_ps(slab(2, self.far[2]), _mm256_set1_ps(t_max)),
+                    ),
+                    _mm256_set1_ps(ROBUST),
+                );
+                let mut out = [0.0; W];
+                _mm256_storeu_ps(out.as_mut_ptr(), near);
+                let mask = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(near, far)) as u32;
+                (out, mask)
+            }
+        }
+
+        #[inline(always)]
+        fn hit(&self, g: &Group, t_min: f32, t_max: f32) -> (u32, [[f32; G]; 3]) {
+            // SAFETY: as in `new`; the loads read whole `[f32; 8]` rows of the group.
+            unsafe {
+                let load = |row: &[f32; G]| _mm256_loadu_ps(row.as_ptr());
+                let (add, sub, mul) = (_mm256_add_ps, _mm256_sub_ps, _mm256_mul_ps);
+                let [dx, dy, dz] = self.dir;
+                let [e1x, e1y, e1z] = [load(&g.e1[0]), load(&g.e1[1]), load(&g.e1[2])];
+                let [e2x, e2y, e2z] = [load(&g.e2[0]), load(&g.e2[1]), load(&g.e2[2])];
+                // The operations of `super::intersect`, in its order.
+                let px = sub(mul(dy, e2z), mul(e2y, dz));
+                let py = sub(mul(dz, e2x), mul(e2z, dx));
+                let pz = sub(mul(dx, e2y), mul(e2x, dy));
+                let det = add(add(mul(e1x, px), mul(e1y, py)), mul(e1z, pz));
+                let inv_det = _mm256_div_ps(_mm256_set1_ps(1.0), det);
+                let sx = sub(self.origin[0], load(&g.v0[0]));
+                let sy = sub(self.origin[1], load(&g.v0[1]));
+                let sz = sub(self.origin[2], load(&g.v0[2]));
+                let u = mul(add(add(mul(sx, px), mul(sy, py)), mul(sz, pz)), inv_det);
+                let qx = sub(mul(sy, e1z), mul(e1y, sz));
+                let qy = sub(mul(sz, e1x), mul(e1z, sx));
+                let qz = sub(mul(sx, e1y), mul(e1x, sy));
+                let v = mul(add(add(mul(dx, qx), mul(dy, qy)), mul(dz, qz)), inv_det);
+                let t = mul(add(add(mul(e2x, qx), mul(e2y, qy)), mul(e2z, qz)), inv_det);
+                let (zero, one) = (_mm256_setzero_ps(), _mm256_set1_ps(1.0));
+                let abs_det = _mm256_andnot_ps(_mm256_set1_ps(-0.0), det);
+                let and = _mm256_and_ps;
+                let ok = and(
+                    and(
+                        and(
+                            _mm256_cmp_ps::<_CMP_NEQ_UQ>(det, zero),
+                            _mm256_cmp_ps::<_CMP_LT_OQ>(abs_det, _mm256_set1_ps(f32::INFINITY)),
+                        ),
+                        and(
+                            _mm256_cmp_ps::<_CMP_GE_OQ>(u, zero),
+                            _mm256_cmp_ps::<_CMP_LE_OQ>(u, one),
+                        ),
+                    ),
+                    and(
+                        and(
+                            _mm256_cmp_ps::<_CMP_GE_OQ>(v, zero),
+                            _mm256_cmp_ps::<_CMP_LE_OQ>(add(u, v), one),
+                        ),
+                        and(
+                            _mm256_cmp_ps::<_CMP_GT_OQ>(t, _mm256_set1_ps(t_min)),
+                            _mm256_cmp_ps::<_CMP_LT_OQ>(t, _mm256_set1_ps(t_max)),
+                        ),
+                    ),
+                );
+                let mask = _mm256_movemask_ps(ok) as u32;
+                let mut out = [[0.0; G]; 3];
+                if mask != 0 {
+                    _mm256_storeu_ps(out[0].as_mut_ptr(), t);
+                    _mm256_storeu_ps(out[1].as_mut_ptr(), u);
+                    _mm256_storeu_ps(out[2].as_mut_ptr(), v);
+                }
+                (mask, out)
+            }
+        }
+    }
+}
+
+/// The lanes of four triangles (first corners, edges 1 and 2) that the ray hits for `t` in
+/// `(t_min, t_max)`, and each lane's `(t, u, v)`; the arithmetic of `super::intersect`, four
+/// lanes at once.
 #[inline(always)]
 fn intersect4(
-    g: &Group,
+    [v0, e1, e2]: [[Vec4; 3]; 3],
     origin: Vec3,
     dir: Vec3,
     t_min: f32,
     t_max: f32,
 ) -> (u32, Vec4, Vec4, Vec4) {
     let [dx, dy, dz] = [dir.x, dir.y, dir.z].map(Vec4::splat);
-    let [e1x, e1y, e1z] = g.e1;
-    let [e2x, e2y, e2z] = g.e2;
+    let [e1x, e1y, e1z] = e1;
+    let [e2x, e2y, e2z] = e2;
     // p = dir × e2
     let px = dy * e2z - e2y * dz;
     let py = dz * e2x - e2z * dx;
     let pz = dx * e2y - e2x * dy;
     let det = e1x * px + e1y * py + e1z * pz;
     let inv_det = Vec4::ONE / det;
-    let sx = Vec4::splat(origin.x) - g.v0[0];
-    let sy = Vec4::splat(origin.y) - g.v0[1];
-    let sz = Vec4::splat(origin.z) - g.v0[2];
+    let sx = Vec4::splat(origin.x) - v0[0];
+    let sy = Vec4::splat(origin.y) - v0[1];
+    let sz = Vec4::splat(origin.z) - v0[2];
     let u = (sx * px + sy * py + sz * pz) * inv_det;
     // q = s × e1
     let qx = sy * e1z - e1y * sz;
@@ -166,6 +352,7 @@ impl WideBvh {
             groups: Vec::new(),
             ids: Vec::new(),
             stack_len: 1,
+            avx2: has_avx2(),
         };
         if bvh2.nodes.is_empty() {
             return tree;
@@ -178,9 +365,9 @@ impl WideBvh {
             collect_prims(bvh2, n, &mut prims);
             tree.leaf_tree(&prims, tris, mesh_ids)
         };
-        if counts[0] <= 4 || bvh2.nodes[0].is_leaf() {
+        if counts[0] <= G || bvh2.nodes[0].is_leaf() {
             tree.root = leaf_of(&mut tree, 0);
-            tree.stack_len = 3 * tree.depth() + 1;
+            tree.stack_len = (W - 1) * tree.depth() + 1;
             return tree;
         }
         tree.root = 0;
@@ -188,14 +375,14 @@ impl WideBvh {
         // (BVH2 node, wide node slot)
         let mut work = vec![(0usize, 0usize)];
         while let Some((n2, slot)) = work.pop() {
-            // Open the largest inner child until four children.
+            // Open the largest inner child until W children.
             let first = bvh2.nodes[n2].first_index as usize;
             let mut kids = vec![first, first + 1];
-            while kids.len() < 4 {
+            while kids.len() < W {
                 let open = kids
                     .iter()
                     .enumerate()
-                    .filter(|&(_, &k)| !bvh2.nodes[k].is_leaf() && counts[k] > 4)
+                    .filter(|&(_, &k)| !bvh2.nodes[k].is_leaf() && counts[k] > G)
                     .max_by(|a, b| {
                         let area = |k: usize| bvh2.nodes[k].aabb().half_area();
                         area(*a.1).total_cmp(&area(*b.1))
@@ -210,7 +397,7 @@ impl WideBvh {
             for (lane, &k) in kids.iter().enumerate() {
                 let aabb = bvh2.nodes[k].aabb();
                 set_lane(&mut node, lane, aabb.min.into(), aabb.max.into());
-                node.child[lane] = if bvh2.nodes[k].is_leaf() || counts[k] <= 4 {
+                node.child[lane] = if bvh2.nodes[k].is_leaf() || counts[k] <= G {
                     leaf_of(&mut tree, k)
                 } else {
                     let s = tree.nodes.len();
@@ -221,7 +408,7 @@ impl WideBvh {
             }
             tree.nodes[slot] = node;
         }
-        tree.stack_len = 3 * tree.depth() + 1;
+        tree.stack_len = (W - 1) * tree.depth() + 1;
         tree
     }
 
@@ -244,16 +431,16 @@ impl WideBvh {
         deepest
     }
 
-    /// A leaf group for at most four triangles, else a node over up to four leaf trees of
-    /// consecutive parts (only for BVH2 leaves larger than four, which the build avoids).
+    /// A leaf group for at most `G` triangles, else a node over up to `W` leaf trees of
+    /// consecutive parts (only for BVH2 leaves larger than `G`, which the build avoids).
     fn leaf_tree(&mut self, prims: &[u32], tris: &[Triangle], mesh_ids: &[u32]) -> u32 {
-        if prims.len() <= 4 {
+        if prims.len() <= G {
             let mut g = Group {
-                v0: [Vec4::ZERO; 3],
-                e1: [Vec4::ZERO; 3],
-                e2: [Vec4::ZERO; 3],
+                v0: [[0.0; G]; 3],
+                e1: [[0.0; G]; 3],
+                e2: [[0.0; G]; 3],
             };
-            let mut ids = [u32::MAX; 4];
+            let mut ids = [u32::MAX; G];
             for (lane, &p) in prims.iter().enumerate() {
                 let t = &tris[p as usize];
                 let (v0, v1, v2) = (Vec3::from(t.v0), Vec3::from(t.v1), Vec3::from(t.v2));
@@ -272,7 +459,7 @@ impl WideBvh {
         let slot = self.nodes.len();
         self.nodes.push(empty_node());
         let mut node = empty_node();
-        for (lane, part) in prims.chunks(prims.len().div_ceil(4)).enumerate() {
+        for (lane, part) in prims.chunks(prims.len().div_ceil(W)).enumerate() {
             let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
             for &p in part {
                 let t = &tris[p as usize];
@@ -294,9 +481,61 @@ impl WideBvh {
         self.stack_len
     }
 
+    /// Box and triangle tests without AVX2 even where the CPU has it (tests compare both).
+    #[cfg(test)]
+    pub(super) fn without_avx2(mut self) -> Self {
+        self.avx2 = false;
+        self
+    }
+
     /// Closest hit for `t` in `(t_min, t_max)`: `(mesh triangle, t, u, v)`.
     #[inline]
     pub(super) fn closest(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        t_min: f32,
+        t_max: f32,
+    ) -> Option<(u32, f32, f32, f32)> {
+        #[cfg(target_arch = "x86_64")]
+        if self.avx2 {
+            // SAFETY: `avx2` is set only when the CPU reports AVX2.
+            return unsafe { self.closest_avx2(origin, dir, t_min, t_max) };
+        }
+        self.closest_with::<Halves>(origin, dir, t_min, t_max)
+    }
+
+    /// Whether any triangle is hit for `t` in `(t_min, t_max)`.
+    #[inline]
+    pub(super) fn any(&self, origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> bool {
+        #[cfg(target_arch = "x86_64")]
+        if self.avx2 {
+            // SAFETY: as in `closest`.
+            return unsafe { self.any_avx2(origin, dir, t_min, t_max) };
+        }
+        self.any_with::<Halves>(origin, dir, t_min, t_max)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx,avx2")]
+    unsafe fn closest_avx2(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        t_min: f32,
+        t_max: f32,
+    ) -> Option<(u32, f32, f32, f32)> {
+        self.closest_with::<avx::Avx>(origin, dir, t_min, t_max)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx,avx2")]
+    unsafe fn any_avx2(&self, origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> bool {
+        self.any_with::<avx::Avx>(origin, dir, t_min, t_max)
+    }
+
+    #[inline(always)]
+    fn closest_with<R: BoxRay>(
         &self,
         origin: Vec3,
         dir: Vec3,
@@ -307,15 +546,9 @@ impl WideBvh {
             return None;
         }
         let mut buf = [Entry::default(); FIXED_STACK];
-        let mut heap = Vec::new();
-        let stack: &mut [Entry] = if self.stack_len <= buf.len() {
-            &mut buf
-        } else {
-            heap.resize(self.stack_len, Entry::default());
-            &mut heap
-        };
-        let ray = BoxRay::new(origin, dir);
-        let t_min4 = Vec4::splat(t_min);
+        let mut deep = Vec::new();
+        let stack = self.stack(&mut buf, &mut deep);
+        let ray = R::new(origin, dir);
         let mut t_max = t_max;
         let mut best = None;
         let mut sp = 0;
@@ -323,16 +556,15 @@ impl WideBvh {
         'walk: loop {
             if code & LEAF == 0 {
                 let node = &self.nodes[code as usize];
-                let (near, mut mask) = ray.enter(node, t_min4, Vec4::splat(t_max));
+                let (near, mut mask) = ray.enter(node, t_min, t_max);
                 if mask != 0 {
-                    let near = near.to_array();
                     if mask & (mask - 1) == 0 {
                         code = node.child[mask.trailing_zeros() as usize];
                         continue;
                     }
                     // Sort the entered children by entry distance; walk the nearest, push the
                     // rest farthest first.
-                    let mut hits = [Entry::default(); 4];
+                    let mut hits = [Entry::default(); W];
                     let mut n = 0;
                     while mask != 0 {
                         let lane = mask.trailing_zeros() as usize;
@@ -358,9 +590,8 @@ impl WideBvh {
                 }
             } else {
                 let g = (code & !LEAF) as usize;
-                let (mut mask, t, u, v) = intersect4(&self.groups[g], origin, dir, t_min, t_max);
+                let (mut mask, [t, u, v]) = ray.hit(&self.groups[g], t_min, t_max);
                 if mask != 0 {
-                    let (t, u, v) = (t.to_array(), u.to_array(), v.to_array());
                     while mask != 0 {
                         let lane = mask.trailing_zeros() as usize;
                         mask &= mask - 1;
@@ -382,36 +613,30 @@ impl WideBvh {
                 }
             }
         }
+        give_back(deep);
         best
     }
 
-    /// Whether any triangle is hit for `t` in `(t_min, t_max)`.
-    #[inline]
-    pub(super) fn any(&self, origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> bool {
+    #[inline(always)]
+    fn any_with<R: BoxRay>(&self, origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> bool {
         if self.root == EMPTY {
             return false;
         }
-        let mut buf = [0u32; FIXED_STACK];
-        let mut heap = Vec::new();
-        let stack: &mut [u32] = if self.stack_len <= buf.len() {
-            &mut buf
-        } else {
-            heap.resize(self.stack_len, 0);
-            &mut heap
-        };
-        let ray = BoxRay::new(origin, dir);
-        let (t_min4, t_max4) = (Vec4::splat(t_min), Vec4::splat(t_max));
+        let mut buf = [Entry::default(); FIXED_STACK];
+        let mut deep = Vec::new();
+        let stack = self.stack(&mut buf, &mut deep);
+        let ray = R::new(origin, dir);
         let mut sp = 0;
         let mut code = self.root;
-        loop {
+        let hit = loop {
             if code & LEAF == 0 {
                 let node = &self.nodes[code as usize];
-                let (_, mut mask) = ray.enter(node, t_min4, t_max4);
+                let (_, mut mask) = ray.enter(node, t_min, t_max);
                 if mask != 0 {
                     code = node.child[mask.trailing_zeros() as usize];
                     mask &= mask - 1;
                     while mask != 0 {
-                        stack[sp] = node.child[mask.trailing_zeros() as usize];
+                        stack[sp].code = node.child[mask.trailing_zeros() as usize];
                         sp += 1;
                         mask &= mask - 1;
                     }
@@ -419,30 +644,70 @@ impl WideBvh {
                 }
             } else {
                 let g = &self.groups[(code & !LEAF) as usize];
-                if intersect4(g, origin, dir, t_min, t_max).0 != 0 {
-                    return true;
+                if ray.hit(g, t_min, t_max).0 != 0 {
+                    break true;
                 }
             }
             if sp == 0 {
-                return false;
+                break false;
             }
             sp -= 1;
-            code = stack[sp];
-        }
+            code = stack[sp].code;
+        };
+        give_back(deep);
+        hit
     }
+
+    /// The traversal stack: `buf` when the tree is shallow enough, else this thread's deep
+    /// stack (taken into `deep`; `give_back` returns it), grown to the tree's need once.
+    #[inline(always)]
+    fn stack<'a>(
+        &self,
+        buf: &'a mut [Entry; FIXED_STACK],
+        deep: &'a mut Vec<Entry>,
+    ) -> &'a mut [Entry] {
+        if self.stack_len <= FIXED_STACK {
+            return buf;
+        }
+        *deep = DEEP_STACK.take();
+        if deep.len() < self.stack_len {
+            deep.resize(self.stack_len, Entry::default());
+        }
+        deep
+    }
+}
+
+thread_local! {
+    /// Per thread, the stack of traversals of trees deeper than `FIXED_STACK` allows.
+    static DEEP_STACK: std::cell::Cell<Vec<Entry>> = const { std::cell::Cell::new(Vec::new()) };
+}
+
+/// Returns a deep stack taken by `WideBvh::stack` (an empty one is left alone).
+#[inline(always)]
+fn give_back(deep: Vec<Entry>) {
+    if !deep.is_empty() {
+        DEEP_STACK.set(deep);
+    }
+}
+
+fn has_avx2() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    return std::is_x86_feature_detected!("avx2");
+    #[cfg(not(target_arch = "x86_64"))]
+    false
 }
 
 fn empty_node() -> Node {
     Node {
         planes: [
-            Vec4::INFINITY,
-            Vec4::INFINITY,
-            Vec4::INFINITY,
-            Vec4::NEG_INFINITY,
-            Vec4::NEG_INFINITY,
-            Vec4::NEG_INFINITY,
+            [f32::INFINITY; W],
+            [f32::INFINITY; W],
+            [f32::INFINITY; W],
+            [f32::NEG_INFINITY; W],
+            [f32::NEG_INFINITY; W],
+            [f32::NEG_INFINITY; W],
         ],
-        child: [EMPTY; 4],
+        child: [EMPTY; W],
     }
 }
 
