@@ -60,13 +60,14 @@ pub(super) struct WideBvh {
     ids: Vec<[u32; G]>,
     /// Stack entries a traversal can need: `W − 1` per level below the root, plus one.
     stack_len: usize,
-    /// Whether the CPU has AVX2 (x86-64): box tests then take eight lanes in one step.
+    /// Whether the CPU has AVX2 (x86-64): box and triangle tests then take eight lanes in one
+    /// step.
     avx2: bool,
 }
 
-/// A ray prepared for a node's box tests: origin and reciprocal direction splatted across
-/// lanes, and which plane (min or max) each axis enters through. One implementation per
-/// instruction set; the traversal is written once over this.
+/// A ray prepared for a node's box tests and a leaf's triangle tests: origin, direction and
+/// reciprocal direction splatted across lanes, and which plane (min or max) each axis enters
+/// through. One implementation per instruction set; the traversal is written once over this.
 trait BoxRay {
     fn new(origin: Vec3, dir: Vec3) -> Self;
 
