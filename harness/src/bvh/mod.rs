@@ -43,14 +43,18 @@ pub struct SceneBvh {
     bvh: Option<WideBvh>,
     /// The mesh triangle of each triangle built into the tree.
     built: Vec<u32>,
-    /// Corner positions per triangle, in mesh order.
-    tris: Vec<[Vec3; 3]>,
-    /// Corner shading normals per triangle.
-    normals: Vec<[Vec3; 3]>,
-    /// Corner texture coordinates per triangle.
-    uvs: Vec<[Vec2; 3]>,
-    /// Material per triangle.
-    materials: Vec<u32>,
+    /// What a hit record reads, per triangle in mesh order (one place: a hit touches one
+    /// triangle's record, not four arrays).
+    corners: Vec<Corners>,
+}
+
+/// A triangle's corner positions, shading normals and texture coordinates, and its material.
+#[derive(Clone, Copy, Debug)]
+struct Corners {
+    p: [Vec3; 3],
+    n: [Vec3; 3],
+    uv: [Vec2; 3],
+    material: u32,
 }
 
 /// A triangle as the scalar intersection test reads it: the first corner and the edges to the
@@ -112,10 +116,7 @@ impl SceneBvh {
     /// are treated as degenerate triangles at the origin, which are never hit.
     pub fn new(mesh: &Mesh) -> Self {
         let count = mesh.triangle_count();
-        let mut tris = Vec::with_capacity(count);
-        let mut normals = Vec::with_capacity(count);
-        let mut uvs = Vec::with_capacity(count);
-        let mut materials = Vec::with_capacity(count);
+        let mut corners = Vec::with_capacity(count);
         for t in 0..count {
             let idx = &mesh.indices[3 * t..3 * t + 3];
             let in_range = idx.iter().all(|&i| (i as usize) < mesh.positions.len());
@@ -139,15 +140,17 @@ impl SceneBvh {
                     .unwrap_or(face)
             });
             let uv = [0, 1, 2].map(|k| mesh.uvs.get(at(k)).copied().unwrap_or(Vec2::ZERO));
-            tris.push(p);
-            normals.push(n);
-            uvs.push(uv);
-            materials.push(mesh.materials.get(at(0)).copied().unwrap_or(0));
+            corners.push(Corners {
+                p,
+                n,
+                uv,
+                material: mesh.materials.get(at(0)).copied().unwrap_or(0),
+            });
         }
-        let mut seen = std::collections::HashSet::with_capacity(tris.len());
-        let built: Vec<u32> = (0..tris.len() as u32)
+        let mut seen = std::collections::HashSet::with_capacity(corners.len());
+        let built: Vec<u32> = (0..corners.len() as u32)
             .filter(|&t| {
-                let p = tris[t as usize];
+                let p = corners[t as usize].p;
                 let area = (p[1] - p[0]).cross(p[2] - p[0]).length_squared();
                 let mut key = p.map(|v| v.to_array().map(f32::to_bits));
                 key.sort_unstable();
@@ -158,7 +161,7 @@ impl SceneBvh {
             let obvhs_tris: Vec<Triangle> = built
                 .iter()
                 .map(|&i| {
-                    let t = &tris[i as usize];
+                    let t = &corners[i as usize].p;
                     Triangle {
                         v0: Vec3A::from(t[0]),
                         v1: Vec3A::from(t[1]),
@@ -178,10 +181,7 @@ impl SceneBvh {
         SceneBvh {
             bvh,
             built,
-            tris,
-            normals,
-            uvs,
-            materials,
+            corners,
         }
     }
 
@@ -195,7 +195,7 @@ impl SceneBvh {
 
     /// Number of triangles in the BVH.
     pub fn triangle_count(&self) -> usize {
-        self.tris.len()
+        self.corners.len()
     }
 
     /// Number of triangles in the tree itself: those with area, duplicates counted once.
@@ -225,9 +225,8 @@ impl SceneBvh {
         let (tri, t, u, v) = bvh.closest(origin, dir, t_min, t_max)?;
         let i = tri as usize;
         let w = 1.0 - u - v;
-        let [p0, p1, p2] = self.tris[i];
-        let [n0, n1, n2] = self.normals[i];
-        let [uv0, uv1, uv2] = self.uvs[i];
+        let c = &self.corners[i];
+        let ([p0, p1, p2], [n0, n1, n2], [uv0, uv1, uv2]) = (c.p, c.n, c.uv);
         let mut geometric_normal = (p1 - p0).cross(p2 - p0).normalize_or(Vec3::Y);
         if geometric_normal.dot(dir) > 0.0 {
             geometric_normal = -geometric_normal;
@@ -244,7 +243,7 @@ impl SceneBvh {
             geometric_normal,
             shading_normal,
             uv: w * uv0 + u * uv1 + v * uv2,
-            material: self.materials[i],
+            material: c.material,
         })
     }
 
