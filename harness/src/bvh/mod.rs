@@ -1,7 +1,7 @@
 //! CPU ray casting over the static geometry with an eight-wide BVH (`wide`, collapsed from an
-//! `obvhs` PLOC tree): closest-hit
-//! (triangle, barycentrics, position, normals, material) and any-hit (occlusion) queries. The
-//! techniques use it to place and validate VPLs; the reference renderer traces paths with it.
+//! `obvhs` PLOC tree): closest-hit (triangle, barycentrics, position, normals, material) and
+//! any-hit (occlusion) queries. The techniques use it to place and validate VPLs; the reference
+//! renderer traces paths with it.
 
 use std::time::Duration;
 
@@ -80,8 +80,8 @@ impl Leaf {
 
 /// Möller–Trumbore: `(t, u, v)` of the hit of `origin + t·dir` with triangle `tri` for `t` in
 /// the open interval `(t_min, t_max)`, where `(u, v)` weight corners 1 and 2. Both sides hit.
-/// The tree's four-lane test (`wide::intersect4`) does these operations in this order; the
-/// tests compare the tree against this one.
+/// The tree's lane tests (`wide::intersect4` and the AVX one) do these operations in this
+/// order; the tests compare the tree against this one.
 #[cfg(test)]
 fn intersect(
     tri: &Leaf,
