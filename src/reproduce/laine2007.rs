@@ -489,15 +489,17 @@ fn management(args: &ReproduceArgs) -> Result<Table> {
             // Wall and CPU time (every thread of the process: the rays and Voronoi areas run
             // across cores) of one step; then (untimed) the VPLs lighting the frame.
             let mut used = Vec::with_capacity(frames as usize);
+            let mut rebuilt = 0u32;
             let mut step = |f: u32| {
                 let light = clock.frame(f).light;
                 let c = gibench_harness::calibrate::process_cpu_ms();
                 let t = std::time::Instant::now();
-                m.step(&scene, &bvh, light);
+                let s = m.step(&scene, &bvh, light);
                 let wall = t.elapsed().as_secs_f64() * 1e3;
                 let cpu = c.zip(gibench_harness::calibrate::process_cpu_ms());
                 if f > 0 {
                     used.push(m.vpls().len() as f64);
+                    rebuilt += s.rebuilt as u32;
                 }
                 (wall, cpu.map(|(a, b)| b - a))
             };
@@ -519,12 +521,13 @@ fn management(args: &ReproduceArgs) -> Result<Table> {
                 Cell::Ms(Some(s.p99)),
                 Cell::Ms(Some(s.max)),
                 Cell::Ms(Some(fill)),
+                Cell::Num(Some(rebuilt as f64), 0),
             ]);
             records.insert(
                 format!("{label}-{vpls}"),
                 serde_json::json!({
                     "wall_ms": s, "cpu_ms": c, "fill_frame_wall_ms": fill, "fill_frame_cpu_ms": fill_cpu,
-                    "vpls_used": used,
+                    "vpls_used": used, "frames_rebuilt": rebuilt,
                 }),
             );
         }
@@ -540,6 +543,7 @@ fn management(args: &ReproduceArgs) -> Result<Table> {
             Cell::Ms(None),
             Cell::Ms(None),
             Cell::Ms(None),
+            Cell::Num(None, 0),
         ]);
     }
     let json = serde_json::json!({
@@ -551,7 +555,7 @@ fn management(args: &ReproduceArgs) -> Result<Table> {
     gibench_harness::error::write_atomic(&out(args).join("laine-management.json"), &bytes)?;
     Ok(Table {
         title: format!("VPL management per frame on the CPU ({name}, {frames} frames, recalcMin 4, recalcMax 8)"),
-        columns: ["source", "light", "VPLs", "VPLs used mean", "VPLs used min", "median ms", "median CPU ms", "p99 ms", "max ms", "fill frame ms"]
+        columns: ["source", "light", "VPLs", "VPLs used mean", "VPLs used min", "median ms", "median CPU ms", "p99 ms", "max ms", "fill frame ms", "frames rebuilt"]
             .map(String::from)
             .into(),
         rows,
@@ -562,8 +566,9 @@ fn management(args: &ReproduceArgs) -> Result<Table> {
                  miss rays, and the Voronoi areas from 512 VPLs, run across the machine's {} cores, the triangulation and the \
                  largest-empty-circle search on one). VPLs used: the VPLs lighting each frame after the first (a \
                  sampling point whose ray misses makes none; deletions free recalcMin slots each frame). Fill frame: \
-                 the first frame, which creates every VPL (wall). The \
-                 sphere is triangulated on its surface (no 3D tetrahedralisation).",
+                 the first frame, which creates every VPL (wall). Frames rebuilt: frames after the first whose \
+                 triangulation was built from scratch (a bulk load) instead of moving last frame's with its points \
+                 (`SamplingDomain::update_sites`). The sphere is triangulated on its surface (no 3D tetrahedralisation).",
                 std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1)
             ),
             format!("Paper: {} — a range over its test scenes, median only.", paper["source"].as_str().unwrap_or("")),

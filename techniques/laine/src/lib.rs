@@ -20,9 +20,10 @@
 //!
 //! Deviations (also in the README): the sphere is triangulated on its surface (stereographic
 //! projection into `spade`) instead of with a 3D tetrahedralisation, as the paper's §6 asks for;
-//! the sampling points are re-derived from the VPLs' positions each frame and the triangulation
-//! rebuilt by one bulk load (the paper updates it incrementally; both give the same
-//! triangulation); the first
+//! the sampling points are re-derived from the VPLs' positions each frame and last frame's
+//! triangulation is moved with them, the few sites whose motion breaks it taken out and put
+//! back (`SamplingDomain::update_sites`; the paper does not say how its triangulation follows
+//! the moving points — the result is their Delaunay triangulation either way); the first
 //! frame fills all `vpls` slots (the paper does not describe start-up); intensities are
 //! normalised by the domain's area, and a sampling point whose ray left the scene stays in the
 //! domain (fixed relative to the light, re-tested each frame) so that its share of the power
@@ -161,6 +162,8 @@ pub struct Manager {
     started: bool,
     /// Dispersion of the sampling points after this frame's management.
     last_dispersion: f64,
+    /// The sampling points' domain after the last step.
+    domain: Option<SamplingDomain>,
 }
 
 /// The technique: management plus the shared gathering.
@@ -210,6 +213,9 @@ pub struct Step {
     pub on_rim: u32,
     /// VPLs deleted (invalid or redundant).
     pub deleted: u32,
+    /// Whether the sampling points were triangulated from scratch (the first frame, or where
+    /// moving last frame's triangulation did not apply) rather than moved.
+    pub rebuilt: bool,
 }
 
 impl Manager {
@@ -226,6 +232,7 @@ impl Manager {
             next_id: 0,
             started: false,
             last_dispersion: 0.0,
+            domain: None,
         }
     }
 
@@ -261,7 +268,7 @@ impl Manager {
             })
             .collect();
         // The domain of the valid VPLs' new sampling points, then the misses that still
-        // miss, in that order: one bulk load (the points all moved with the light).
+        // miss, in that order (the points all moved with the light).
         let samples: Vec<Vec3> = self
             .vpls
             .iter()
@@ -281,7 +288,16 @@ impl Manager {
         let site_of_miss: Vec<Option<usize>> = (self.misses.iter().zip(&still_missing))
             .map(|((id, s), ok)| add(*id, *s, *ok))
             .collect();
-        let (mut domain, accepted) = SamplingDomain::from_sites(kind, &sites);
+        let mut rebuilt = true;
+        // Last frame's domain moved to the new points (kinetic, see `update_sites`), or built.
+        let (mut domain, accepted) = match self.domain.take() {
+            Some(mut d) if d.kind() == kind => {
+                let u = d.update_sites(&sites);
+                rebuilt = u.rebuilt;
+                (d, u.accepted)
+            }
+            _ => SamplingDomain::from_sites(kind, &sites),
+        };
         let mut kept = Vec::with_capacity(self.vpls.len());
         for ((m, sample), site) in self.vpls.drain(..).zip(samples).zip(site_of_vpl) {
             if site.is_some_and(|k| accepted[k]) {
@@ -357,11 +373,13 @@ impl Manager {
             m.vpl.flux = power * share as f32 * m.vpl.color;
         }
         self.last_dispersion = domain.dispersion();
+        self.domain = Some(domain);
         Step {
             new_slots,
             created,
             on_rim,
             deleted,
+            rebuilt,
         }
     }
 }

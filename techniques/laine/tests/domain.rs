@@ -753,3 +753,97 @@ fn bulk_built_domain_equals_the_inserted_one() {
         }
     }
 }
+
+/// `update_sites` (the management's per-frame kinetic update: last frame's triangulation moved
+/// with its points, the sites whose motion breaks it taken out and put back) ends where
+/// `from_sites` would: the same accepted sites, Delaunay triangles, largest empty circle,
+/// deletion candidate and Voronoi areas — over 40 frames of a coherent motion (a rotation and
+/// a varying shear, like the sampling points of a moving light) with jitter that turns
+/// triangles over and pushes disc points past the rim, a few sites leaving each frame; then
+/// a new id and an invalid point, which must rebuild. The motion is large enough that the
+/// repair path runs, and small enough that the kinetic path is the one that ran.
+#[test]
+fn moved_domain_equals_the_bulk_built_one() {
+    for kind in [DomainKind::Disc, DomainKind::Sphere] {
+        let pts = point_set(kind, 600, true);
+        let mut sites: Vec<(u64, DVec3)> = (pts.iter().enumerate())
+            .map(|(i, p)| (i as u64 * 5 + 2, *p))
+            .collect();
+        let (mut d, _) = SamplingDomain::from_sites(kind, &sites);
+        let mut rng = Rng(0x5eed + kind as u64);
+        let (mut rebuilt, mut reinserted) = (0, 0);
+        let check = |d: &SamplingDomain, sites: &[(u64, DVec3)], got: &[bool], frame: usize| {
+            let (want_d, want) = SamplingDomain::from_sites(kind, sites);
+            assert_eq!(got, want, "{kind:?} frame {frame}");
+            assert_eq!(
+                canonical_triangles(d),
+                canonical_triangles(&want_d),
+                "{kind:?} frame {frame}"
+            );
+            let (c, r) = d.largest_empty_circle().unwrap();
+            let (wc, wr) = want_d.largest_empty_circle().unwrap();
+            assert!(
+                (c - wc).length() < 1e-12 && (r - wr).abs() < 1e-12,
+                "{kind:?} frame {frame}"
+            );
+            assert_eq!(d.deletion_candidate(), want_d.deletion_candidate());
+            let mut va = d.voronoi_areas();
+            let mut vb = want_d.voronoi_areas();
+            va.sort_by_key(|p| p.0);
+            vb.sort_by_key(|p| p.0);
+            assert_eq!(va.len(), vb.len());
+            for ((ia, x), (ib, y)) in va.iter().zip(&vb) {
+                assert_eq!(ia, ib);
+                assert!(
+                    (x - y).abs() < 1e-12,
+                    "{kind:?} frame {frame} site {ia}: {x} vs {y}"
+                );
+            }
+        };
+        for frame in 0..40 {
+            let (angle, shear) = (0.01, 0.004 * (frame % 3) as f64);
+            let (sin, cos) = f64::sin_cos(angle);
+            for s in &mut sites {
+                let p = s.1;
+                let mut jitter = DVec3::new(rng.next(), rng.next(), rng.next()) - 0.5;
+                let q = match kind {
+                    DomainKind::Disc => {
+                        jitter.z = 0.0;
+                        DVec3::new(
+                            cos * p.x - sin * p.y + shear * p.y,
+                            sin * p.x + cos * p.y,
+                            0.0,
+                        )
+                    }
+                    DomainKind::Sphere => DVec3::new(
+                        cos * p.x - sin * p.z + shear * p.y,
+                        p.y,
+                        sin * p.x + cos * p.z,
+                    )
+                    .normalize(),
+                };
+                s.1 = q + 0.003 * jitter;
+            }
+            for _ in 0..3 {
+                let k = (rng.next() * sites.len() as f64) as usize;
+                sites.swap_remove(k);
+            }
+            let u = d.update_sites(&sites);
+            rebuilt += u.rebuilt as usize;
+            reinserted += u.reinserted;
+            check(&d, &sites, &u.accepted, frame);
+        }
+        assert_eq!(rebuilt, 0, "{kind:?}: rebuilt {rebuilt} of 40 frames");
+        assert!(
+            reinserted >= 40,
+            "{kind:?}: only {reinserted} sites reinserted in 40 frames"
+        );
+        // A site the domain does not hold, and an invalid point: rebuilt, refused as
+        // `from_sites` refuses it.
+        sites.push((1, DVec3::new(0.1, 0.2, 0.3)));
+        sites.push((sites[3].0 + 1, DVec3::new(f64::NAN, 0.0, 0.0)));
+        let u = d.update_sites(&sites);
+        assert!(u.rebuilt);
+        check(&d, &sites, &u.accepted, 40);
+    }
+}
