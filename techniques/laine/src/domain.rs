@@ -259,6 +259,31 @@ fn spherical_triangle_area(a: DVec3, b: DVec3, c: DVec3) -> f64 {
     2.0 * det.atan2(den)
 }
 
+/// The area of the spherical polygon `ring` (in order around `s`, star-shaped from it): the
+/// fan of signed triangles (s, ring[k], ring[k + 1]), |Σ spherical_triangle_area|. Each term is
+/// 2 atan2(det, den); when every corner lies within 60° of `s` (chord < 1) the polygon lies in
+/// a cap of area π, so every term's angle and their sum stay inside (−π/2, π/2) and the sum is
+/// the argument of the product of the (den + i det): one atan2 per polygon instead of one per
+/// corner (the terms' den ≥ 1.5 there, so the product neither vanishes nor overflows for any
+/// degree a triangulation has).
+fn spherical_fan_area(s: DVec3, ring: &[DVec3]) -> f64 {
+    let n = ring.len();
+    if ring.iter().all(|c| (*c - s).length_squared() < 1.0) {
+        let (mut re, mut im) = (1.0, 0.0);
+        for k in 0..n {
+            let (a, b) = (ring[k], ring[(k + 1) % n]);
+            let det = s.dot(a.cross(b));
+            let den = 1.0 + s.dot(a) + a.dot(b) + b.dot(s);
+            (re, im) = (re * den - im * det, re * det + im * den);
+        }
+        return (2.0 * im.atan2(re)).abs();
+    }
+    (0..n)
+        .map(|k| spherical_triangle_area(s, ring[k], ring[(k + 1) % n]))
+        .sum::<f64>()
+        .abs()
+}
+
 /// Unit circumcentre of the spherical triangle (a, b, c) (counter-clockwise seen from outside):
 /// the outward normal of its plane, i.e. the centre of the circumcap on the empty side.
 fn spherical_circumcentre(a: DVec3, b: DVec3, c: DVec3) -> DVec3 {
@@ -638,15 +663,8 @@ impl SamplingDomain {
             *self.tri.vertex_data_mut(h) = site;
         }
         self.pole = pole;
-        for g in &mut self.grids {
-            g.fill(u64::MAX);
-        }
-        for v in self.tri.vertices() {
-            let s = v.data();
-            for level in 0..2 {
-                self.grids[level][grid_cell(self.kind, level, s.point)] = s.id;
-            }
-        }
+        // The location grids keep last frame's sites: a moved site is still a good place to
+        // start a walk from, and a hint never changes the result.
         self.lec_mut().valid = false;
         let reinserted = pending.len();
         for site in pending {
@@ -978,11 +996,7 @@ impl SamplingDomain {
             if np == 1 {
                 out.push(0);
             } else {
-                for e in self.tri.directed_edges() {
-                    if e.is_outer_edge() {
-                        out.push(e.from().fix().index());
-                    }
-                }
+                out.extend(self.tri.convex_hull().map(|e| e.from().fix().index()));
             }
         }
         out.sort_unstable();
@@ -1132,6 +1146,13 @@ impl SamplingDomain {
         let (p, q) = (pos(e.from()), pos(e.to()));
         let left = e.face().as_inner().map(|f| centres[f.fix().index()]);
         let right = e.rev().face().as_inner().map(|f| centres[f.fix().index()]);
+        // Both ends inside the disc (with a margin far above rounding): the Voronoi edge, a
+        // segment between them, cannot reach the rim.
+        let inside =
+            |c: Option<Option<DVec2>>| c.flatten().is_some_and(|c| c.length_squared() < 1.0 - 1e-9);
+        if inside(left) && inside(right) {
+            return out;
+        }
         let normal = (q - p).perp().normalize_or_zero();
         let (origin, t_range) = match (left, right) {
             (Some(Some(l)), Some(Some(r))) => (r, (0.0, (l - r).dot(normal))),
@@ -1236,8 +1257,9 @@ impl SamplingDomain {
                     lec.faces
                         .set_leaf(f.fix().index(), self.sphere_face_slot(f.fix()));
                 }
+                // Only the convex hull's edges (the outer face's) have a wrap-around triangle.
                 lec.wraps.reset(t.num_directed_edges());
-                for d in t.directed_edges() {
+                for d in t.convex_hull() {
                     lec.wraps
                         .set_leaf(d.fix().index(), self.sphere_wrap_slot(d.fix()));
                 }
@@ -1517,17 +1539,24 @@ impl SamplingDomain {
             // One cell per site, in site order: from the circumcentres of its faces where the
             // cell lies inside the disc, by clipping otherwise.
             DomainKind::Disc => {
-                let centres: Vec<Option<DVec2>> = self
-                    .tri
-                    .all_faces()
-                    .map(|f| f.as_inner().and_then(|f| self.disc_face_centre(f.fix())))
-                    .collect();
+                // The circumcentres the largest-empty-circle candidates keep (the same
+                // function's values), or computed here.
+                let lec = self.lec_cache();
+                let computed: Vec<Option<DVec2>>;
+                let centres = if lec.valid && lec.centres.len() == self.tri.num_all_faces() {
+                    &lec.centres[..]
+                } else {
+                    computed = (self.tri.all_faces())
+                        .map(|f| f.as_inner().and_then(|f| self.disc_face_centre(f.fix())))
+                        .collect();
+                    &computed[..]
+                };
                 map_sites(
                     self.tri.num_vertices(),
                     DiscCellScratch::default,
                     |scratch, i| {
                         let v = FixedVertexHandle::from_index(i);
-                        if let Some(area) = self.disc_inner_cell_area(v, &centres) {
+                        if let Some(area) = self.disc_inner_cell_area(v, centres) {
                             return (self.site_id(i), area);
                         }
                         let poly = self.disc_cell(v, scratch);
@@ -1558,20 +1587,27 @@ impl SamplingDomain {
             return lune_areas(&pts, m);
         }
         let (tris, wraps) = self.triangles_and_wraps();
-        let centres: Vec<DVec3> = tris
-            .iter()
-            .map(|t| {
-                let [a, b, c] = t.map(|i| self.site_point(i as usize));
-                spherical_circumcentre(a, b, c)
-            })
-            .collect();
-        let fan_area = |s: DVec3, ring: &[DVec3]| -> f64 {
-            let n = ring.len();
-            (0..n)
-                .map(|k| spherical_triangle_area(s, ring[k], ring[(k + 1) % n]))
-                .sum::<f64>()
-                .abs()
+        // The circumcentres the largest-empty-circle candidates keep (the same function's
+        // values: `sphere_triangle_slot`), or computed here.
+        let lec = self.lec_cache();
+        let kept = lec.valid
+            && lec.faces.len() == self.tri.num_all_faces()
+            && lec.wraps.len() == self.tri.num_directed_edges();
+        let centres: Vec<DVec3> = if kept {
+            let inner = (1..self.tri.num_all_faces()).map(|f| lec.faces.centre(f));
+            let outer = (self.tri.directed_edges())
+                .filter(|e| e.is_outer_edge())
+                .map(|e| lec.wraps.centre(e.fix().index()));
+            inner.chain(outer).collect()
+        } else {
+            (tris.iter())
+                .map(|t| {
+                    let [a, b, c] = t.map(|i| self.site_point(i as usize));
+                    spherical_circumcentre(a, b, c)
+                })
+                .collect()
         };
+        drop(lec);
         // One cell per planar site, in site order; then the pole's.
         let mut out: Vec<(u64, f64)> = map_sites(
             self.tri.num_vertices(),
@@ -1588,7 +1624,7 @@ impl SamplingDomain {
                         }
                     }
                 }
-                (v.data().id, fan_area(v.data().point, ring))
+                (v.data().id, spherical_fan_area(v.data().point, ring))
             },
         );
         let mut ring: Vec<DVec3> = Vec::with_capacity(16);
@@ -1604,7 +1640,7 @@ impl SamplingDomain {
                     }
                 }
             }
-            out.push((pole.id, fan_area(pole.point, &ring)));
+            out.push((pole.id, spherical_fan_area(pole.point, &ring)));
         }
         out
     }

@@ -66,7 +66,10 @@ impl MaxTree {
         self.centre.resize(len, DVec3::ZERO);
         self.site.clear();
         self.site.resize(len, 0);
-        self.cap = len.next_power_of_two().max(1);
+        // Room for an eighth more slots: the insertions after a recompute (a frame's new
+        // sampling points) then grow the slots without rebuilding the tree. The winner does
+        // not depend on the tree's shape (largest radius, then lowest slot: a total order).
+        self.cap = (len + len / 8).next_power_of_two().max(1);
         self.node.clear();
         self.node.resize(2 * self.cap, NONE);
         for i in 0..len {
@@ -119,6 +122,16 @@ impl MaxTree {
             self.node[n] = self.better(self.node[2 * n], self.node[2 * n + 1]);
             n /= 2;
         }
+    }
+
+    /// The number of slots.
+    pub(crate) fn len(&self) -> usize {
+        self.radius.len()
+    }
+
+    /// Slot `i`'s centre (zero where it holds no candidate).
+    pub(crate) fn centre(&self, i: usize) -> DVec3 {
+        self.centre[i]
     }
 
     /// The best slot's candidate, `None` if no slot has one.
