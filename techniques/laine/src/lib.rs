@@ -186,6 +186,10 @@ fn domain_kind(light: &LightPose) -> DomainKind {
     }
 }
 
+/// Creation rays from which a batch is cast across cores (the first frame's); a frame's few
+/// are cast on the calling thread.
+const PARALLEL_RAYS: usize = 64;
+
 /// Whether a VPL is still lit by the light at its new position (§4.4): in front of a spot's
 /// (or area light's) plane — sampling points on the disc's boundary circle, which the
 /// largest-empty-circle search produces, lie exactly in it and stay valid —, its surface
@@ -338,29 +342,57 @@ impl Manager {
         let mut new_slots = Vec::new();
         let mut created = 0;
         let mut on_rim = 0;
-        while created < budget
-            && (self.vpls.len() as u32) < self.max_lights
-            && self.misses.len() < self.max_lights as usize
-        {
-            let Some((centre, _, site)) = domain.largest_empty_circle_near() else {
+        // In batches: a batch of k sampling points, k = the creations left before the budget,
+        // the VPL slots or the miss list could run out (each creation adds one VPL or one
+        // miss), is inserted one by one as before, then its rays are cast — across cores for
+        // large batches (the first frame's) — and their results taken in order. The points
+        // and outcomes are the one-at-a-time loop's: the rays do not depend on the domain.
+        let mut batch: Vec<(u64, Vec3)> = Vec::new();
+        loop {
+            let room = (budget - created)
+                .min(self.max_lights.saturating_sub(self.vpls.len() as u32))
+                .min((self.max_lights as usize).saturating_sub(self.misses.len()) as u32);
+            if room == 0 {
                 break;
+            }
+            batch.clear();
+            let mut stopped = false;
+            for _ in 0..room {
+                let Some((centre, _, site)) = domain.largest_empty_circle_near() else {
+                    stopped = true;
+                    break;
+                };
+                let id = self.next_id;
+                self.next_id += 1;
+                if domain.insert_near(id, centre, site).is_err() {
+                    stopped = true;
+                    break;
+                }
+                created += 1;
+                if kind == DomainKind::Disc && centre.truncate().length() >= 1.0 - 1e-9 {
+                    on_rim += 1;
+                }
+                batch.push((id, centre.as_vec3()));
+            }
+            let ray = |&(id, sample): &(u64, Vec3)| {
+                vpl::vpl_from_sample(scene, bvh, &light, sample, Vec3::ZERO, id)
             };
-            let id = self.next_id;
-            self.next_id += 1;
-            if domain.insert_near(id, centre, site).is_err() {
-                break;
-            }
-            created += 1;
-            if kind == DomainKind::Disc && centre.truncate().length() >= 1.0 - 1e-9 {
-                on_rim += 1;
-            }
-            let sample = centre.as_vec3();
-            if let Some(v) = vpl::vpl_from_sample(scene, bvh, &light, sample, Vec3::ZERO, id) {
-                let slot = self.free_slots.pop().expect("fewer VPLs than slots");
-                new_slots.push(slot);
-                self.vpls.push(Managed { id, slot, vpl: v });
+            let hits: Vec<Option<Vpl>> = if batch.len() >= PARALLEL_RAYS {
+                batch.par_iter().map(ray).collect()
             } else {
-                self.misses.push((id, sample));
+                batch.iter().map(ray).collect()
+            };
+            for (&(id, sample), hit) in batch.iter().zip(hits) {
+                if let Some(v) = hit {
+                    let slot = self.free_slots.pop().expect("fewer VPLs than slots");
+                    new_slots.push(slot);
+                    self.vpls.push(Managed { id, slot, vpl: v });
+                } else {
+                    self.misses.push((id, sample));
+                }
+            }
+            if stopped {
+                break;
             }
         }
         // 4. Intensities: Voronoi areas over the domain's area.
