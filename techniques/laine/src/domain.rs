@@ -1573,41 +1573,44 @@ impl SamplingDomain {
     }
 
     fn sphere_voronoi_areas(&self) -> Vec<(u64, f64)> {
-        let pts = self.points();
-        match pts.len() {
-            0 => return Vec::new(),
-            1 => return vec![(pts[0].0, 4.0 * PI)],
-            2 => return vec![(pts[0].0, 2.0 * PI), (pts[1].0, 2.0 * PI)],
-            _ => {}
+        let n = self.len();
+        if n < 3 {
+            let pts = self.points();
+            return match n {
+                0 => Vec::new(),
+                1 => vec![(pts[0].0, 4.0 * PI)],
+                _ => vec![(pts[0].0, 2.0 * PI), (pts[1].0, 2.0 * PI)],
+            };
         }
         // Coplanar sites (all on one circle): lunes.
-        let (a, b, c) = (pts[0].1, pts[1].1, pts[2].1);
+        let [a, b, c] = [0, 1, 2].map(|i| self.site_point(i));
         let m = spherical_circumcentre(a, b, c);
-        if m != DVec3::ZERO && pts.iter().all(|&(_, x)| m.dot(x - a).abs() <= 1e-10) {
-            return lune_areas(&pts, m);
+        if m != DVec3::ZERO && (0..n).all(|i| m.dot(self.site_point(i) - a).abs() <= 1e-10) {
+            return lune_areas(&self.points(), m);
         }
-        let (tris, wraps) = self.triangles_and_wraps();
-        // The circumcentres the largest-empty-circle candidates keep (the same function's
-        // values: `sphere_triangle_slot`), or computed here.
+        // The circumcentres of the triangles around each site: those the largest-empty-circle
+        // candidates keep (the same function's values: `sphere_triangle_slot`), or computed.
         let lec = self.lec_cache();
         let kept = lec.valid
             && lec.faces.len() == self.tri.num_all_faces()
             && lec.wraps.len() == self.tri.num_directed_edges();
-        let centres: Vec<DVec3> = if kept {
-            let inner = (1..self.tri.num_all_faces()).map(|f| lec.faces.centre(f));
-            let outer = (self.tri.directed_edges())
-                .filter(|e| e.is_outer_edge())
-                .map(|e| lec.wraps.centre(e.fix().index()));
-            inner.chain(outer).collect()
-        } else {
-            (tris.iter())
-                .map(|t| {
-                    let [a, b, c] = t.map(|i| self.site_point(i as usize));
-                    spherical_circumcentre(a, b, c)
-                })
-                .collect()
+        let lec = &*lec;
+        let face_centre = |f: FixedFaceHandle<InnerTag>| {
+            if kept {
+                return lec.faces.centre(f.index());
+            }
+            let [a, b, c] = self.tri.face(f).vertices().map(|v| v.data().point);
+            spherical_circumcentre(a, b, c)
         };
-        drop(lec);
+        // The wrap-around triangle (from, to, pole) of outer edge `e`.
+        let wrap_centre = |e: FixedDirectedEdgeHandle| {
+            if kept {
+                return lec.wraps.centre(e.index());
+            }
+            let e = self.tri.directed_edge(e);
+            let [a, b] = [e.from(), e.to()].map(|v| v.data().point);
+            spherical_circumcentre(a, b, self.site_point(self.pole_index()))
+        };
         // One cell per planar site, in site order; then the pole's.
         let mut out: Vec<(u64, f64)> = map_sites(
             self.tri.num_vertices(),
@@ -1617,29 +1620,20 @@ impl SamplingDomain {
                 ring.clear();
                 for e in v.out_edges() {
                     match e.face().as_inner() {
-                        Some(f) => ring.push(centres[f.fix().index() - 1]),
+                        Some(f) => ring.push(face_centre(f.fix())),
                         None => {
-                            ring.push(centres[wraps[e.fix().index()] as usize]);
-                            ring.push(centres[wraps[e.prev().fix().index()] as usize]);
+                            ring.push(wrap_centre(e.fix()));
+                            ring.push(wrap_centre(e.prev().fix()));
                         }
                     }
                 }
                 (v.data().id, spherical_fan_area(v.data().point, ring))
             },
         );
-        let mut ring: Vec<DVec3> = Vec::with_capacity(16);
         if let Some(pole) = self.pole {
-            ring.clear();
-            if let Some(start) = self.tri.directed_edges().find(|e| e.is_outer_edge()) {
-                let mut e = start;
-                loop {
-                    ring.push(centres[wraps[e.fix().index()] as usize]);
-                    e = e.next();
-                    if e.fix() == start.fix() || ring.len() > tris.len() {
-                        break;
-                    }
-                }
-            }
+            let ring: Vec<DVec3> = (self.tri.convex_hull())
+                .map(|e| wrap_centre(e.fix()))
+                .collect();
             out.push((pole.id, spherical_fan_area(pole.point, &ring)));
         }
         out

@@ -398,10 +398,14 @@ impl Manager {
         // 4. Intensities: Voronoi areas over the domain's area.
         let total = light.domain().area();
         let power = light.emitted_flux(extent);
-        let areas: std::collections::HashMap<u64, f64> =
-            domain.voronoi_areas().into_iter().collect();
+        let mut areas = domain.voronoi_areas();
+        areas.sort_unstable_by_key(|a| a.0);
         for m in &mut self.vpls {
-            let share = areas.get(&m.id).copied().unwrap_or(0.0) / total;
+            let area = match areas.binary_search_by_key(&m.id, |a| a.0) {
+                Ok(k) => areas[k].1,
+                Err(_) => 0.0,
+            };
+            let share = area / total;
             m.vpl.flux = power * share as f32 * m.vpl.color;
         }
         self.last_dispersion = domain.dispersion();
