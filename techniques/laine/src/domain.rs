@@ -596,17 +596,12 @@ impl SamplingDomain {
         if sites.len() < 8 || self.tri.num_inner_faces() == 0 {
             return None;
         }
-        let mut index: IdMap<usize> =
-            IdMap::with_capacity_and_hasher(sites.len(), Default::default());
-        for (k, &(id, _)) in sites.iter().enumerate() {
-            if index.insert(id, k).is_some() || !self.slots.contains_key(&id) {
-                return None;
-            }
-        }
-        // The new pole (it must stay), then every other site's new planar position.
+        // The new pole (it must stay: its id among the sites), then per vertex (spade's
+        // index) its site at the new point; a site the domain does not hold, or a repeated
+        // one, rebuilds.
         let pole = match self.pole {
             Some(p) => {
-                let x = sites[*index.get(&p.id)?].1;
+                let x = sites.iter().find(|s| s.0 == p.id)?.1;
                 let len = x.length();
                 if !(len > 0.0 && len.is_finite()) {
                     return None;
@@ -615,20 +610,37 @@ impl SamplingDomain {
             }
             None => None,
         };
+        let n = self.tri.num_vertices();
+        let mut target = vec![None; n];
+        let mut pole_seen = false;
+        for &(id, point) in sites {
+            match *self.slots.get(&id)? {
+                Slot::Planar(h) => {
+                    let slot = &mut target[h.index()];
+                    if slot.is_some() {
+                        return None;
+                    }
+                    let (pos, point) = stored_site(self.kind, pole.as_ref(), point).ok()??;
+                    *slot = Some(Site { pos, point, id });
+                }
+                Slot::Pole if !pole_seen => pole_seen = true,
+                Slot::Pole => return None,
+            }
+        }
+        // Remove the sites that are gone (spade swap-removes a vertex; so does `target`).
         let gone: Vec<u64> = (self.tri.vertices())
-            .map(|v| v.data().id)
-            .filter(|id| !index.contains_key(id))
+            .zip(&target)
+            .filter(|(_, t)| t.is_none())
+            .map(|(v, _)| v.data().id)
             .collect();
         for id in gone {
+            let Some(Slot::Planar(h)) = self.slots.get(&id) else {
+                return None;
+            };
+            target.swap_remove(h.index());
             self.remove(id)?;
         }
-        // Per vertex (spade's index), its site at the new point.
-        let mut target = Vec::with_capacity(self.tri.num_vertices());
-        for v in self.tri.vertices() {
-            let (id, point) = sites[index[&v.data().id]];
-            let (pos, point) = stored_site(self.kind, pole.as_ref(), point).ok()??;
-            target.push(Site { pos, point, id });
-        }
+        let mut target: Vec<Site> = target.into_iter().collect::<Option<_>>()?;
         // Remove (at the old points) what the motion would break, until nothing is.
         let limit = sites.len() / 4;
         let mut pending: Vec<Site> = Vec::new();
