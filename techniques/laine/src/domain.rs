@@ -201,6 +201,42 @@ impl Pole {
     }
 }
 
+/// A Delaunay edge as a queue key: its squared length, then its two ids (smaller first), so
+/// that equal lengths are ordered by the sites, not by the triangulation's numbering.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+struct EdgeKey {
+    /// The squared length's bits (a non-negative float orders as its bits).
+    bits: u64,
+    ids: [u64; 2],
+}
+
+impl EdgeKey {
+    fn new(l2: f64, a: u64, b: u64) -> Self {
+        EdgeKey {
+            bits: l2.to_bits(),
+            ids: [a.min(b), a.max(b)],
+        }
+    }
+
+    fn length(&self) -> f64 {
+        f64::from_bits(self.bits).sqrt()
+    }
+}
+
+/// The Delaunay edges of a [`SamplingDomain`] by length (see
+/// [`SamplingDomain::remove_redundant`]).
+#[derive(Debug)]
+pub struct RedundancyQueue {
+    heap: std::collections::BinaryHeap<std::cmp::Reverse<EdgeKey>>,
+    /// The longest edge queued by the last pass, if it left edges out (all longer).
+    bound: Option<EdgeKey>,
+    scratch: Vec<usize>,
+}
+
+/// Edges [`SamplingDomain::redundancy_queue`] keeps from one pass (a frame deletes a few
+/// sites, each taking its shortest edge and a handful of its neighbours' with it).
+const QUEUED_EDGES: usize = 32;
+
 /// What [`SamplingDomain::update_sites`] did.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct SiteUpdate {
@@ -1460,10 +1496,11 @@ impl SamplingDomain {
     }
 
     fn shortest_edge_indices(&self) -> Option<(usize, usize, f64)> {
-        let mut best: Option<(usize, usize, f64)> = None;
+        let mut best: Option<(EdgeKey, usize, usize)> = None;
         let mut consider = |a: usize, b: usize, l2: f64| {
-            if best.is_none_or(|(_, _, bl)| l2 < bl) {
-                best = Some((a, b, l2));
+            let key = EdgeKey::new(l2, self.site_id(a), self.site_id(b));
+            if best.is_none_or(|(k, _, _)| key < k) {
+                best = Some((key, a, b));
             }
         };
         for e in self.tri.undirected_edges() {
@@ -1480,7 +1517,7 @@ impl SamplingDomain {
                 consider(np, i, (self.site_point(i) - pp).length_squared());
             }
         }
-        best.map(|(a, b, l2)| (a, b, l2.sqrt()))
+        best.map(|(k, a, b)| (a, b, k.length()))
     }
 
     /// The distance from site `index` to its second-closest Delaunay neighbour (+∞ with fewer
@@ -1515,17 +1552,115 @@ impl SamplingDomain {
     /// fewer than two sites.
     pub fn deletion_candidate(&self) -> Option<u64> {
         let (a, b, _) = self.shortest_edge_indices()?;
+        Some(self.redundant_endpoint(a, b))
+    }
+
+    /// Of the endpoints (internal indices) of a shortest edge, the one §4.5 deletes.
+    fn redundant_endpoint(&self, a: usize, b: usize) -> u64 {
         let mut scratch = Vec::new();
         let da = self.second_closest_distance(a, &mut scratch);
         let db = self.second_closest_distance(b, &mut scratch);
         let (ia, ib) = (self.site_id(a), self.site_id(b));
-        Some(if da < db {
+        if da < db {
             ia
         } else if db < da {
             ib
         } else {
             ia.max(ib)
-        })
+        }
+    }
+
+    /// The shortest Delaunay edges, for a run of §4.5 deletions with
+    /// [`remove_redundant`](Self::remove_redundant): one pass over the edges keeps the
+    /// 32 shortest (and the longest of them as a bound: every edge left out is
+    /// longer), instead of one pass per deletion.
+    pub fn redundancy_queue(&self) -> RedundancyQueue {
+        let mut best: std::collections::BinaryHeap<EdgeKey> =
+            std::collections::BinaryHeap::with_capacity(QUEUED_EDGES + 1);
+        let mut total = 0;
+        let mut keep = |key: EdgeKey| {
+            total += 1;
+            if best.len() < QUEUED_EDGES {
+                best.push(key);
+            } else if best.peek().is_some_and(|m| key < *m) {
+                best.pop();
+                best.push(key);
+            }
+        };
+        for e in self.tri.undirected_edges() {
+            let [a, b] = e.vertices();
+            let l2 = (a.data().point - b.data().point).length_squared();
+            keep(EdgeKey::new(l2, a.data().id, b.data().id));
+        }
+        if self.pole.is_some() {
+            let np = self.pole_index();
+            let mut nb = Vec::new();
+            self.neighbours(np, &mut nb);
+            let (p, id) = (self.site_point(np), self.site_id(np));
+            for n in nb {
+                let l2 = (self.site_point(n) - p).length_squared();
+                keep(EdgeKey::new(l2, id, self.site_id(n)));
+            }
+        }
+        let bound = (total > best.len()).then(|| best.peek().copied()).flatten();
+        RedundancyQueue {
+            heap: best.into_iter().map(std::cmp::Reverse).collect(),
+            bound,
+            scratch: Vec::new(),
+        }
+    }
+
+    /// Pushes the edges of site `index` onto `q`.
+    fn queue_edges_of(&self, index: usize, q: &mut RedundancyQueue) {
+        let mut nb = std::mem::take(&mut q.scratch);
+        self.neighbours(index, &mut nb);
+        let (p, id) = (self.site_point(index), self.site_id(index));
+        for &n in &nb {
+            let l2 = (self.site_point(n) - p).length_squared();
+            q.heap
+                .push(std::cmp::Reverse(EdgeKey::new(l2, id, self.site_id(n))));
+        }
+        q.scratch = nb;
+    }
+
+    /// Deletes the site [`deletion_candidate`](Self::deletion_candidate) names, taking the
+    /// shortest edge from `q` (built by [`redundancy_queue`](Self::redundancy_queue) on this
+    /// domain, and changed since only by this method): entries whose edge is gone are skipped
+    /// (a site of theirs was removed — or, with cocircular sites, a removal chose the other
+    /// diagonal), and the edges around the hole are queued after the removal. Returns the id removed,
+    /// `None` with fewer than two sites.
+    pub fn remove_redundant(&mut self, q: &mut RedundancyQueue) -> Option<u64> {
+        let (a, b) = loop {
+            // The shortest queued edge is the shortest edge if it is within the bound;
+            // otherwise the queue is refilled.
+            let k = match q.heap.peek() {
+                Some(&std::cmp::Reverse(k)) if q.bound.is_none_or(|b| k <= b) => k,
+                _ if q.bound.is_some() => {
+                    *q = self.redundancy_queue();
+                    continue;
+                }
+                _ => return None,
+            };
+            q.heap.pop();
+            let (Some(a), Some(b)) = (self.index_of(k.ids[0]), self.index_of(k.ids[1])) else {
+                continue;
+            };
+            self.neighbours(a, &mut q.scratch);
+            if q.scratch.contains(&b) {
+                break (a, b);
+            }
+        };
+        let victim = self.redundant_endpoint(a, b);
+        let index = self.index_of(victim)?;
+        self.neighbours(index, &mut q.scratch);
+        let around: Vec<u64> = q.scratch.iter().map(|&n| self.site_id(n)).collect();
+        self.remove(victim)?;
+        for id in around {
+            if let Some(n) = self.index_of(id) {
+                self.queue_edges_of(n, q);
+            }
+        }
+        Some(victim)
     }
 
     /// The area of every site's Voronoi region (§4.7, after Yakowitz et al.), to which the

@@ -320,11 +320,12 @@ impl Manager {
         self.misses
             .retain(|_| site_of_miss.next().flatten().is_some_and(|k| accepted[k]));
         // 2. Deletion of redundant VPLs until recalc-min slots are free.
+        let mut queue = None;
         while (self.free_slots.len() as u32) < self.recalc_min {
-            let Some(id) = domain.deletion_candidate() else {
+            let q = queue.get_or_insert_with(|| domain.redundancy_queue());
+            let Some(id) = domain.remove_redundant(q) else {
                 break;
             };
-            domain.remove(id);
             self.misses.retain(|(m, _)| *m != id);
             if let Some(i) = self.vpls.iter().position(|m| m.id == id) {
                 let m = self.vpls.remove(i);

@@ -847,3 +847,27 @@ fn moved_domain_equals_the_bulk_built_one() {
         check(&d, &sites, &u.accepted, 40);
     }
 }
+
+/// `remove_redundant` (the management's run of §4.5 deletions from one queue of edges) deletes
+/// the sites that `deletion_candidate` and `remove` called in turn delete, in the same order —
+/// down to two sites, on the disc and on the sphere (whose projection pole is deleted along
+/// the way) — and leaves the same domain.
+#[test]
+fn queued_deletions_equal_repeated_candidates() {
+    for kind in [DomainKind::Disc, DomainKind::Sphere] {
+        for random in [true, false] {
+            let pts = point_set(kind, 200, random);
+            let mut a = build(kind, &pts);
+            let mut b = a.clone();
+            let mut q = b.redundancy_queue();
+            for step in 0..198 {
+                let want = a.deletion_candidate().unwrap();
+                a.remove(want).unwrap();
+                let got = b.remove_redundant(&mut q);
+                assert_eq!(got, Some(want), "{kind:?} random {random} deletion {step}");
+            }
+            assert_eq!(canonical_triangles(&a), canonical_triangles(&b));
+            assert_eq!(a.len(), 2);
+        }
+    }
+}
