@@ -397,10 +397,12 @@ fn clip_half_plane(poly: &[DVec2], m: DVec2, d: DVec2, out: &mut Vec<DVec2>) {
     }
 }
 
-/// Sites from which per-site passes (the Voronoi areas) run across cores; below it one thread
-/// is faster than handing the work out (and the instruction-count gate's 256-site kernels
-/// count all of it).
-const PARALLEL_SITES: usize = 512;
+/// Sites from which per-site passes (the Voronoi areas) run across cores. Below it one thread
+/// is faster: measured in the management at 1024 sites on 2 cores (frames alternating between
+/// the two ways in one run), handing the pass to the pool cost more than it saved — its
+/// workers sleep between a frame's passes, and waking them and the caller costs tens of
+/// microseconds.
+const PARALLEL_SITES: usize = 4096;
 
 /// How a point enters a domain of `kind` whose sphere pole is `pole`
 /// ([`SamplingDomain::insert`]'s rules, shared with [`SamplingDomain::from_sites`]):

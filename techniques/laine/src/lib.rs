@@ -320,18 +320,24 @@ impl Manager {
         self.misses
             .retain(|_| site_of_miss.next().flatten().is_some_and(|k| accepted[k]));
         // 2. Deletion of redundant VPLs until recalc-min slots are free.
+        // The VPLs are in creation order, so their ids ascend: found by binary search, and
+        // taken out of the lists in one pass at the end.
         let mut queue = None;
+        let mut gone = Vec::new();
         while (self.free_slots.len() as u32) < self.recalc_min {
             let q = queue.get_or_insert_with(|| domain.redundancy_queue());
             let Some(id) = domain.remove_redundant(q) else {
                 break;
             };
-            self.misses.retain(|(m, _)| *m != id);
-            if let Some(i) = self.vpls.iter().position(|m| m.id == id) {
-                let m = self.vpls.remove(i);
-                self.free_slots.push(m.slot);
+            gone.push(id);
+            if let Ok(i) = self.vpls.binary_search_by_key(&id, |m| m.id) {
+                self.free_slots.push(self.vpls[i].slot);
                 deleted += 1;
             }
+        }
+        if !gone.is_empty() {
+            self.vpls.retain(|m| !gone.contains(&m.id));
+            self.misses.retain(|(m, _)| !gone.contains(m));
         }
         // 3. Creation at the largest empty circle's centre.
         let budget = if self.started {
