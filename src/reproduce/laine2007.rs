@@ -563,8 +563,7 @@ fn management(args: &ReproduceArgs) -> Result<Table> {
             format!(
                 "gibench: validity rays, deletion, creation rays and Voronoi intensities of `laine`'s manager per frame \
                  after the first: wall time (median, p99, max) and CPU time of every thread (median; the validity and \
-                 miss rays, and the Voronoi areas from 512 VPLs, run across the machine's {} cores, the triangulation and the \
-                 largest-empty-circle search on one). VPLs used: the VPLs lighting each frame after the first (a \
+                 miss rays run across the machine's {} cores, as do the first frame's creation rays; the rest on one). VPLs used: the VPLs lighting each frame after the first (a \
                  sampling point whose ray misses makes none; deletions free recalcMin slots each frame). Fill frame: \
                  the first frame, which creates every VPL (wall). Frames rebuilt: frames after the first whose \
                  triangulation was built from scratch (a bulk load) instead of moving last frame's with its points \

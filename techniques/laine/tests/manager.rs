@@ -140,10 +140,11 @@ fn fnv(h: &mut u64, word: u64) {
 /// The VPL layout frame by frame — every VPL's slot, position, normal and sampling point, the
 /// counts created and deleted — over 300 frames of the moving light, hashed and pinned, and the
 /// dispersion's sum over the frames: the faster management (kept largest-empty-circle
-/// candidates, hinted point location, rays and Voronoi areas across cores, the per-frame bulk
-/// load) must give exactly the layout the rules gave before it. The constants were computed with
-/// the sites inserted one by one (before the bulk load); a bulk load numbers the triangles'
-/// corners differently, so a circumradius can differ in its last bits (≤ 10⁻¹³ relative), hence
+/// candidates, hinted point location, rays across cores, the per-frame bulk load, then the
+/// moved triangulation and the queued deletions) must give exactly the layout the rules gave
+/// before it. The constants were computed with the sites inserted one by one (before the bulk
+/// load); another numbering of the triangles' corners can move a circumradius in its last bits
+/// (≤ 10⁻¹³ relative), hence
 /// the dispersion's tolerance. The per-frame flux, which goes through libm's atan2, is left out.
 /// A deliberate change of the rules changes these.
 #[test]
