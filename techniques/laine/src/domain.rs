@@ -1295,12 +1295,12 @@ impl SamplingDomain {
                 lec.edges.reset(2 * t.num_undirected_edges());
                 for u in t.fixed_undirected_edges() {
                     let [a, b] = self.disc_edge_slots(u, &lec.centres);
-                    lec.edges.set_leaf(2 * u.index(), a);
-                    lec.edges.set_leaf(2 * u.index() + 1, b);
+                    lec.edges.set(2 * u.index(), a);
+                    lec.edges.set(2 * u.index() + 1, b);
                 }
                 lec.vertices.reset(t.num_vertices());
                 for v in t.fixed_vertices() {
-                    lec.vertices.set_leaf(v.index(), self.disc_vertex_slot(v));
+                    lec.vertices.set(v.index(), self.disc_vertex_slot(v));
                 }
                 lec.wraps.reset(0);
             }
@@ -1313,20 +1313,13 @@ impl SamplingDomain {
                 lec.wraps.reset(t.num_directed_edges());
                 for d in t.convex_hull() {
                     lec.wraps
-                        .set_leaf(d.fix().index(), self.sphere_wrap_slot(d.fix()));
+                        .set(d.fix().index(), self.sphere_wrap_slot(d.fix()));
                 }
                 lec.edges.reset(0);
                 lec.vertices.reset(0);
             }
         }
-        for tree in [
-            &mut lec.faces,
-            &mut lec.edges,
-            &mut lec.vertices,
-            &mut lec.wraps,
-        ] {
-            tree.build();
-        }
+        lec.faces.build();
         lec.valid = true;
     }
 

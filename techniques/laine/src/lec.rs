@@ -5,11 +5,12 @@
 //! candidate (centre, radius) per slot — per inner face (its circumcentre), per undirected edge
 //! two (its Voronoi edge crossing the disc's rim), per vertex one (the rim point opposite it),
 //! and on the sphere per outer directed edge one (the wrap-around triangle at the pole) — with
-//! a max tree per kind, so the largest empty circle is a lookup, not a pass over the
-//! triangulation.
+//! a max tree over the faces and, for the other kinds (whose few candidates lie near the hull),
+//! a short list of the slots that hold one, so the largest empty circle is a lookup, not a
+//! pass over the triangulation.
 //!
 //! The answer is the one of the plain scan (faces, then edges, then vertices, each in index
-//! order, the first strictly largest radius winning): each tree breaks ties towards the lower
+//! order, the first strictly largest radius winning): each kind breaks ties towards the lower
 //! index and kinds are compared in scan order. Every slot is computed by the same function the
 //! scan would apply to the same triangulation, so results are bit-identical
 //! (`lec_cache_equals_the_scan` in the tests checks it over random insert/remove sequences).
@@ -144,14 +145,82 @@ impl MaxTree {
     }
 }
 
+/// Slots of which few hold a candidate (the disc's rim crossings and rim points, the
+/// sphere's wrap-around triangles: only near the hull): the candidates in a short list, found
+/// by slot. Same answers as a [`MaxTree`] (the largest radius, ties to the lower slot) without
+/// a tree over every slot to clear and rebuild each time the candidates are recomputed.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct SparseMax {
+    /// Per slot, its entry in `items` (`NONE`: no candidate).
+    at: Vec<u32>,
+    /// (slot, centre, radius, site).
+    items: Vec<(u32, DVec3, f64, u32)>,
+}
+
+impl SparseMax {
+    /// Empties the list and sizes it for `len` slots, all without a candidate.
+    pub(crate) fn reset(&mut self, len: usize) {
+        self.at.clear();
+        self.at.resize(len, NONE);
+        self.items.clear();
+    }
+
+    /// Sets slot `i` (growing the slots if needed).
+    pub(crate) fn set(&mut self, i: usize, candidate: Candidate) {
+        if i >= self.at.len() {
+            self.at.resize(i + 1, NONE);
+        }
+        let k = self.at[i];
+        match (k, candidate) {
+            (NONE, None) => {}
+            (NONE, Some((c, r, site))) => {
+                self.at[i] = self.items.len() as u32;
+                self.items.push((i as u32, c, r, site));
+            }
+            (k, Some((c, r, site))) => self.items[k as usize] = (i as u32, c, r, site),
+            (k, None) => {
+                self.items.swap_remove(k as usize);
+                if let Some(moved) = self.items.get(k as usize) {
+                    self.at[moved.0 as usize] = k;
+                }
+                self.at[i] = NONE;
+            }
+        }
+    }
+
+    /// The number of slots.
+    pub(crate) fn len(&self) -> usize {
+        self.at.len()
+    }
+
+    /// Slot `i`'s centre (zero where it holds no candidate).
+    pub(crate) fn centre(&self, i: usize) -> DVec3 {
+        match self.at.get(i) {
+            Some(&k) if k != NONE => self.items[k as usize].1,
+            _ => DVec3::ZERO,
+        }
+    }
+
+    /// The candidate of the largest radius (ties to the lower slot), `None` if none.
+    pub(crate) fn best(&self) -> Candidate {
+        let mut best: Option<&(u32, DVec3, f64, u32)> = None;
+        for item in &self.items {
+            if best.is_none_or(|b| item.2 > b.2 || (item.2 == b.2 && item.0 < b.0)) {
+                best = Some(item);
+            }
+        }
+        best.map(|&(_, c, r, site)| (c, r, site))
+    }
+}
+
 /// The cached candidates; `valid` is false until the next query recomputes them.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct LecCache {
     pub(crate) valid: bool,
     pub(crate) faces: MaxTree,
-    pub(crate) edges: MaxTree,
-    pub(crate) vertices: MaxTree,
-    pub(crate) wraps: MaxTree,
+    pub(crate) edges: SparseMax,
+    pub(crate) vertices: SparseMax,
+    pub(crate) wraps: SparseMax,
     /// Disc: each face's circumcentre (`None`: degenerate or the outer face), which the edge
     /// slots read.
     pub(crate) centres: Vec<Option<glam::DVec2>>,
@@ -162,11 +231,15 @@ impl LecCache {
     /// triangles, edges, vertices; a later kind wins only with a strictly larger radius).
     pub(crate) fn best(&self) -> Candidate {
         let mut best: Candidate = None;
-        for tree in [&self.faces, &self.wraps, &self.edges, &self.vertices] {
-            if let Some(c) = tree.best() {
-                if best.is_none_or(|b| c.1 > b.1) {
-                    best = Some(c);
-                }
+        let kinds = [
+            self.faces.best(),
+            self.wraps.best(),
+            self.edges.best(),
+            self.vertices.best(),
+        ];
+        for c in kinds.into_iter().flatten() {
+            if best.is_none_or(|b| c.1 > b.1) {
+                best = Some(c);
             }
         }
         best
