@@ -5,7 +5,7 @@
 //! candidate (centre, radius) per slot — per inner face (its circumcentre), per undirected edge
 //! two (its Voronoi edge crossing the disc's rim), per vertex one (the rim point opposite it),
 //! and on the sphere per outer directed edge one (the wrap-around triangle at the pole) — with
-//! a max tree over the faces and, for the other kinds (whose few candidates lie near the hull),
+//! blocks of slots over the faces and, for the other kinds (whose few candidates lie near the hull),
 //! a short list of the slots that hold one, so the largest empty circle is a lookup, not a
 //! pass over the triangulation.
 //!
@@ -28,38 +28,26 @@ use glam::DVec3;
 /// A candidate: centre, radius and the spade index of a site on its circle.
 pub(crate) type Candidate = Option<(DVec3, f64, u32)>;
 
-/// A max tree over slots `0..len`: the slot with the largest radius, ties to the lower index.
-/// Slots without a candidate hold −∞.
+/// Slots `0..len` in blocks of [`BLOCK`], each block knowing its best slot: the slot with the
+/// largest radius, ties to the lower index (slots without a candidate hold −∞). A change
+/// rescans its block; the answer scans the blocks' best — both short, branch-light loops over
+/// contiguous radii, and a full recomputation is one pass.
 #[derive(Clone, Debug, Default)]
-pub(crate) struct MaxTree {
+pub(crate) struct BlockMax {
     radius: Vec<f64>,
     centre: Vec<DVec3>,
     site: Vec<u32>,
-    /// Heap-ordered internal nodes (1 is the root; leaves at `cap + i`), each the best slot
-    /// below it.
-    node: Vec<u32>,
-    cap: usize,
+    /// Per block, its best slot (`NONE`: no candidate in it).
+    block: Vec<u32>,
 }
 
 const NONE: u32 = u32::MAX;
 
-impl MaxTree {
-    fn better(&self, a: u32, b: u32) -> u32 {
-        if a == NONE {
-            return b;
-        }
-        if b == NONE {
-            return a;
-        }
-        let (ra, rb) = (self.radius[a as usize], self.radius[b as usize]);
-        if rb > ra || (rb == ra && b < a) {
-            b
-        } else {
-            a
-        }
-    }
+/// Slots per block of a [`BlockMax`].
+const BLOCK: usize = 64;
 
-    /// Empties the tree and sizes it for `len` slots, all without a candidate.
+impl BlockMax {
+    /// Empties the slots and sizes them for `len`, all without a candidate.
     pub(crate) fn reset(&mut self, len: usize) {
         self.radius.clear();
         self.radius.resize(len, f64::NEG_INFINITY);
@@ -67,25 +55,30 @@ impl MaxTree {
         self.centre.resize(len, DVec3::ZERO);
         self.site.clear();
         self.site.resize(len, 0);
-        // Room for an eighth more slots: the insertions after a recompute (a frame's new
-        // sampling points) then grow the slots without rebuilding the tree. The winner does
-        // not depend on the tree's shape (largest radius, then lowest slot: a total order).
-        self.cap = (len + len / 8).next_power_of_two().max(1);
-        self.node.clear();
-        self.node.resize(2 * self.cap, NONE);
-        for i in 0..len {
-            self.node[self.cap + i] = i as u32;
-        }
+        self.block.clear();
+        self.block.resize(len.div_ceil(BLOCK), NONE);
     }
 
-    /// Recomputes every internal node (after [`reset`](Self::reset) and [`set_leaf`]s).
+    /// The best slot of block `b`.
+    fn scan_block(&self, b: usize) -> u32 {
+        let end = ((b + 1) * BLOCK).min(self.radius.len());
+        let (mut best, mut r) = (NONE, f64::NEG_INFINITY);
+        for i in b * BLOCK..end {
+            if self.radius[i] > r {
+                (best, r) = (i as u32, self.radius[i]);
+            }
+        }
+        best
+    }
+
+    /// Recomputes every block (after [`reset`](Self::reset) and [`set_leaf`]s).
     pub(crate) fn build(&mut self) {
-        for n in (1..self.cap).rev() {
-            self.node[n] = self.better(self.node[2 * n], self.node[2 * n + 1]);
+        for b in 0..self.block.len() {
+            self.block[b] = self.scan_block(b);
         }
     }
 
-    /// Sets slot `i` without updating the internal nodes (then [`build`](Self::build)).
+    /// Sets slot `i` without updating its block (then [`build`](Self::build)).
     pub(crate) fn set_leaf(&mut self, i: usize, candidate: Candidate) {
         let (c, r, site) = candidate.unwrap_or((DVec3::ZERO, f64::NEG_INFINITY, 0));
         self.centre[i] = c;
@@ -93,36 +86,16 @@ impl MaxTree {
         self.site[i] = site;
     }
 
-    /// Sets slot `i` (growing the tree if needed) and updates its path to the root.
+    /// Sets slot `i` (growing the slots if needed) and rescans its block.
     pub(crate) fn set(&mut self, i: usize, candidate: Candidate) {
         if i >= self.radius.len() {
-            let len = i + 1;
-            if len > self.cap {
-                let radius = std::mem::take(&mut self.radius);
-                let centre = std::mem::take(&mut self.centre);
-                let site = std::mem::take(&mut self.site);
-                self.reset(len);
-                self.radius[..radius.len()].copy_from_slice(&radius);
-                self.centre[..centre.len()].copy_from_slice(&centre);
-                self.site[..site.len()].copy_from_slice(&site);
-                self.set_leaf(i, candidate);
-                self.build();
-                return;
-            }
-            let old = self.radius.len();
-            self.radius.resize(len, f64::NEG_INFINITY);
-            self.centre.resize(len, DVec3::ZERO);
-            self.site.resize(len, 0);
-            for k in old..len {
-                self.node[self.cap + k] = k as u32;
-            }
+            self.radius.resize(i + 1, f64::NEG_INFINITY);
+            self.centre.resize(i + 1, DVec3::ZERO);
+            self.site.resize(i + 1, 0);
+            self.block.resize((i + 1).div_ceil(BLOCK), NONE);
         }
         self.set_leaf(i, candidate);
-        let mut n = (self.cap + i) / 2;
-        while n >= 1 {
-            self.node[n] = self.better(self.node[2 * n], self.node[2 * n + 1]);
-            n /= 2;
-        }
+        self.block[i / BLOCK] = self.scan_block(i / BLOCK);
     }
 
     /// The number of slots.
@@ -137,18 +110,21 @@ impl MaxTree {
 
     /// The best slot's candidate, `None` if no slot has one.
     pub(crate) fn best(&self) -> Candidate {
-        let b = *self.node.get(1)? as usize;
-        if b == NONE as usize || self.radius[b] == f64::NEG_INFINITY {
-            return None;
+        let (mut best, mut r) = (NONE, f64::NEG_INFINITY);
+        for &k in &self.block {
+            if k != NONE && self.radius[k as usize] > r {
+                (best, r) = (k, self.radius[k as usize]);
+            }
         }
-        Some((self.centre[b], self.radius[b], self.site[b]))
+        let b = best as usize;
+        (best != NONE).then(|| (self.centre[b], self.radius[b], self.site[b]))
     }
 }
 
 /// Slots of which few hold a candidate (the disc's rim crossings and rim points, the
 /// sphere's wrap-around triangles: only near the hull): the candidates in a short list, found
-/// by slot. Same answers as a [`MaxTree`] (the largest radius, ties to the lower slot) without
-/// a tree over every slot to clear and rebuild each time the candidates are recomputed.
+/// by slot. Same answers as a [`BlockMax`] (the largest radius, ties to the lower slot) without
+/// a pass over every slot each time the candidates are recomputed.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct SparseMax {
     /// Per slot, its entry in `items` (`NONE`: no candidate).
@@ -217,7 +193,7 @@ impl SparseMax {
 #[derive(Clone, Debug, Default)]
 pub(crate) struct LecCache {
     pub(crate) valid: bool,
-    pub(crate) faces: MaxTree,
+    pub(crate) faces: BlockMax,
     pub(crate) edges: SparseMax,
     pub(crate) vertices: SparseMax,
     pub(crate) wraps: SparseMax,
