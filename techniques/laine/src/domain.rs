@@ -302,11 +302,11 @@ fn spherical_triangle_area(a: DVec3, b: DVec3, c: DVec3) -> f64 {
 /// 2 atan2(det, den); when every corner lies within 60° of `s` (chord < 1) the polygon lies in
 /// a cap of area π, so every term's angle and their sum stay inside (−π/2, π/2) and the sum is
 /// the argument of the product of the (den + i det): one atan2 per polygon instead of one per
-/// corner (the terms' den ≥ 1.5 there, so the product neither vanishes nor overflows for any
-/// degree a triangulation has).
+/// corner. The terms' den ≥ 1.5 there and their modulus is below 4.2, so up to 64 corners the
+/// product neither vanishes nor overflows (past about 500 it would); larger rings sum the terms.
 fn spherical_fan_area(s: DVec3, ring: &[DVec3]) -> f64 {
     let n = ring.len();
-    if ring.iter().all(|c| (*c - s).length_squared() < 1.0) {
+    if n <= 64 && ring.iter().all(|c| (*c - s).length_squared() < 1.0) {
         let (mut re, mut im) = (1.0, 0.0);
         for k in 0..n {
             let (a, b) = (ring[k], ring[(k + 1) % n]);
@@ -426,7 +426,13 @@ fn stored_site(
             let mut p = point.truncate();
             let len2 = p.length_squared();
             if len2 > 1.0 {
-                p /= len2.sqrt();
+                if len2.is_finite() {
+                    p /= len2.sqrt();
+                } else {
+                    // |p|² overflowed: scaled down first.
+                    let q = p / p.abs().max_element();
+                    p = q / q.length();
+                }
             }
             let pos = spade::mitigate_underflow(Point2::new(p.x, p.y));
             Ok(Some((pos, DVec3::new(pos.x, pos.y, 0.0))))
@@ -593,9 +599,10 @@ impl SamplingDomain {
     /// Moves the domain to `sites` (id, point), the same sites as now at new points (the
     /// management's sampling points after the light moved; sites absent from `sites` are
     /// removed): afterwards the domain holds the Delaunay triangulation of the new points, the
-    /// one [`from_sites`](Self::from_sites) would build (up to the internal numbering, the
-    /// diagonal of four cocircular points, and which sphere site is the projection pole), and
-    /// the result is `from_sites`'s acceptance per site.
+    /// one [`from_sites`](Self::from_sites) would build (up to the internal numbering and the
+    /// diagonal of four cocircular points: candidates of exactly equal radius are told apart
+    /// by the numbering, and circumcentres of near-degenerate triangles by the order of their
+    /// corners), and the result is `from_sites`'s acceptance per site.
     ///
     /// Kinetic, not rebuilt: the points move a little per frame, so almost every triangle of
     /// last frame's triangulation is still a Delaunay triangle of the new points. The sites
@@ -609,7 +616,8 @@ impl SamplingDomain {
     /// triangulation (Delaunay's lemma), into which the removed sites are inserted at their
     /// new points. Measured on Sibenik's animation at 1024 sites: about four such edges per
     /// frame, and a triangle turning over in one frame of 40 (disc) to 150 (sphere). Anything else — a new or repeated id, an invalid
-    /// point, the sphere's pole leaving, more than a quarter of the sites to move this way, a
+    /// point, a sphere whose first site is not its projection pole (`from_sites` makes the first
+    /// site the pole: after the pole's site is deleted, one rebuild), more than a quarter of the sites to move this way, a
     /// refused re-insertion — rebuilds from the sites instead (`from_sites`), so the result
     /// never depends on which path ran.
     pub fn update_sites(&mut self, sites: &[(u64, DVec3)]) -> SiteUpdate {
@@ -636,12 +644,16 @@ impl SamplingDomain {
         if sites.len() < 8 || self.tri.num_inner_faces() == 0 {
             return None;
         }
-        // The new pole (it must stay: its id among the sites), then per vertex (spade's
-        // index) its site at the new point; a site the domain does not hold, or a repeated
-        // one, rebuilds.
+        // The new pole (it must stay, and be the first site: `from_sites` makes the first
+        // site the pole, and the sphere's duplicate rule is relative to it), then per vertex
+        // (spade's index) its site at the new point; a site the domain does not hold, or a
+        // repeated one, rebuilds.
         let pole = match self.pole {
             Some(p) => {
-                let x = sites.iter().find(|s| s.0 == p.id)?.1;
+                let &(id, x) = sites.first()?;
+                if id != p.id {
+                    return None;
+                }
                 let len = x.length();
                 if !(len > 0.0 && len.is_finite()) {
                     return None;

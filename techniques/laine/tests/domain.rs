@@ -871,3 +871,71 @@ fn queued_deletions_equal_repeated_candidates() {
         }
     }
 }
+
+/// `update_sites` accepts and refuses as `from_sites` also when the sites come in another
+/// order: `from_sites` makes the first site the sphere's projection pole and refuses points
+/// within 10⁻¹² of it, so a list whose first site is not the domain's pole must rebuild — here
+/// a site moves to 5·10⁻¹³ from the new first site (kept by a move from the old pole, refused
+/// by `from_sites`).
+#[test]
+fn update_sites_refuses_as_from_sites_whatever_the_order() {
+    let kind = DomainKind::Sphere;
+    let mut sites: Vec<(u64, DVec3)> = (point_set(kind, 16, true).into_iter().enumerate())
+        .map(|(i, p)| (i as u64 + 1, p))
+        .collect();
+    let a = sites[3].1;
+    sites[7].1 = a + DVec3::new(1e-7, 0.0, 0.0);
+    let (mut d, _) = SamplingDomain::from_sites(kind, &sites);
+    sites.swap(0, 3);
+    sites[7].1 = a + DVec3::new(5e-13, 0.0, 0.0);
+    let u = d.update_sites(&sites);
+    let (want_d, want) = SamplingDomain::from_sites(kind, &sites);
+    assert_eq!(u.accepted, want);
+    assert!(want.iter().any(|a| !a), "the near duplicate is refused");
+    assert_eq!(canonical_triangles(&d), canonical_triangles(&want_d));
+}
+
+/// A sphere site of high degree (a ring of m sites around +Z): its Voronoi area is the cap
+/// inside the ring and all areas sum to 4π — past degree 500 a product of the fan's terms would
+/// overflow (it gave NaN at 600).
+#[test]
+fn sphere_voronoi_area_of_a_site_of_high_degree() {
+    let theta = 0.2f64;
+    for m in [100usize, 600] {
+        let mut sites = vec![(0u64, -DVec3::Z), (1, DVec3::Z)];
+        let mut rng = Rng(3);
+        for k in 0..m {
+            let phi = 2.0 * PI * (k as f64 + 0.1 * rng.next()) / m as f64;
+            let p = DVec3::new(
+                theta.sin() * phi.cos(),
+                theta.sin() * phi.sin(),
+                theta.cos(),
+            );
+            sites.push((k as u64 + 2, p));
+        }
+        let (d, _) = SamplingDomain::from_sites(DomainKind::Sphere, &sites);
+        let areas = d.voronoi_areas();
+        let total: f64 = areas.iter().map(|a| a.1).sum();
+        let top = areas.iter().find(|a| a.0 == 1).unwrap().1;
+        let cap = 2.0 * PI * (1.0 - (theta / 2.0).cos());
+        assert!(
+            (total - 4.0 * PI).abs() < 1e-9,
+            "ring of {m}: total {total}"
+        );
+        assert!(
+            (top - cap).abs() < 0.01 * cap,
+            "ring of {m}: {top} vs the cap's {cap}"
+        );
+    }
+}
+
+/// A disc point so far out that its squared length overflows is still moved onto the rim
+/// along its direction (it was stored at the centre).
+#[test]
+fn a_huge_disc_point_lands_on_the_rim() {
+    let mut d = SamplingDomain::new(DomainKind::Disc);
+    d.insert(1, DVec3::new(1e300, 1e300, 0.0)).unwrap();
+    let p = d.point(1).unwrap();
+    let want = DVec3::new(1.0, 1.0, 0.0).normalize();
+    assert!((p - want).length() < 1e-15, "stored {p}");
+}
