@@ -113,6 +113,14 @@ fn laine_management_records_spot_and_omni_at_256_and_1024() {
                 used["min"].as_f64().unwrap(),
             );
             assert_eq!(used["count"].as_u64(), Some(4), "{rec}");
+            // How the triangulation followed the points: frames rebuilt from scratch (at most
+            // the four timed) and sites repaired per frame.
+            assert!(
+                rec["frames_rebuilt"].as_u64().is_some_and(|n| n <= 4),
+                "{rec}"
+            );
+            let repaired = rec["sites_repaired_per_frame"].as_f64().unwrap_or(f64::NAN);
+            assert!(repaired >= 0.0 && repaired <= vpls as f64, "{rec}");
             assert!(
                 mean <= vpls as f64 && min >= 0.6 * vpls as f64,
                 "{light}-{vpls}: {used}"

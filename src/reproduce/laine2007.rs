@@ -489,7 +489,7 @@ fn management(args: &ReproduceArgs) -> Result<Table> {
             // Wall and CPU time (every thread of the process: the rays and Voronoi areas run
             // across cores) of one step; then (untimed) the VPLs lighting the frame.
             let mut used = Vec::with_capacity(frames as usize);
-            let mut rebuilt = 0u32;
+            let (mut rebuilt, mut repaired) = (0u32, 0u64);
             let mut step = |f: u32| {
                 let light = clock.frame(f).light;
                 let c = gibench_harness::calibrate::process_cpu_ms();
@@ -500,6 +500,7 @@ fn management(args: &ReproduceArgs) -> Result<Table> {
                 if f > 0 {
                     used.push(m.vpls().len() as f64);
                     rebuilt += s.rebuilt as u32;
+                    repaired += s.repaired as u64;
                 }
                 (wall, cpu.map(|(a, b)| b - a))
             };
@@ -522,12 +523,14 @@ fn management(args: &ReproduceArgs) -> Result<Table> {
                 Cell::Ms(Some(s.max)),
                 Cell::Ms(Some(fill)),
                 Cell::Num(Some(rebuilt as f64), 0),
+                Cell::Num(Some(repaired as f64 / frames as f64), 1),
             ]);
             records.insert(
                 format!("{label}-{vpls}"),
                 serde_json::json!({
                     "wall_ms": s, "cpu_ms": c, "fill_frame_wall_ms": fill, "fill_frame_cpu_ms": fill_cpu,
                     "vpls_used": used, "frames_rebuilt": rebuilt,
+                    "sites_repaired_per_frame": repaired as f64 / frames as f64,
                 }),
             );
         }
@@ -544,6 +547,7 @@ fn management(args: &ReproduceArgs) -> Result<Table> {
             Cell::Ms(None),
             Cell::Ms(None),
             Cell::Num(None, 0),
+            Cell::Num(None, 1),
         ]);
     }
     let json = serde_json::json!({
@@ -555,7 +559,7 @@ fn management(args: &ReproduceArgs) -> Result<Table> {
     gibench_harness::error::write_atomic(&out(args).join("laine-management.json"), &bytes)?;
     Ok(Table {
         title: format!("VPL management per frame on the CPU ({name}, {frames} frames, recalcMin 4, recalcMax 8)"),
-        columns: ["source", "light", "VPLs", "VPLs used mean", "VPLs used min", "median ms", "median CPU ms", "p99 ms", "max ms", "fill frame ms", "frames rebuilt"]
+        columns: ["source", "light", "VPLs", "VPLs used mean", "VPLs used min", "median ms", "median CPU ms", "p99 ms", "max ms", "fill frame ms", "frames rebuilt", "sites repaired per frame"]
             .map(String::from)
             .into(),
         rows,
@@ -567,7 +571,8 @@ fn management(args: &ReproduceArgs) -> Result<Table> {
                  sampling point whose ray misses makes none; deletions free recalcMin slots each frame). Fill frame: \
                  the first frame, which creates every VPL (wall). Frames rebuilt: frames after the first whose \
                  triangulation was built from scratch (a bulk load) instead of moving last frame's with its points \
-                 (`SamplingDomain::update_sites`). The sphere is triangulated on its surface (no 3D tetrahedralisation).",
+                 (`SamplingDomain::update_sites`); sites repaired: per frame after the first on average, the sampling points whose \
+                 motion broke last frame's triangulation, taken out and put back. The sphere is triangulated on its surface (no 3D tetrahedralisation).",
                 std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1)
             ),
             format!("Paper: {} — a range over its test scenes, median only.", paper["source"].as_str().unwrap_or("")),

@@ -220,6 +220,9 @@ pub struct Step {
     /// Whether the sampling points were triangulated from scratch (the first frame, or where
     /// moving last frame's triangulation did not apply) rather than moved.
     pub rebuilt: bool,
+    /// Moved: the sampling points whose motion broke last frame's triangulation (taken out
+    /// and put back).
+    pub repaired: u32,
 }
 
 impl Manager {
@@ -292,12 +295,13 @@ impl Manager {
         let site_of_miss: Vec<Option<usize>> = (self.misses.iter().zip(&still_missing))
             .map(|((id, s), ok)| add(*id, *s, *ok))
             .collect();
-        let mut rebuilt = true;
+        let (mut rebuilt, mut repaired) = (true, 0);
         // Last frame's domain moved to the new points (kinetic, see `update_sites`), or built.
         let (mut domain, accepted) = match self.domain.take() {
             Some(mut d) if d.kind() == kind => {
                 let u = d.update_sites(&sites);
                 rebuilt = u.rebuilt;
+                repaired = u.reinserted as u32;
                 (d, u.accepted)
             }
             _ => SamplingDomain::from_sites(kind, &sites),
@@ -423,6 +427,7 @@ impl Manager {
             on_rim,
             deleted,
             rebuilt,
+            repaired,
         }
     }
 }
