@@ -1601,34 +1601,32 @@ impl SamplingDomain {
             let l2 = (a.data().point - b.data().point).length_squared();
             keep(EdgeKey::new(l2, a.data().id, b.data().id));
         }
+        let mut scratch = Vec::new();
         if self.pole.is_some() {
-            let np = self.pole_index();
-            let mut nb = Vec::new();
-            self.neighbours(np, &mut nb);
-            let (p, id) = (self.site_point(np), self.site_id(np));
-            for n in nb {
-                let l2 = (self.site_point(n) - p).length_squared();
-                keep(EdgeKey::new(l2, id, self.site_id(n)));
-            }
+            self.edge_keys_of(self.pole_index(), &mut scratch, keep);
         }
         let bound = (total > best.len()).then(|| best.peek().copied()).flatten();
         RedundancyQueue {
             heap: best.into_iter().map(std::cmp::Reverse).collect(),
             bound,
-            scratch: Vec::new(),
+            scratch,
+        }
+    }
+
+    /// `f` of the queue key of every Delaunay edge of site `index` (`nb`: scratch).
+    fn edge_keys_of(&self, index: usize, nb: &mut Vec<usize>, mut f: impl FnMut(EdgeKey)) {
+        self.neighbours(index, nb);
+        let (p, id) = (self.site_point(index), self.site_id(index));
+        for &n in nb.iter() {
+            let l2 = (self.site_point(n) - p).length_squared();
+            f(EdgeKey::new(l2, id, self.site_id(n)));
         }
     }
 
     /// Pushes the edges of site `index` onto `q`.
     fn queue_edges_of(&self, index: usize, q: &mut RedundancyQueue) {
         let mut nb = std::mem::take(&mut q.scratch);
-        self.neighbours(index, &mut nb);
-        let (p, id) = (self.site_point(index), self.site_id(index));
-        for &n in &nb {
-            let l2 = (self.site_point(n) - p).length_squared();
-            q.heap
-                .push(std::cmp::Reverse(EdgeKey::new(l2, id, self.site_id(n))));
-        }
+        self.edge_keys_of(index, &mut nb, |k| q.heap.push(std::cmp::Reverse(k)));
         q.scratch = nb;
     }
 
