@@ -93,8 +93,18 @@ fn slab_setup(dir: Vec3) -> (Vec3, [usize; 3], [usize; 3]) {
         }
     };
     let inv = Vec3::new(1.0 / safe(dir.x), 1.0 / safe(dir.y), 1.0 / safe(dir.z));
-    let near = [0, 1, 2].map(|k| if inv[k] < 0.0 { k + 3 } else { k });
-    let far = near.map(|p| (p + 3) % 6);
+    // Written out per axis: as array `map`s this was a function call per ray.
+    let (nx, ny, nz) = (inv.x < 0.0, inv.y < 0.0, inv.z < 0.0);
+    let near = [
+        if nx { 3 } else { 0 },
+        if ny { 4 } else { 1 },
+        if nz { 5 } else { 2 },
+    ];
+    let far = [
+        if nx { 0 } else { 3 },
+        if ny { 1 } else { 4 },
+        if nz { 2 } else { 5 },
+    ];
     (inv, near, far)
 }
 
