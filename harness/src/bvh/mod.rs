@@ -48,10 +48,11 @@ pub struct SceneBvh {
     corners: Vec<Corners>,
 }
 
-/// A triangle's corner positions, shading normals and texture coordinates, and its material.
+/// A triangle's unit geometric normal (from its corners, in their order), the shading normals
+/// and texture coordinates of its corners, and its material.
 #[derive(Clone, Copy, Debug)]
 struct Corners {
-    p: [Vec3; 3],
+    ng: Vec3,
     n: [Vec3; 3],
     uv: [Vec2; 3],
     material: u32,
@@ -117,6 +118,7 @@ impl SceneBvh {
     pub fn new(mesh: &Mesh) -> Self {
         let count = mesh.triangle_count();
         let mut corners = Vec::with_capacity(count);
+        let mut positions = Vec::with_capacity(count);
         for t in 0..count {
             let idx = &mesh.indices[3 * t..3 * t + 3];
             let in_range = idx.iter().all(|&i| (i as usize) < mesh.positions.len());
@@ -131,6 +133,7 @@ impl SceneBvh {
             } else {
                 [Vec3::ZERO; 3]
             };
+            // Also the hit record's geometric normal (computed here once, not per hit).
             let face = (p[1] - p[0]).cross(p[2] - p[0]).normalize_or(Vec3::Y);
             let n = [0, 1, 2].map(|k| {
                 mesh.normals
@@ -140,8 +143,9 @@ impl SceneBvh {
                     .unwrap_or(face)
             });
             let uv = [0, 1, 2].map(|k| mesh.uvs.get(at(k)).copied().unwrap_or(Vec2::ZERO));
+            positions.push(p);
             corners.push(Corners {
-                p,
+                ng: face,
                 n,
                 uv,
                 material: mesh.materials.get(at(0)).copied().unwrap_or(0),
@@ -150,7 +154,7 @@ impl SceneBvh {
         let mut seen = std::collections::HashSet::with_capacity(corners.len());
         let built: Vec<u32> = (0..corners.len() as u32)
             .filter(|&t| {
-                let p = corners[t as usize].p;
+                let p = positions[t as usize];
                 let area = (p[1] - p[0]).cross(p[2] - p[0]).length_squared();
                 let mut key = p.map(|v| v.to_array().map(f32::to_bits));
                 key.sort_unstable();
@@ -161,7 +165,7 @@ impl SceneBvh {
             let obvhs_tris: Vec<Triangle> = built
                 .iter()
                 .map(|&i| {
-                    let t = &corners[i as usize].p;
+                    let t = &positions[i as usize];
                     Triangle {
                         v0: Vec3A::from(t[0]),
                         v1: Vec3A::from(t[1]),
@@ -226,8 +230,8 @@ impl SceneBvh {
         let i = tri as usize;
         let w = 1.0 - u - v;
         let c = &self.corners[i];
-        let ([p0, p1, p2], [n0, n1, n2], [uv0, uv1, uv2]) = (c.p, c.n, c.uv);
-        let mut geometric_normal = (p1 - p0).cross(p2 - p0).normalize_or(Vec3::Y);
+        let ([n0, n1, n2], [uv0, uv1, uv2]) = (c.n, c.uv);
+        let mut geometric_normal = c.ng;
         if geometric_normal.dot(dir) > 0.0 {
             geometric_normal = -geometric_normal;
         }
