@@ -271,7 +271,8 @@ impl Manager {
             .par_iter()
             .map(|(_, sample)| {
                 let (origin, dir) = light.ray_of_sample(*sample, extent);
-                bvh.closest_hit(origin, dir, eps, f32::INFINITY).is_none()
+                // Any hit, not the closest: only whether the ray still misses matters.
+                !bvh.any_hit(origin, dir, eps, f32::INFINITY)
             })
             .collect();
         // The domain of the valid VPLs' new sampling points, then the misses that still
