@@ -830,7 +830,18 @@ impl SamplingDomain {
         }
     }
 
-    /// All `(id, point)` pairs, in no particular order.
+    /// The position of site `id` in the domain's internal order, which [`points`] and
+    /// [`voronoi_areas`] list the sites in (it changes as sites come and go).
+    ///
+    /// [`points`]: Self::points
+    /// [`voronoi_areas`]: Self::voronoi_areas
+    pub fn site_index(&self, id: u64) -> Option<usize> {
+        self.index_of(id)
+    }
+
+    /// All `(id, point)` pairs, in the domain's internal order (see [`site_index`]).
+    ///
+    /// [`site_index`]: Self::site_index
     pub fn points(&self) -> Vec<(u64, DVec3)> {
         let mut out: Vec<(u64, DVec3)> = self
             .tri
@@ -1687,7 +1698,9 @@ impl SamplingDomain {
     ///   on one plane (always the case for three) have lune-shaped cells between the bisectors
     ///   of their neighbours along the common circle: area = 2 × the lune's dihedral angle.
     ///
-    /// In no particular order.
+    /// In the sites' internal order: the entry of site `id` is at [`site_index`]`(id)`.
+    ///
+    /// [`site_index`]: Self::site_index
     pub fn voronoi_areas(&self) -> Vec<(u64, f64)> {
         match self.kind {
             // One cell per site, in site order: from the circumcentres of its faces where the
@@ -1795,13 +1808,14 @@ impl SamplingDomain {
 }
 
 /// Voronoi areas of sites all on one circle with axis `m`: lunes between the bisectors of
-/// consecutive sites around the axis; area = 2 × dihedral angle.
+/// consecutive sites around the axis; area = 2 × dihedral angle. In the order of `pts`.
 fn lune_areas(pts: &[(u64, DVec3)], m: DVec3) -> Vec<(u64, f64)> {
     let u = m.any_orthonormal_vector();
     let w = m.cross(u);
-    let mut angles: Vec<(f64, u64)> = pts
+    let mut angles: Vec<(f64, usize)> = pts
         .iter()
-        .map(|&(id, x)| (x.dot(w).atan2(x.dot(u)), id))
+        .enumerate()
+        .map(|(k, &(_, x))| (x.dot(w).atan2(x.dot(u)), k))
         .collect();
     angles.sort_by(|a, b| a.0.total_cmp(&b.0));
     let n = angles.len();
@@ -1814,7 +1828,9 @@ fn lune_areas(pts: &[(u64, DVec3)], m: DVec3) -> Vec<(u64, f64)> {
             g
         }
     };
-    (0..n)
-        .map(|i| (angles[i].1, gap(i) + gap((i + n - 1) % n)))
-        .collect()
+    let mut out: Vec<(u64, f64)> = pts.iter().map(|&(id, _)| (id, 0.0)).collect();
+    for i in 0..n {
+        out[angles[i].1].1 = gap(i) + gap((i + n - 1) % n);
+    }
+    out
 }

@@ -248,6 +248,11 @@ impl Manager {
         self.vpls.iter().map(|m| (m.slot, m.vpl)).collect()
     }
 
+    /// The sampling points' domain after the last step (`None` before the first).
+    pub fn domain(&self) -> Option<&SamplingDomain> {
+        self.domain.as_ref()
+    }
+
     /// Dispersion (largest empty circle radius) of all sampling points after the last step.
     pub fn dispersion(&self) -> f64 {
         self.last_dispersion
@@ -410,12 +415,12 @@ impl Manager {
         // 4. Intensities: Voronoi areas over the domain's area.
         let total = light.domain().area();
         let power = light.emitted_flux(extent);
-        let mut areas = domain.voronoi_areas();
-        areas.sort_unstable_by_key(|a| a.0);
+        // Each site's area sits at its index in the domain's order.
+        let areas = domain.voronoi_areas();
         for m in &mut self.vpls {
-            let area = match areas.binary_search_by_key(&m.id, |a| a.0) {
-                Ok(k) => areas[k].1,
-                Err(_) => 0.0,
+            let area = match domain.site_index(m.id).and_then(|k| areas.get(k)) {
+                Some(&(id, a)) if id == m.id => a,
+                _ => 0.0,
             };
             let share = area / total;
             m.vpl.flux = power * share as f32 * m.vpl.color;

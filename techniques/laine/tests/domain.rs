@@ -231,8 +231,10 @@ fn check_voronoi_areas(d: &SamplingDomain) {
         ((total - expected) / expected).abs() < 1e-9,
         "Voronoi areas sum to {total}, expected {expected}"
     );
-    for (id, a) in areas {
+    for (k, &(id, a)) in areas.iter().enumerate() {
         assert!(a > 0.0 && a.is_finite(), "area of {id} = {a}");
+        // The management reads a site's area at its index.
+        assert_eq!(d.site_index(id), Some(k), "area of {id} listed at {k}");
     }
 }
 

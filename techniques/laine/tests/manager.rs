@@ -130,6 +130,38 @@ fn area_light_vpls_lie_in_front_of_the_light() {
     }
 }
 
+/// Each VPL's flux is the light's flux times its own sampling point's share of the domain (its
+/// Voronoi area over the domain's) times its colour: the area read for that VPL (by its id,
+/// `Vpl::path`), not another site's.
+#[test]
+fn each_vpl_gets_its_own_voronoi_share() {
+    for kind in [LightKind::Spot, LightKind::Omni] {
+        let (scene, bvh) = cornell(kind);
+        let clock = FrameClock::new(&scene.descriptor);
+        let mut m = Manager::new(128, 4, 8);
+        for frame in 0..30 {
+            let light = clock.frame(frame).light;
+            m.step(&scene, &bvh, light);
+            let areas: std::collections::HashMap<u64, f64> = m
+                .domain()
+                .expect("a domain after a step")
+                .voronoi_areas()
+                .into_iter()
+                .collect();
+            let (power, total) = (light.emitted_flux(&scene.extent), light.domain().area());
+            for (_, v) in m.vpls() {
+                let share = areas[&v.path] / total;
+                assert_eq!(
+                    v.flux,
+                    power * share as f32 * v.color,
+                    "{kind:?} frame {frame}: VPL {}",
+                    v.path
+                );
+            }
+        }
+    }
+}
+
 /// FNV-1a over 64-bit words.
 fn fnv(h: &mut u64, word: u64) {
     for b in word.to_le_bytes() {
