@@ -322,6 +322,14 @@ fn spherical_fan_area(s: DVec3, ring: &[DVec3]) -> f64 {
         .abs()
 }
 
+/// Sphere: the circumcentre of the spherical triangle of sites `[a, b, c]`, with its radius and
+/// `site` (the index of `a`, where a walk to the circumcentre starts).
+fn sphere_triangle_slot([a, b, c]: [DVec3; 3], site: usize) -> Candidate {
+    let m = spherical_circumcentre(a, b, c);
+    let r = (m - a).length();
+    (m != DVec3::ZERO && r.is_finite()).then_some((m, r, site as u32))
+}
+
 /// Unit circumcentre of the spherical triangle (a, b, c) (counter-clockwise seen from outside):
 /// the outward normal of its plane, i.e. the centre of the circumcap on the empty side.
 fn spherical_circumcentre(a: DVec3, b: DVec3, c: DVec3) -> DVec3 {
@@ -1184,23 +1192,25 @@ impl SamplingDomain {
         }
     }
 
-    /// Disc: the circumcentre of inner face `f`.
-    fn disc_face_centre(&self, f: FixedFaceHandle<InnerTag>) -> Option<DVec2> {
-        let [a, b, c] = self
-            .tri
-            .face(f)
-            .vertices()
-            .map(|v| v.data().point.truncate());
-        circumcentre(a, b, c)
+    /// Disc: inner face `f`'s corners, counter-clockwise, and the index of the first.
+    fn disc_face_corners(&self, f: FixedFaceHandle<InnerTag>) -> ([DVec2; 3], usize) {
+        let [a, b, c] = self.tri.face(f).vertices();
+        (
+            [a, b, c].map(|v| v.data().point.truncate()),
+            a.fix().index(),
+        )
     }
 
-    /// Disc, case (1): face `f`'s circumcentre `m` if inside the disc.
-    fn disc_face_slot(&self, f: FixedFaceHandle<InnerTag>, m: Option<DVec2>) -> Candidate {
-        let m = m?;
-        let a = self.tri.face(f).vertices()[0];
-        let r = (m - a.data().point.truncate()).length();
-        (m.length_squared() <= 1.0 && r.is_finite())
-            .then(|| (m.extend(0.0), r, a.fix().index() as u32))
+    /// Disc: inner face `f`'s circumcentre and its case (1) slot (the circumcentre, if inside
+    /// the disc), from one walk round the face.
+    fn disc_face(&self, f: FixedFaceHandle<InnerTag>) -> (Option<DVec2>, Candidate) {
+        let ([a, b, c], site) = self.disc_face_corners(f);
+        let m = circumcentre(a, b, c);
+        let slot = m.and_then(|m| {
+            let r = (m - a).length();
+            (m.length_squared() <= 1.0 && r.is_finite()).then(|| (m.extend(0.0), r, site as u32))
+        });
+        (m, slot)
     }
 
     /// Disc, case (2): where the Voronoi edge of undirected edge `u` crosses the rim (its two
@@ -1270,19 +1280,10 @@ impl SamplingDomain {
         (inside && r.is_finite()).then(|| (c.extend(0.0), r, v.fix().index() as u32))
     }
 
-    /// Sphere: the circumcentre of the spherical triangle of sites `t`, with its radius.
-    fn sphere_triangle_slot(&self, t: [usize; 3]) -> Candidate {
-        let [a, b, c] = t.map(|i| self.site_point(i));
-        let m = spherical_circumcentre(a, b, c);
-        let r = (m - a).length();
-        // The pole has no spade index: a wrap-around triangle's hint is its first site.
-        (m != DVec3::ZERO && r.is_finite()).then_some((m, r, t[0] as u32))
-    }
-
     /// Sphere: inner face `f`'s triangle.
     fn sphere_face_slot(&self, f: FixedFaceHandle<InnerTag>) -> Candidate {
-        let v = self.tri.face(f).vertices();
-        self.sphere_triangle_slot(v.map(|v| v.fix().index()))
+        let [a, b, c] = self.tri.face(f).vertices();
+        sphere_triangle_slot([a, b, c].map(|v| v.data().point), a.fix().index())
     }
 
     /// Sphere: the wrap-around triangle (from, to, pole) of directed edge `d` if it is a
@@ -1292,11 +1293,15 @@ impl SamplingDomain {
         if self.pole.is_none() || self.tri.num_vertices() < 2 || !e.is_outer_edge() {
             return None;
         }
-        self.sphere_triangle_slot([
+        // The pole has no spade index: a wrap-around triangle's hint is its first site.
+        sphere_triangle_slot(
+            [
+                e.from().data().point,
+                e.to().data().point,
+                self.site_point(self.pole_index()),
+            ],
             e.from().fix().index(),
-            e.to().fix().index(),
-            self.pole_index(),
-        ])
+        )
     }
 
     /// Fills every slot of `lec` from the current triangulation.
@@ -1308,12 +1313,10 @@ impl SamplingDomain {
                 lec.centres.clear();
                 lec.centres.resize(t.num_all_faces(), None);
                 for f in t.inner_faces() {
-                    lec.centres[f.fix().index()] = self.disc_face_centre(f.fix());
-                }
-                for f in t.inner_faces() {
                     let i = f.fix().index();
-                    lec.faces
-                        .set_leaf(i, self.disc_face_slot(f.fix(), lec.centres[i]));
+                    let (centre, slot) = self.disc_face(f.fix());
+                    lec.centres[i] = centre;
+                    lec.faces.set_leaf(i, slot);
                 }
                 lec.edges.reset(2 * t.num_undirected_edges());
                 for u in t.fixed_undirected_edges() {
@@ -1358,11 +1361,9 @@ impl SamplingDomain {
             DomainKind::Disc => {
                 lec.centres.resize(t.num_all_faces(), None);
                 for &f in &faces {
-                    lec.centres[f.index()] = self.disc_face_centre(f);
-                }
-                for &f in &faces {
-                    lec.faces
-                        .set(f.index(), self.disc_face_slot(f, lec.centres[f.index()]));
+                    let (centre, slot) = self.disc_face(f);
+                    lec.centres[f.index()] = centre;
+                    lec.faces.set(f.index(), slot);
                 }
                 for &f in &faces {
                     for d in t.face(f).adjacent_edges() {
@@ -1462,8 +1463,9 @@ impl SamplingDomain {
         };
         let mut centres = vec![None; self.tri.num_all_faces()];
         for f in self.tri.inner_faces() {
-            centres[f.fix().index()] = self.disc_face_centre(f.fix());
-            consider(self.disc_face_slot(f.fix(), centres[f.fix().index()]));
+            let (centre, slot) = self.disc_face(f.fix());
+            centres[f.fix().index()] = centre;
+            consider(slot);
         }
         for u in self.tri.fixed_undirected_edges() {
             for c in self.disc_edge_slots(u, &centres) {
@@ -1714,7 +1716,10 @@ impl SamplingDomain {
                     &lec.centres[..]
                 } else {
                     computed = (self.tri.all_faces())
-                        .map(|f| f.as_inner().and_then(|f| self.disc_face_centre(f.fix())))
+                        .map(|f| {
+                            let [a, b, c] = self.disc_face_corners(f.as_inner()?.fix()).0;
+                            circumcentre(a, b, c)
+                        })
                         .collect();
                     &computed[..]
                 };
