@@ -1226,9 +1226,6 @@ impl SamplingDomain {
     ) -> [Candidate; 2] {
         let mut out = [None, None];
         let e = self.tri.directed_edge(u.as_directed());
-        let site = e.from().fix().index() as u32;
-        let pos = |v: spade::handles::VertexHandle<Site>| v.data().point.truncate();
-        let (p, q) = (pos(e.from()), pos(e.to()));
         let left = e.face().as_inner().map(|f| centres[f.fix().index()]);
         let right = e.rev().face().as_inner().map(|f| centres[f.fix().index()]);
         // Both ends inside the disc (with a margin far above rounding): the Voronoi edge, a
@@ -1238,6 +1235,9 @@ impl SamplingDomain {
         if inside(left) && inside(right) {
             return out;
         }
+        let site = e.from().fix().index() as u32;
+        let pos = |v: spade::handles::VertexHandle<Site>| v.data().point.truncate();
+        let (p, q) = (pos(e.from()), pos(e.to()));
         let normal = (q - p).perp().normalize_or_zero();
         let (origin, t_range) = match (left, right) {
             (Some(Some(l)), Some(Some(r))) => (r, (0.0, (l - r).dot(normal))),
