@@ -10,16 +10,18 @@
 
 use gibench_harness::assets::AssetPaths;
 use gibench_harness::bvh::SceneBvh;
-use gibench_harness::glam::Vec3;
+use gibench_harness::glam::{DVec3, Vec3};
 use gibench_harness::scene::Scene;
 use gibench_laine::domain::{DomainKind, SamplingDomain};
 
 /// The kernels, in the order `list` prints them.
-const KERNELS: [&str; 6] = [
+const KERNELS: [&str; 8] = [
     "bvh-closest-hit-cornell",
     "bvh-shadow-cornell",
     "domain-delete-insert-disc-256",
     "domain-fill-at-largest-empty-circle-sphere-256",
+    "domain-frame-disc-1024",
+    "domain-frame-sphere-1024",
     "domain-voronoi-areas-disc-256",
     "vpl-generation-cornell",
 ];
@@ -32,6 +34,8 @@ pub struct Setup {
     targets: Vec<Vec3>,
     disc: SamplingDomain,
     sphere: SamplingDomain,
+    disc_1024: SamplingDomain,
+    sphere_1024: SamplingDomain,
 }
 
 fn setup() -> Setup {
@@ -46,6 +50,12 @@ fn setup() -> Setup {
         .filter_map(|d| bvh.closest_hit(light.position, *d, 0.0, f32::INFINITY))
         .map(|h| h.position + h.geometric_normal * scene.extent.ray_epsilon)
         .collect();
+    // One frame before the counted ones, as the management's frames follow others: buffers
+    // sized, candidates kept.
+    let [mut disc_1024, mut sphere_1024] =
+        [DomainKind::Disc, DomainKind::Sphere].map(|k| SamplingDomain::spiral(k, 1024));
+    domain_frame(&mut disc_1024, 0);
+    domain_frame(&mut sphere_1024, 0);
     Setup {
         scene,
         bvh,
@@ -53,7 +63,46 @@ fn setup() -> Setup {
         targets,
         disc: SamplingDomain::spiral(DomainKind::Disc, 256),
         sphere: SamplingDomain::spiral(DomainKind::Sphere, 256),
+        disc_1024,
+        sphere_1024,
     }
+}
+
+/// The domain's share of one frame of Laine's management at 1024 VPLs, without its rays: every
+/// site moved as a moving light moves them (a turn of 0.002 rad, and on the disc a shear and a
+/// shrink of 0.05 %: a few sites repaired per frame, as on Sibenik), four redundant sites
+/// deleted, eight created at the largest empty circle, the Voronoi areas.
+fn domain_frame(d: &mut SamplingDomain, round: u64) -> f64 {
+    let (s, c) = 0.002f64.sin_cos();
+    let mut sites: Vec<(u64, DVec3)> = d
+        .points()
+        .into_iter()
+        .map(|(id, q)| {
+            let p = match d.kind() {
+                DomainKind::Disc => {
+                    DVec3::new(c * q.x - s * q.y + 0.001 * q.y, s * q.x + c * q.y, 0.0) * 0.9995
+                }
+                DomainKind::Sphere => DVec3::new(c * q.x - s * q.z, q.y, s * q.x + c * q.z),
+            };
+            (id, p)
+        })
+        .collect();
+    // The sphere's projection pole (listed last) first, as the management lists it.
+    if d.kind() == DomainKind::Sphere {
+        sites.rotate_right(1);
+    }
+    let moved = d.update_sites(&sites);
+    let mut queue = d.redundancy_queue();
+    for _ in 0..4 {
+        d.remove_redundant(&mut queue).expect("sites to delete");
+    }
+    for k in 0..8 {
+        let (centre, _, near) = d.largest_empty_circle_near().expect("sites");
+        d.insert_near(1_000_000 + 8 * round + k, centre, near)
+            .expect("inserted");
+    }
+    let areas: f64 = d.voronoi_areas().iter().map(|(_, a)| a).sum();
+    areas + moved.reinserted as f64 + if moved.rebuilt { 1e6 } else { 0.0 }
 }
 
 /// The kernel `name` once; what it returns keeps the work from being optimised away.
@@ -94,6 +143,8 @@ pub extern "Rust" fn gibench_kernel_body(name: &str, s: &mut Setup, round: u64) 
             }
             sum
         }
+        "domain-frame-disc-1024" => domain_frame(&mut s.disc_1024, round + 1),
+        "domain-frame-sphere-1024" => domain_frame(&mut s.sphere_1024, round + 1),
         "domain-voronoi-areas-disc-256" => s.disc.voronoi_areas().iter().map(|(_, a)| a).sum(),
         "vpl-generation-cornell" => {
             let rho = s.scene.average_reflectance().max_element();
