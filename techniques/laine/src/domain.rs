@@ -308,11 +308,16 @@ fn spherical_fan_area(s: DVec3, ring: &[DVec3]) -> f64 {
     let n = ring.len();
     if n <= 64 && ring.iter().all(|c| (*c - s).length_squared() < 1.0) {
         let (mut re, mut im) = (1.0, 0.0);
+        // s · corner, once per corner (b · s and s · b round alike: the products commute and
+        // are summed in the same order).
+        let mut sa = s.dot(ring[0]);
         for k in 0..n {
             let (a, b) = (ring[k], ring[(k + 1) % n]);
+            let sb = if k + 1 < n { s.dot(b) } else { s.dot(ring[0]) };
             let det = s.dot(a.cross(b));
-            let den = 1.0 + s.dot(a) + a.dot(b) + b.dot(s);
+            let den = 1.0 + sa + a.dot(b) + sb;
             (re, im) = (re * den - im * det, re * det + im * den);
+            sa = sb;
         }
         return (2.0 * im.atan2(re)).abs();
     }
@@ -1318,15 +1323,23 @@ impl SamplingDomain {
                     lec.centres[i] = centre;
                     lec.faces.set_leaf(i, slot);
                 }
+                // After a reset every slot is empty: only candidates are set (most edges and
+                // vertices have none).
                 lec.edges.reset(2 * t.num_undirected_edges());
                 for u in t.fixed_undirected_edges() {
                     let [a, b] = self.disc_edge_slots(u, &lec.centres);
-                    lec.edges.set(2 * u.index(), a);
-                    lec.edges.set(2 * u.index() + 1, b);
+                    for (k, c) in [(0, a), (1, b)] {
+                        if c.is_some() {
+                            lec.edges.set(2 * u.index() + k, c);
+                        }
+                    }
                 }
                 lec.vertices.reset(t.num_vertices());
                 for v in t.fixed_vertices() {
-                    lec.vertices.set(v.index(), self.disc_vertex_slot(v));
+                    let c = self.disc_vertex_slot(v);
+                    if c.is_some() {
+                        lec.vertices.set(v.index(), c);
+                    }
                 }
                 lec.wraps.reset(0);
             }
