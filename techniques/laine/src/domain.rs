@@ -784,11 +784,28 @@ impl SamplingDomain {
         };
         match dirty {
             None => {
+                // Face by face: its orientation, then each of its edges in the edge's own
+                // direction (once per edge, as `check_edge` takes them) with the face's third
+                // corner as the vertex opposite on the left.
                 for f in self.tri.inner_faces() {
-                    check_face(f.adjacent_edge(), &mut broken);
-                }
-                for e in self.tri.undirected_edges() {
-                    check_edge(e.as_directed(), &mut broken);
+                    let edges = f.adjacent_edges();
+                    let corners = edges.map(|e| e.from());
+                    let [a, b, c] = corners.map(at);
+                    if robust::orient2d(a, b, c) <= 0.0 {
+                        broken.extend(corners.map(|v| v.data().id));
+                    }
+                    for (k, e) in edges.into_iter().enumerate() {
+                        if e.fix().as_undirected().as_directed() != e.fix() {
+                            continue;
+                        }
+                        let Some(d) = e.rev().opposite_vertex() else {
+                            continue;
+                        };
+                        let (p, q, r) = (corners[k], corners[(k + 1) % 3], corners[(k + 2) % 3]);
+                        if robust::incircle(at(p), at(q), at(r), at(d)) > 0.0 {
+                            broken.push(d.data().id);
+                        }
+                    }
                 }
             }
             Some(ids) => {
