@@ -65,8 +65,8 @@ use std::sync::Mutex;
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 use spade::handles::{
-    DirectedEdgeHandle, FixedDirectedEdgeHandle, FixedFaceHandle, FixedUndirectedEdgeHandle,
-    FixedVertexHandle, InnerTag, VertexHandle,
+    FixedDirectedEdgeHandle, FixedFaceHandle, FixedUndirectedEdgeHandle, FixedVertexHandle,
+    InnerTag, VertexHandle,
 };
 use spade::{
     DelaunayTriangulation, HasPosition, HintGenerator, Point2, PositionInTriangulation,
@@ -761,49 +761,37 @@ impl SamplingDomain {
             let p = target[v.fix().index()].pos;
             robust::Coord { x: p.x, y: p.y }
         };
+        type V<'a> = VertexHandle<'a, Site, (), (), ()>;
         let mut broken = Vec::new();
-        // A triangle of the old triangulation (its first directed edge `e`) turned over or flat.
-        let check_face = |e: DirectedEdgeHandle<'_, Site, (), (), ()>, broken: &mut Vec<u64>| {
-            if e.face().as_inner().is_none() {
-                return;
-            }
-            let (a, b, c) = (e.from(), e.to(), e.next().to());
-            if robust::orient2d(at(a), at(b), at(c)) <= 0.0 {
-                broken.extend([a, b, c].map(|v| v.data().id));
+        // A triangle of the old triangulation (corners counter-clockwise) turned over or flat.
+        let check_face = |corners: [V<'_>; 3], broken: &mut Vec<u64>| {
+            let [a, b, c] = corners.map(at);
+            if robust::orient2d(a, b, c) <= 0.0 {
+                broken.extend(corners.map(|v| v.data().id));
             }
         };
-        // The edge `e` between two triangles, no longer locally Delaunay: the vertex opposite
-        // it on its right is inside the left triangle's circumcircle.
-        let check_edge = |e: DirectedEdgeHandle<'_, Site, (), (), ()>, broken: &mut Vec<u64>| {
-            let (Some(c), Some(d)) = (e.opposite_vertex(), e.rev().opposite_vertex()) else {
-                return;
-            };
-            if robust::incircle(at(e.from()), at(e.to()), at(c), at(d)) > 0.0 {
+        // The edge p → q between two triangles (r opposite it on its left, d on its right), no
+        // longer locally Delaunay: d is inside the left triangle's circumcircle.
+        let check_edge = |[p, q, r, d]: [V<'_>; 4], broken: &mut Vec<u64>| {
+            if robust::incircle(at(p), at(q), at(r), at(d)) > 0.0 {
                 broken.push(d.data().id);
             }
         };
         match dirty {
             None => {
-                // Face by face: its orientation, then each of its edges in the edge's own
-                // direction (once per edge, as `check_edge` takes them) with the face's third
-                // corner as the vertex opposite on the left.
+                // Face by face: its orientation, then each of its edges once, in the edge's own
+                // direction, the face's third corner opposite on the left.
                 for f in self.tri.inner_faces() {
                     let edges = f.adjacent_edges();
                     let corners = edges.map(|e| e.from());
-                    let [a, b, c] = corners.map(at);
-                    if robust::orient2d(a, b, c) <= 0.0 {
-                        broken.extend(corners.map(|v| v.data().id));
-                    }
+                    check_face(corners, &mut broken);
                     for (k, e) in edges.into_iter().enumerate() {
                         if e.fix().as_undirected().as_directed() != e.fix() {
                             continue;
                         }
-                        let Some(d) = e.rev().opposite_vertex() else {
-                            continue;
-                        };
-                        let (p, q, r) = (corners[k], corners[(k + 1) % 3], corners[(k + 2) % 3]);
-                        if robust::incircle(at(p), at(q), at(r), at(d)) > 0.0 {
-                            broken.push(d.data().id);
+                        if let Some(d) = e.rev().opposite_vertex() {
+                            let [p, q, r] = [k, k + 1, k + 2].map(|i| corners[i % 3]);
+                            check_edge([p, q, r, d], &mut broken);
                         }
                     }
                 }
@@ -814,8 +802,13 @@ impl SamplingDomain {
                         continue;
                     };
                     for e in self.tri.vertex(*h).out_edges() {
-                        check_face(e, &mut broken);
-                        check_edge(e, &mut broken);
+                        if e.face().as_inner().is_some() {
+                            check_face([e.from(), e.to(), e.next().to()], &mut broken);
+                        }
+                        if let (Some(r), Some(d)) = (e.opposite_vertex(), e.rev().opposite_vertex())
+                        {
+                            check_edge([e.from(), e.to(), r, d], &mut broken);
+                        }
                     }
                 }
             }
