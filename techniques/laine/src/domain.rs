@@ -299,32 +299,57 @@ fn spherical_triangle_area(a: DVec3, b: DVec3, c: DVec3) -> f64 {
 
 /// The area of the spherical polygon `ring` (in order around `s`, star-shaped from it): the
 /// fan of signed triangles (s, ring[k], ring[k + 1]), |Σ spherical_triangle_area|. Each term is
-/// 2 atan2(det, den); when every corner lies within 60° of `s` (chord < 1) the polygon lies in
-/// a cap of area π, so every term's angle and their sum stay inside (−π/2, π/2) and the sum is
-/// the argument of the product of the (den + i det): one atan2 per polygon instead of one per
-/// corner. The terms' den ≥ 1.5 there and their modulus is below 4.2, so up to 64 corners the
-/// product neither vanishes nor overflows (past about 500 it would); larger rings sum the terms.
+/// 2 atan2(det, den); when every corner lies within 60° of `s` (s · corner > 1/2, i.e. chord
+/// < 1) the polygon lies in a cap of area π, so every term's angle and their sum stay inside
+/// (−π/2, π/2) and the sum is the argument of the product of the (den + i det): one atan2 per
+/// polygon instead of one per corner. The terms' den ≥ 1.5 there and their modulus is below
+/// 4.2, so up to 64 corners the product neither vanishes nor overflows (past about 500 it
+/// would); larger rings, or rings reaching farther, sum the terms. One pass: the product is
+/// taken from the closing pair (ring[n − 1], ring[0]) on, each corner's s · corner serving
+/// both its pairs and the 60° test.
 fn spherical_fan_area(s: DVec3, ring: &[DVec3]) -> f64 {
     let n = ring.len();
-    if n <= 64 && ring.iter().all(|c| (*c - s).length_squared() < 1.0) {
+    if (1..=64).contains(&n) {
         let (mut re, mut im) = (1.0, 0.0);
-        // s · corner, once per corner (b · s and s · b round alike: the products commute and
-        // are summed in the same order).
-        let mut sa = s.dot(ring[0]);
-        for k in 0..n {
-            let (a, b) = (ring[k], ring[(k + 1) % n]);
-            let sb = if k + 1 < n { s.dot(b) } else { s.dot(ring[0]) };
+        let mut near = true;
+        let mut a = ring[n - 1];
+        let mut sa = s.dot(a);
+        for &b in ring {
+            let sb = s.dot(b);
             let det = s.dot(a.cross(b));
             let den = 1.0 + sa + a.dot(b) + sb;
             (re, im) = (re * den - im * det, re * det + im * den);
-            sa = sb;
+            near &= sb > 0.5;
+            (a, sa) = (b, sb);
         }
-        return (2.0 * im.atan2(re)).abs();
+        if near {
+            return (2.0 * atan_right_half(im, re)).abs();
+        }
     }
     (0..n)
         .map(|k| spherical_triangle_area(s, ring[k], ring[(k + 1) % n]))
         .sum::<f64>()
         .abs()
+}
+
+/// atan2(y, x) for x > 0 (the right half-plane, where it is atan(y / x)): for t = y / x with
+/// |t| ≤ 1/16 — a Voronoi cell's fan at a few hundred sites and more, whose angle is half its
+/// area — the Taylor series of atan to the t¹³ term (the first omitted one, t¹⁵/15, is below
+/// 2⁻⁵⁹ of the result), within about an ulp of libm's at a fraction of its cost; libm's atan2
+/// otherwise.
+fn atan_right_half(y: f64, x: f64) -> f64 {
+    let t = y / x;
+    if t.is_nan() || t.abs() > 1.0 / 16.0 {
+        return y.atan2(x);
+    }
+    let t2 = t * t;
+    // 1 − t²/3 + t⁴/5 − … + t¹²/13, by Horner's rule in t².
+    let mut p = 1.0 / 13.0;
+    for k in (0..6).rev() {
+        let c = 1.0 / (2 * k + 1) as f64;
+        p = if k % 2 == 0 { c } else { -c } + t2 * p;
+    }
+    t * p
 }
 
 /// Sphere: the circumcentre of the spherical triangle of sites `[a, b, c]`, with its radius and
@@ -1861,4 +1886,26 @@ fn lune_areas(pts: &[(u64, DVec3)], m: DVec3) -> Vec<(u64, f64)> {
         out[angles[i].1].1 = gap(i) + gap((i + n - 1) % n);
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The series agrees with libm's atan2 to within an ulp across its range (and is libm's
+    /// beyond it), for both signs of y and across magnitudes of x.
+    #[test]
+    fn atan_right_half_matches_libm() {
+        for x in [1e-3, 0.5, 1.0, 3.0, 1e6] {
+            for k in -2000..=2000 {
+                let t = k as f64 / 2000.0 * 0.07;
+                let y = t * x;
+                let (got, want) = (atan_right_half(y, x), y.atan2(x));
+                assert!(
+                    (got - want).abs() <= f64::EPSILON * want.abs(),
+                    "atan2({y}, {x}): {got} vs {want}"
+                );
+            }
+        }
+    }
 }

@@ -176,9 +176,9 @@ fn fnv(h: &mut u64, word: u64) {
 /// moved triangulation and the queued deletions) must give exactly the layout the rules gave
 /// before it. The constants were computed with the sites inserted one by one (before the bulk
 /// load); another numbering of the triangles' corners can move a circumradius in its last bits
-/// (≤ 10⁻¹³ relative), hence
-/// the dispersion's tolerance. The per-frame flux, which goes through libm's atan2, is left out.
-/// A deliberate change of the rules changes these.
+/// (≤ 10⁻¹³ relative), hence the dispersion's tolerance. The per-frame flux (through the
+/// Voronoi areas, whose last bits are not pinned) is left out. A deliberate change of the rules
+/// changes these.
 #[test]
 fn the_vpl_layout_is_the_one_the_rules_gave_before() {
     let mut got = Vec::new();
