@@ -11,11 +11,13 @@ How:
      `mi.load_dict` (perspective camera, box-filtered hdrfilm, independent sampler, two-sided
      diffuse BSDFs, a spot/point/directional light).
   2. Per scene, one Mitsuba warm-up render (JIT compilation, reported apart), then `--repeats`
-     alternations of: `gibench reference --no-cache` as a subprocess (CPU time = user+sys of
-     the child from getrusage(RUSAGE_CHILDREN) deltas, whole process: scene load, BVH build,
-     render, image writing), then one timed Mitsuba render (CPU = time.process_time, all
-     threads, around mi.render plus the evaluation it defers, so load and compilation are
-     outside). The ratio is taken per alternation; min/median/max are reported.
+     alternations of: `gibench reference --no-cache` as a subprocess, then one timed Mitsuba
+     render (CPU = time.process_time, all threads, around mi.render plus the evaluation it
+     defers, so load, BVH build and compilation are outside). gibench's CPU time is read two
+     ways: its JSON sidecar's `cpu_seconds`, the CPU of every thread during its render call
+     (BVH build included) — the primary ratio, the nearest to Mitsuba's — and user+sys of the
+     whole child process from getrusage(RUSAGE_CHILDREN) deltas (process start, scene load and
+     image writing added). The ratio is taken per alternation; min/median/max are reported.
   3. Raw rays (`--rays N`, default 262144; 0 skips): `gibench export-scene --rays N` also
      writes N closest-hit rays (from primary hits, cosine-distributed like the reference's path
      segments) and N shadow segments to the light; per alternation `gibench raycast` casts both
@@ -38,9 +40,8 @@ Caveats (read before quoting a ratio):
     cutoff_angle = beam_width = 90 is uniform over the front hemisphere. Images differ; the
     cost per sample is what is compared. Area lights are replaced by a spot light (their far
     field); suns map to `directional`.
-  * gibench's CPU time includes its process start, scene load and output writing; Mitsuba's
-    excludes everything but the render. This favours Mitsuba a little; the render-wall ratio
-    shows the size of the effect.
+  * gibench's render CPU includes its BVH build; Mitsuba's excludes it (built at load). This
+    favours Mitsuba a little; the whole-process ratio adds gibench's start, load and output.
   * Raw rays: gibench's closest_hit returns a full hit record (normals, uv, material), Mitsuba's
     ray_intersect_preliminary only the distance, primitive and barycentrics; Mitsuba casts all
     rays as one vectorised wavefront (Embree's packet or stream traversal under Dr.Jit), gibench
@@ -157,6 +158,7 @@ def gibench_render(args, name, w, h, out):
     cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
     sidecar = json.loads(next(Path(out).glob("*-reference.json")).read_text())
     return {"cpu_s": cpu, "wall_s": wall, "render_wall_s": sidecar.get("seconds"),
+            "render_cpu_s": sidecar.get("cpu_seconds"),
             "outside_render_wall_s": wall - sidecar["seconds"] if "seconds" in sidecar else None}
 
 
@@ -259,15 +261,25 @@ def compare_scene(args, mi, dr, name, w, h, tmp):
         m["samples_per_cpu_s"] = samples / m["cpu_s"]
         one = {"gibench": g, "mitsuba": m,
                "ratio_cpu": g["samples_per_cpu_s"] / m["samples_per_cpu_s"]}
+        if g["render_cpu_s"]:
+            g["samples_per_render_cpu_s"] = samples / g["render_cpu_s"]
+            one["ratio_render_cpu"] = g["samples_per_render_cpu_s"] / m["samples_per_cpu_s"]
         if g["render_wall_s"]:
             one["ratio_render_wall"] = m["wall_s"] / g["render_wall_s"]
         runs.append(one)
-        print(f"  {name} #{i + 1}: gibench {g['cpu_s']:.2f} CPU-s ({g['wall_s']:.2f} s wall, "
-              f"render {g['render_wall_s'] or float('nan'):.2f} s), mitsuba {m['cpu_s']:.2f} "
-              f"CPU-s ({m['wall_s']:.2f} s wall), ratio {one['ratio_cpu']:.3f}", flush=True)
+        print(f"  {name} #{i + 1}: gibench {g['cpu_s']:.2f} CPU-s (render "
+              f"{g['render_cpu_s'] or float('nan'):.2f} CPU-s; {g['wall_s']:.2f} s wall, render "
+              f"{g['render_wall_s'] or float('nan'):.2f} s), mitsuba {m['cpu_s']:.2f} CPU-s "
+              f"({m['wall_s']:.2f} s wall), ratio render CPU "
+              f"{one.get('ratio_render_cpu', float('nan')):.3f}, whole process "
+              f"{one['ratio_cpu']:.3f}", flush=True)
     summary = {"gibench_samples_per_cpu_s": spread([r["gibench"]["samples_per_cpu_s"] for r in runs]),
                "mitsuba_samples_per_cpu_s": spread([r["mitsuba"]["samples_per_cpu_s"] for r in runs]),
                "ratio_cpu": spread([r["ratio_cpu"] for r in runs])}
+    if all("ratio_render_cpu" in r for r in runs):
+        summary["gibench_samples_per_render_cpu_s"] = spread(
+            [r["gibench"]["samples_per_render_cpu_s"] for r in runs])
+        summary["ratio_render_cpu"] = spread([r["ratio_render_cpu"] for r in runs])
     if all("ratio_render_wall" in r for r in runs):
         summary["ratio_render_wall"] = spread([r["ratio_render_wall"] for r in runs])
     return {"scene": name, "triangles": meta.get("triangles"), "light_kind": meta["light"]["kind"],
@@ -304,8 +316,10 @@ def main():
               "spp": args.spp, "resolution": [w, h], "gibench_bounces": BOUNCES,
               "max_depth": MAX_DEPTH, "rr_depth": MAX_DEPTH + 1, "light_note": LIGHT_NOTE,
               "gibench_cpu": "user+sys of the whole `gibench reference` process (getrusage "
-                             "RUSAGE_CHILDREN); its sidecar 'seconds' (render call incl. BVH "
-                             "build, wall) gives ratio_render_wall",
+                             "RUSAGE_CHILDREN) gives ratio_cpu; its sidecar 'cpu_seconds' (CPU "
+                             "of every thread during the render call, BVH build included) gives "
+                             "ratio_render_cpu, and 'seconds' (the same call's wall time) "
+                             "ratio_render_wall",
               "mitsuba_cpu": "time.process_time around mi.render + dr.eval + dr.sync_thread"}
     git = subprocess.run(["git", "describe", "--always", "--dirty", "--abbrev=7"],
                          capture_output=True, text=True, cwd=Path(__file__).resolve().parent)
@@ -325,17 +339,25 @@ def main():
              f"{w}x{h}, {args.spp} spp, {BOUNCES} indirect bounces (Mitsuba max_depth "
              f"{MAX_DEPTH}, no Russian roulette), {os.cpu_count()} CPUs, {args.repeats} "
              "alternations; samples = width x height x spp.", "",
-             "| scene | triangles | gibench samples/CPU-s (median) | Mitsuba samples/CPU-s "
-             "(median) | ratio gibench/Mitsuba, median [min–max] | render-wall ratio |",
-             "|---|---:|---:|---:|---:|---:|"]
+             "| scene | triangles | gibench samples/render-CPU-s (median) | Mitsuba "
+             "samples/CPU-s (median) | ratio gibench/Mitsuba, render CPU, median [min–max] "
+             "| whole-process CPU ratio | render-wall ratio |",
+             "|---|---:|---:|---:|---:|---:|---:|"]
+    dash = "–"
     for r in results:
         s = r["summary"]
-        lines.append(f"| {r['scene']} | {r['triangles']} | {s['gibench_samples_per_cpu_s']['median']:,.0f}"
-                     f" | {s['mitsuba_samples_per_cpu_s']['median']:,.0f} | {rng(s['ratio_cpu'])}"
-                     f" | {rng(s['ratio_render_wall']) if 'ratio_render_wall' in s else '–'} |")
-    lines += ["", "CPU: gibench's whole process (load, BVH, render, image output); Mitsuba's "
-              "render only, after a warm-up. Render-wall ratio: gibench's sidecar render time "
-              "(BVH build included) against Mitsuba's render wall time.", "",
+        render = s.get("gibench_samples_per_render_cpu_s")
+        render = f"{render['median']:,.0f}" if render else dash
+        lines.append(f"| {r['scene']} | {r['triangles']} | {render}"
+                     f" | {s['mitsuba_samples_per_cpu_s']['median']:,.0f}"
+                     f" | {rng(s['ratio_render_cpu']) if 'ratio_render_cpu' in s else dash}"
+                     f" | {rng(s['ratio_cpu'])}"
+                     f" | {rng(s['ratio_render_wall']) if 'ratio_render_wall' in s else dash} |")
+    lines += ["", "Render CPU: the CPU of every thread of gibench during its render call (BVH "
+              "build included), from its JSON sidecar, against Mitsuba's render CPU after a "
+              "warm-up (its BVH is built when the scene loads, outside). Whole-process CPU: "
+              "gibench's process start, scene load and image output added. Render-wall ratio: "
+              "the render call's wall time against Mitsuba's render wall time.", "",
               f"Light: {LIGHT_NOTE}", "", "Per sample gibench traces 16 rays (+2 per pixel), "
               f"Mitsuba 19 (max_depth {MAX_DEPTH}); see scripts/compare_mitsuba.py for caveats."]
     if args.rays > 0:

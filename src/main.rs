@@ -1377,8 +1377,13 @@ pub(crate) fn reference_planned(
         settings.seed
     ));
     let start = std::time::Instant::now();
+    let cpu_start = gibench_harness::calibrate::process_cpu_ms();
     let r = cache.get(scene, &frame, resolution, &settings)?;
     let seconds = start.elapsed().as_secs_f64();
+    // CPU of every thread over the same call (BVH build included, as `seconds`).
+    let cpu_seconds = cpu_start
+        .zip(gibench_harness::calibrate::process_cpu_ms())
+        .map(|(a, b)| (b - a) / 1e3);
     let mut estimate = None;
     if args.error_estimate {
         let other = ReferenceSettings {
@@ -1430,6 +1435,7 @@ pub(crate) fn reference_planned(
     let info = serde_json::json!({
         "scene": desc.name, "frame": args.frame, "resolution": resolution, "spp": settings.spp,
         "bounces": settings.bounces, "seed": settings.seed, "seconds": seconds,
+        "cpu_seconds": cpu_seconds,
         "reference_version": gibench_harness::reference::REFERENCE_VERSION,
         "git_commit": gibench_harness::runner::git_commit(), "error_estimate": estimate,
     });
