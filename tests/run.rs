@@ -178,6 +178,12 @@ fn reference_two_seeds_agree_at_default_spp() {
     )
     .unwrap();
     assert_eq!(info["spp"], 256);
+    // The render call's CPU time (every thread), beside its wall time.
+    let cpu = info["cpu_seconds"].as_f64().unwrap();
+    assert!(
+        cpu > 0.0 && info["seconds"].as_f64().unwrap() > 0.0,
+        "{info}"
+    );
     let e = &info["error_estimate"];
     for k in ["one_bounce_rel_mse", "multi_bounce_rel_mse"] {
         let v = e[k].as_f64().unwrap();
