@@ -103,7 +103,7 @@ pub fn check(target: &str, args: &ReproduceArgs) -> Result<()> {
 pub fn work(target: &str, args: &ReproduceArgs) -> (u64, u64) {
     match target {
         "laine-management" => {
-            let frames = management_frames(args) as u64;
+            let frames = management_frames(args) as u64 * MANAGEMENT_PASSES as u64;
             (4 * frames, frames * 2 * (256 + 1024))
         }
         "laine-dispersion" => {
