@@ -570,8 +570,27 @@ impl WideBvh {
                 let node = &self.nodes[code as usize];
                 let (near, mut mask) = ray.enter(node, t_min, t_max);
                 if mask != 0 {
-                    if mask & (mask - 1) == 0 {
-                        code = node.child[mask.trailing_zeros() as usize];
+                    // One entered child: walk it. Two (a third of the nodes with any on
+                    // Sibenik): walk the nearer, push the other, the lower lane first on a tie
+                    // as the sort below orders them. More: sort.
+                    let first = mask.trailing_zeros() as usize & (W - 1);
+                    let rest = mask & (mask - 1);
+                    if rest == 0 {
+                        code = node.child[first];
+                        continue;
+                    }
+                    if rest & (rest - 1) == 0 {
+                        let second = rest.trailing_zeros() as usize & (W - 1);
+                        let (near_lane, far_lane) = if near[second] < near[first] {
+                            (second, first)
+                        } else {
+                            (first, second)
+                        };
+                        stack.push(Entry {
+                            code: node.child[far_lane],
+                            t: near[far_lane],
+                        });
+                        code = node.child[near_lane];
                         continue;
                     }
                     // Sort the entered children by entry distance; walk the nearest, push the
