@@ -1378,7 +1378,7 @@ pub(crate) fn reference_planned(
     ));
     let start = std::time::Instant::now();
     let cpu_start = gibench_harness::calibrate::process_cpu_ms();
-    let r = cache.get(scene, &frame, resolution, &settings)?;
+    let (r, setup) = cache.get_timed(scene, &frame, resolution, &settings)?;
     let seconds = start.elapsed().as_secs_f64();
     // CPU of every thread over the same call (BVH build included, as `seconds`).
     let cpu_seconds = cpu_start
@@ -1436,6 +1436,8 @@ pub(crate) fn reference_planned(
         "scene": desc.name, "frame": args.frame, "resolution": resolution, "spp": settings.spp,
         "bounces": settings.bounces, "seed": settings.seed, "seconds": seconds,
         "cpu_seconds": cpu_seconds,
+        "bvh_build_seconds": setup.map(|t| t.seconds),
+        "bvh_build_cpu_seconds": setup.and_then(|t| t.cpu_seconds),
         "reference_version": gibench_harness::reference::REFERENCE_VERSION,
         "git_commit": gibench_harness::runner::git_commit(), "error_estimate": estimate,
     });

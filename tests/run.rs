@@ -180,8 +180,13 @@ fn reference_two_seeds_agree_at_default_spp() {
     assert_eq!(info["spp"], 256);
     // The render call's CPU time (every thread), beside its wall time.
     let cpu = info["cpu_seconds"].as_f64().unwrap();
+    let wall = info["seconds"].as_f64().unwrap();
+    assert!(cpu > 0.0 && wall > 0.0, "{info}");
+    // Within it, the BVH build's (rendered here, not read from a cache): a part of each.
+    let build = info["bvh_build_seconds"].as_f64().unwrap();
+    let build_cpu = info["bvh_build_cpu_seconds"].as_f64().unwrap();
     assert!(
-        cpu > 0.0 && info["seconds"].as_f64().unwrap() > 0.0,
+        (0.0..wall).contains(&build) && (0.0..cpu).contains(&build_cpu),
         "{info}"
     );
     let e = &info["error_estimate"];

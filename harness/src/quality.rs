@@ -239,6 +239,18 @@ impl ReferenceCache {
         resolution: [u32; 2],
         settings: &ReferenceSettings,
     ) -> Result<ReferenceImages> {
+        Ok(self.get_timed(scene, frame, resolution, settings)?.0)
+    }
+
+    /// [`get`](Self::get), with the tracer's set-up cost when it rendered (`None` from the
+    /// cache).
+    pub fn get_timed(
+        &self,
+        scene: &Scene,
+        frame: &FrameState,
+        resolution: [u32; 2],
+        settings: &ReferenceSettings,
+    ) -> Result<(ReferenceImages, Option<reference::TracerSetup>)> {
         let path = self
             .dir
             .as_ref()
@@ -252,15 +264,15 @@ impl ReferenceCache {
                 if let Ok(f) = std::fs::File::options().append(true).open(p) {
                     let _ = f.set_modified(std::time::SystemTime::now());
                 }
-                return Ok(r);
+                return Ok((r, None));
             }
         }
-        let r = reference::render_reference(scene, frame, resolution, settings);
+        let (r, setup) = reference::render_reference_timed(scene, frame, resolution, settings);
         if let (Some(p), Some(dir)) = (&path, &self.dir) {
             crate::error::write_atomic_direct(p, &encode(&r))?;
             trim(dir, MAX_CACHE_BYTES, p);
         }
-        Ok(r)
+        Ok((r, Some(setup)))
     }
 }
 

@@ -613,7 +613,40 @@ pub fn render_reference(
     resolution: [u32; 2],
     settings: &ReferenceSettings,
 ) -> ReferenceImages {
+    render_reference_timed(scene, frame, resolution, settings).0
+}
+
+/// What setting up the tracer cost in a [`render_reference_timed`] call: the frame's mesh and
+/// its BVH, built before any ray is traced. Renderers that build their acceleration structure
+/// when the scene loads (Mitsuba, Embree) leave this out of their render time; a like-for-like
+/// comparison subtracts it from the render call's.
+#[derive(Clone, Copy, Debug)]
+pub struct TracerSetup {
+    /// Wall seconds.
+    pub seconds: f64,
+    /// CPU seconds of every thread of the process over the same span (`None` where the
+    /// platform has no process CPU clock).
+    pub cpu_seconds: Option<f64>,
+}
+
+/// [`render_reference`], with what setting up the tracer cost.
+pub fn render_reference_timed(
+    scene: &Scene,
+    frame: &FrameState,
+    resolution: [u32; 2],
+    settings: &ReferenceSettings,
+) -> (ReferenceImages, TracerSetup) {
+    let (start, cpu_start) = (
+        std::time::Instant::now(),
+        crate::calibrate::process_cpu_ms(),
+    );
     let tracer = ReferenceTracer::new(scene, frame);
+    let setup = TracerSetup {
+        seconds: start.elapsed().as_secs_f64(),
+        cpu_seconds: cpu_start
+            .zip(crate::calibrate::process_cpu_ms())
+            .map(|(a, b)| (b - a) / 1e3),
+    };
     let [w, h] = resolution;
     let inv = view_projection(frame, resolution).inverse();
     let pixels: Vec<Option<(Vec3, PointIrradiance)>> = (0..w as usize * h as usize)
@@ -657,7 +690,7 @@ pub fn render_reference(
         out.radiance
             .push(albedo * std::f32::consts::FRAC_1_PI * (e.direct + e.multi_bounce));
     }
-    out
+    (out, setup)
 }
 
 #[cfg(test)]
