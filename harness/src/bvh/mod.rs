@@ -209,13 +209,13 @@ impl SceneBvh {
 
     /// Whether the ray's values can be traced (finite origin, finite non-zero direction and a
     /// non-empty, non-NaN interval).
+    #[inline(always)]
     fn usable(origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> bool {
-        origin.is_finite()
-            && dir.is_finite()
-            && dir != Vec3::ZERO
-            && !t_min.is_nan()
-            && !t_max.is_nan()
-            && t_max > t_min
+        // x · 0 is ±0 for a finite x and NaN for ±∞ and NaN, so the six products sum to zero
+        // exactly when every coordinate is finite (a few operations instead of a test per
+        // coordinate); a NaN bound fails the last comparison.
+        let z = origin * 0.0 + dir * 0.0;
+        z.x + z.y + z.z == 0.0 && dir != Vec3::ZERO && t_max > t_min
     }
 
     /// Closest hit along `origin + t·dir` for `t` in `(t_min, t_max)` (a negative `t_min` acts
@@ -618,6 +618,17 @@ mod tests {
             .is_none());
         assert!(bvh.closest_hit(o, Vec3::X, 10.0, 5.0).is_none());
         assert!(!bvh.occluded(o, o, 1e-3));
+        // Non-finite coordinates and a NaN far bound hit nothing; a direction whose squared
+        // length overflows is still finite and traced (a guard built on its length, or on a
+        // sum that overflows, would refuse it).
+        let inf_z = Vec3::new(0.0, 0.0, f32::INFINITY);
+        assert!(bvh.closest_hit(o + inf_z, Vec3::X, 0.0, 1e9).is_none());
+        assert!(bvh.closest_hit(o, Vec3::X + inf_z, 0.0, 1e9).is_none());
+        assert!(!bvh.any_hit(o, Vec3::X + inf_z, 0.0, 1e9));
+        assert!(bvh.closest_hit(o, Vec3::X, 0.0, f32::NAN).is_none());
+        assert!(!bvh.any_hit(o, Vec3::X, 0.0, f32::NAN));
+        assert!(bvh.closest_hit(o, Vec3::X * 1e30, 0.0, 1.0).is_some());
+        assert!(bvh.any_hit(o, Vec3::X * 1e30, 0.0, 1.0));
 
         // Bad indices and a zero-area triangle.
         let mut broken = mesh.clone();
