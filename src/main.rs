@@ -1376,14 +1376,10 @@ pub(crate) fn reference_planned(
         settings.bounces,
         settings.seed
     ));
-    let start = std::time::Instant::now();
-    let cpu_start = gibench_harness::calibrate::process_cpu_ms();
-    let (r, setup) = cache.get_timed(scene, &frame, resolution, &settings)?;
-    let seconds = start.elapsed().as_secs_f64();
-    // CPU of every thread over the same call (BVH build included, as `seconds`).
-    let cpu_seconds = cpu_start
-        .zip(gibench_harness::calibrate::process_cpu_ms())
-        .map(|(a, b)| (b - a) / 1e3);
+    // Wall and all-thread CPU of the call (BVH build included; `setup` has its share).
+    let (r, seconds, cpu_seconds) =
+        gibench_harness::calibrate::timed(|| cache.get_timed(scene, &frame, resolution, &settings));
+    let (r, setup) = r?;
     let mut estimate = None;
     if args.error_estimate {
         let other = ReferenceSettings {

@@ -15,12 +15,11 @@
 //! closest-hit ray, +∞ for a miss) and `shadow-hit.bin` (one byte per shadow ray, 1 = blocked).
 
 use std::path::{Path, PathBuf};
-use std::time::Instant;
 
 use clap::Args;
 use gibench_harness::anim::FrameClock;
 use gibench_harness::assets::AssetPaths;
-use gibench_harness::calibrate::process_cpu_ms;
+use gibench_harness::calibrate::timed;
 use gibench_harness::glam::{Vec2, Vec3};
 use gibench_harness::output::OutputSet;
 use gibench_harness::reference::{camera_ray, cosine_direction, ReferenceTracer};
@@ -165,15 +164,6 @@ pub(crate) struct RaycastArgs {
     /// Extra directory searched first for scene assets.
     #[arg(long)]
     assets: Option<PathBuf>,
-}
-
-/// Wall and CPU (every thread) seconds of `f`, and its result.
-fn timed<T>(f: impl FnOnce() -> T) -> (T, f64, Option<f64>) {
-    let (c0, t0) = (process_cpu_ms(), Instant::now());
-    let out = f();
-    let wall = t0.elapsed().as_secs_f64();
-    let cpu = c0.zip(process_cpu_ms()).map(|(a, b)| (b - a) * 1e-3);
-    (out, wall, cpu)
 }
 
 pub(crate) fn raycast(args: &RaycastArgs) -> Result<()> {

@@ -30,6 +30,17 @@ pub fn process_cpu_ms() -> Option<f64> {
     }
 }
 
+/// `f`'s result with the wall seconds it took and the CPU seconds every thread of the process
+/// spent meanwhile (`None` without a process CPU clock): the timer of CPU work that may run
+/// across cores.
+pub fn timed<T>(f: impl FnOnce() -> T) -> (T, f64, Option<f64>) {
+    let (cpu, wall) = (process_cpu_ms(), Instant::now());
+    let out = f();
+    let wall = wall.elapsed().as_secs_f64();
+    let cpu = cpu.zip(process_cpu_ms()).map(|(a, b)| (b - a) * 1e-3);
+    (out, wall, cpu)
+}
+
 #[cfg(unix)]
 fn cpu_clock_ms(clock: libc::clockid_t) -> Option<f64> {
     let mut ts = libc::timespec {

@@ -636,16 +636,11 @@ pub fn render_reference_timed(
     resolution: [u32; 2],
     settings: &ReferenceSettings,
 ) -> (ReferenceImages, TracerSetup) {
-    let (start, cpu_start) = (
-        std::time::Instant::now(),
-        crate::calibrate::process_cpu_ms(),
-    );
-    let tracer = ReferenceTracer::new(scene, frame);
+    let (tracer, seconds, cpu_seconds) =
+        crate::calibrate::timed(|| ReferenceTracer::new(scene, frame));
     let setup = TracerSetup {
-        seconds: start.elapsed().as_secs_f64(),
-        cpu_seconds: cpu_start
-            .zip(crate::calibrate::process_cpu_ms())
-            .map(|(a, b)| (b - a) / 1e3),
+        seconds,
+        cpu_seconds,
     };
     let [w, h] = resolution;
     let inv = view_projection(frame, resolution).inverse();

@@ -498,17 +498,14 @@ fn management(args: &ReproduceArgs) -> Result<Table> {
             // one step; then (untimed) the VPLs lighting the frame.
             let mut step = |f: u32| {
                 let light = clock.frame(f).light;
-                let c = gibench_harness::calibrate::process_cpu_ms();
-                let t = std::time::Instant::now();
-                let s = m.step(&scene, &bvh, light);
-                let wall = t.elapsed().as_secs_f64() * 1e3;
-                let cpu = c.zip(gibench_harness::calibrate::process_cpu_ms());
+                let (s, wall, cpu) =
+                    gibench_harness::calibrate::timed(|| m.step(&scene, &bvh, light));
                 if f > 0 {
                     acc.used.push(m.vpls().len() as f64);
                     acc.rebuilt += s.rebuilt as u32;
                     acc.repaired += s.repaired as u64;
                 }
-                (wall, cpu.map(|(a, b)| b - a))
+                (wall * 1e3, cpu.map(|c| c * 1e3))
             };
             let (fill, fill_cpu) = step(0);
             let (times, cpu): (Vec<f64>, Vec<Option<f64>>) = (1..=frames).map(&mut step).unzip();
