@@ -139,6 +139,23 @@ fn laine_management_records_spot_and_omni_at_256_and_1024() {
             );
             let repaired = rec["sites_repaired_per_frame"].as_f64().unwrap_or(f64::NAN);
             assert!(repaired >= 0.0 && repaired <= vpls as f64, "{rec}");
+            // The step's parts, each over the same frames; per frame they lie inside the step,
+            // so their means add up to at most the step's mean wall time.
+            let parts = &rec["part_wall_ms"];
+            let mut sum = 0.0;
+            for name in gibench_laine::StepTimes::NAMES {
+                assert_eq!(
+                    parts[name]["count"].as_u64(),
+                    Some(4 * passes),
+                    "{light}-{vpls} {name}: {rec}"
+                );
+                sum += parts[name]["mean"].as_f64().unwrap_or(f64::NAN);
+            }
+            let wall = rec["wall_ms"]["mean"].as_f64().unwrap();
+            assert!(
+                sum > 0.0 && sum <= wall * (1.0 + 1e-9),
+                "{light}-{vpls}: {rec}"
+            );
             assert!(
                 mean <= vpls as f64 && min >= 0.6 * vpls as f64,
                 "{light}-{vpls}: {used}"

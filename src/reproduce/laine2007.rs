@@ -504,6 +504,9 @@ fn management(args: &ReproduceArgs) -> Result<Table> {
                     acc.used.push(m.vpls().len() as f64);
                     acc.rebuilt += s.rebuilt as u32;
                     acc.repaired += s.repaired as u64;
+                    for (part, t) in acc.parts.iter_mut().zip(s.times.parts()) {
+                        part.push(t.as_secs_f64() * 1e3);
+                    }
                 }
                 (wall * 1e3, cpu.map(|c| c * 1e3))
             };
@@ -527,6 +530,7 @@ fn management(args: &ReproduceArgs) -> Result<Table> {
         let (rebuilt, repaired) = (acc.rebuilt, acc.repaired);
         let timed = frames as f64 * MANAGEMENT_PASSES as f64;
         let label = format!("{kind:?}").to_lowercase();
+        let parts = acc.parts.each_ref().map(|p| Stats::of(p));
         rows.push(vec![
             Cell::text("gibench"),
             Cell::text(&label),
@@ -541,6 +545,13 @@ fn management(args: &ReproduceArgs) -> Result<Table> {
             Cell::Ms(Some(fill)),
             Cell::Num(Some(rebuilt as f64), 0),
             Cell::Num(Some(repaired as f64 / timed), 1),
+            Cell::text(
+                parts
+                    .iter()
+                    .map(|p| format!("{:.3}", p.median))
+                    .collect::<Vec<_>>()
+                    .join(" / "),
+            ),
         ]);
         records.insert(
             format!("{label}-{vpls}"),
@@ -550,6 +561,9 @@ fn management(args: &ReproduceArgs) -> Result<Table> {
                 "fill_frame_cpu_ms_per_pass": fill_cpu,
                 "vpls_used": used, "frames_rebuilt": rebuilt,
                 "sites_repaired_per_frame": repaired as f64 / timed,
+                "part_wall_ms": gibench_laine::StepTimes::NAMES.iter().zip(&parts)
+                    .map(|(n, p)| (n.to_string(), serde_json::json!(p)))
+                    .collect::<serde_json::Map<_, _>>(),
             }),
         );
         if vpls < 1024 {
@@ -571,6 +585,7 @@ fn management(args: &ReproduceArgs) -> Result<Table> {
             Cell::Ms(None),
             Cell::Num(None, 0),
             Cell::Num(None, 1),
+            Cell::text("–"),
         ]);
     }
     let json = serde_json::json!({
@@ -583,7 +598,7 @@ fn management(args: &ReproduceArgs) -> Result<Table> {
     gibench_harness::error::write_atomic(&out(args).join("laine-management.json"), &bytes)?;
     Ok(Table {
         title: format!("VPL management per frame on the CPU ({name}, {MANAGEMENT_PASSES} passes of {frames} frames, recalcMin 4, recalcMax 8)"),
-        columns: ["source", "light", "VPLs", "VPLs used mean", "VPLs used min", "median ms", "pass medians ms", "median CPU ms", "p99 ms", "max ms", "fill frame ms", "frames rebuilt", "sites repaired per frame"]
+        columns: ["source", "light", "VPLs", "VPLs used mean", "VPLs used min", "median ms", "pass medians ms", "median CPU ms", "p99 ms", "max ms", "fill frame ms", "frames rebuilt", "sites repaired per frame", "part medians ms: validity / update / deletion / creation / intensities"]
             .map(String::from)
             .into(),
         rows,
@@ -598,7 +613,12 @@ fn management(args: &ReproduceArgs) -> Result<Table> {
                  the first frame, which creates every VPL (wall, the slowest pass's). Frames rebuilt: frames after the first whose \
                  triangulation was built from scratch (a bulk load) instead of moving last frame's with its points \
                  (`SamplingDomain::update_sites`); sites repaired: per frame after the first on average, the sampling points whose \
-                 motion broke last frame's triangulation, taken out and put back. The sphere is triangulated on its surface (no 3D tetrahedralisation).",
+                 motion broke last frame's triangulation, taken out and put back. Part medians: the wall time of each part of \
+                 the step, median over the same frames (`laine::StepTimes`; the medians need not add up to the step's): \
+                 validity — the paper's step 1 (§4.4), the validity rays; update — the surviving sampling points from the new \
+                 light position and their triangulation moved there, the invalid ones taken out; deletion — step 2's redundant \
+                 VPLs (§4.5); creation — step 3 (§4.6), sampling points at the largest empty circle and their rays; \
+                 intensities — step 4 (§4.7), the Voronoi areas. The sphere is triangulated on its surface (no 3D tetrahedralisation).",
                 std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1)
             ),
             format!("Paper: {} — a range over its test scenes, median only.", paper["source"].as_str().unwrap_or("")),
@@ -672,7 +692,6 @@ fn dispersion(args: &ReproduceArgs) -> Result<Table> {
     })
 }
 
-/// Frames of the management table.
 /// Passes of the management table's animation per row.
 const MANAGEMENT_PASSES: usize = 3;
 
@@ -687,8 +706,11 @@ struct ManagementPasses {
     used: Vec<f64>,
     rebuilt: u32,
     repaired: u64,
+    /// Per part of the step ([`gibench_laine::StepTimes::NAMES`]), its wall time per frame.
+    parts: [Vec<f64>; 5],
 }
 
+/// Frames of the management table.
 fn management_frames(args: &ReproduceArgs) -> u32 {
     args.frames.unwrap_or(if args.quick { 100 } else { 1000 })
 }

@@ -223,6 +223,45 @@ pub struct Step {
     /// Moved: the sampling points whose motion broke last frame's triangulation (taken out
     /// and put back).
     pub repaired: u32,
+    /// Wall time of each part of the step.
+    pub times: StepTimes,
+}
+
+/// Wall time of each part of one [`Manager::step`]: the paper's management steps 1–4 (§3),
+/// with the sampling points' triangulation following them to where the light moved apart
+/// from the deletions. Consecutive, non-overlapping intervals inside the step; the last
+/// step's dispersion (for reporting, not a paper step) is in none.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StepTimes {
+    /// §4.4: the validity rays, and whether each missed sampling point still misses (across
+    /// cores).
+    pub validity: std::time::Duration,
+    /// The surviving sampling points from the new light position, and their triangulation
+    /// moved to them (or built), the invalid ones taken out.
+    pub update: std::time::Duration,
+    /// §4.5: redundant VPLs deleted until recalcMin slots are free.
+    pub deletion: std::time::Duration,
+    /// §4.6: new sampling points at the largest empty circle, and their rays.
+    pub creation: std::time::Duration,
+    /// §4.7: the Voronoi areas and from them the VPLs' intensities.
+    pub intensities: std::time::Duration,
+}
+
+impl StepTimes {
+    /// The parts' names as the reports write them, in step order.
+    pub const NAMES: [&'static str; 5] =
+        ["validity", "update", "deletion", "creation", "intensities"];
+
+    /// The parts in step order (as [`NAMES`](Self::NAMES)).
+    pub fn parts(&self) -> [std::time::Duration; 5] {
+        [
+            self.validity,
+            self.update,
+            self.deletion,
+            self.creation,
+            self.intensities,
+        ]
+    }
 }
 
 impl Manager {
@@ -263,6 +302,7 @@ impl Manager {
         let kind = domain_kind(&light);
         let (extent, eps) = (&scene.extent, scene.extent.ray_epsilon);
         let mut deleted = 0;
+        let mut clock = Clock::start();
         // 1. Validity, and the surviving VPLs' sampling points from the new light position.
         // The validity rays, across cores (one per VPL, independent); likewise whether each
         // missed sampling point (fixed relative to the light) still misses.
@@ -280,6 +320,7 @@ impl Manager {
                 !bvh.any_hit(origin, dir, eps, f32::INFINITY)
             })
             .collect();
+        let validity = clock.lap();
         // The domain of the valid VPLs' new sampling points, then the misses that still
         // miss, in that order (the points all moved with the light).
         let samples: Vec<Vec3> = self
@@ -329,6 +370,7 @@ impl Manager {
         let mut site_of_miss = site_of_miss.into_iter();
         self.misses
             .retain(|_| site_of_miss.next().flatten().is_some_and(|k| accepted[k]));
+        let update = clock.lap();
         // 2. Deletion of redundant VPLs until recalc-min slots are free.
         // The VPLs are in creation order, so their ids ascend: found by binary search, and
         // taken out of the lists in one pass at the end.
@@ -349,6 +391,7 @@ impl Manager {
             self.vpls.retain(|m| !gone.contains(&m.id));
             self.misses.retain(|(m, _)| !gone.contains(m));
         }
+        let deletion = clock.lap();
         // 3. Creation at the largest empty circle's centre.
         let budget = if self.started {
             self.recalc_max
@@ -412,6 +455,7 @@ impl Manager {
                 break;
             }
         }
+        let creation = clock.lap();
         // 4. Intensities: Voronoi areas over the domain's area.
         let total = light.domain().area();
         let power = light.emitted_flux(extent);
@@ -425,6 +469,7 @@ impl Manager {
             let share = area / total;
             m.vpl.flux = power * share as f32 * m.vpl.color;
         }
+        let intensities = clock.lap();
         self.last_dispersion = domain.dispersion();
         self.domain = Some(domain);
         Step {
@@ -434,7 +479,30 @@ impl Manager {
             deleted,
             rebuilt,
             repaired,
+            times: StepTimes {
+                validity,
+                update,
+                deletion,
+                creation,
+                intensities,
+            },
         }
+    }
+}
+
+/// Laps of a step's parts: each [`lap`](Self::lap) is the time since the previous one.
+struct Clock(std::time::Instant);
+
+impl Clock {
+    fn start() -> Clock {
+        Clock(std::time::Instant::now())
+    }
+
+    fn lap(&mut self) -> std::time::Duration {
+        let now = std::time::Instant::now();
+        let lap = now - self.0;
+        self.0 = now;
+        lap
     }
 }
 

@@ -212,3 +212,47 @@ fn the_vpl_layout_is_the_one_the_rules_gave_before() {
         assert!((d - wd).abs() <= 1e-9 * wd, "dispersion sum {d} vs {wd}");
     }
 }
+
+/// `Step::times` splits the step into consecutive parts: their sum never exceeds the step's
+/// wall time measured around it (an interval counted twice, or one reaching outside the step,
+/// would), each part the steps run take time over a moving light's frames, and on the first
+/// frame, which creates every VPL, creation is the largest part.
+#[test]
+fn step_times_are_consecutive_parts_of_the_step() {
+    for kind in [LightKind::Spot, LightKind::Omni] {
+        let (scene, bvh) = cornell(kind);
+        let clock = FrameClock::new(&scene.descriptor);
+        let mut m = Manager::new(256, 4, 8);
+        let mut totals = [std::time::Duration::ZERO; 5];
+        for frame in 0..30 {
+            let start = std::time::Instant::now();
+            let step = m.step(&scene, &bvh, clock.frame(frame).light);
+            let elapsed = start.elapsed();
+            let parts = step.times.parts();
+            let sum: std::time::Duration = parts.iter().sum();
+            assert!(
+                sum <= elapsed,
+                "{kind:?} frame {frame}: parts {parts:?} add up to more than the step ({elapsed:?})"
+            );
+            if frame == 0 {
+                assert!(
+                    parts.iter().all(|p| *p <= step.times.creation),
+                    "{kind:?}: the fill frame's parts {parts:?}"
+                );
+            }
+            for (t, p) in totals.iter_mut().zip(parts) {
+                *t += p;
+            }
+        }
+        // Every part but the deletions runs each frame; the omni light's VPLs stay valid, so
+        // its frames delete redundant ones.
+        for (name, t) in gibench_laine::StepTimes::NAMES.iter().zip(totals) {
+            if *name != "deletion" || kind == LightKind::Omni {
+                assert!(
+                    t > std::time::Duration::ZERO,
+                    "{kind:?}: {name} took no time"
+                );
+            }
+        }
+    }
+}
