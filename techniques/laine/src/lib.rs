@@ -228,9 +228,10 @@ pub struct Step {
 }
 
 /// Wall time of each part of one [`Manager::step`]: the paper's management steps 1–4 (§3),
-/// with the sampling points' triangulation following them to where the light moved apart
-/// from the deletions. Consecutive, non-overlapping intervals inside the step; the last
-/// step's dispersion (for reporting, not a paper step) is in none.
+/// with the update of the sampling points' triangulation (they all move with the light)
+/// timed apart from step 2's deletions. Consecutive, non-overlapping intervals inside the
+/// step; the dispersion the step records at its end (for reporting, not a paper step) is in
+/// none.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct StepTimes {
     /// §4.4: the validity rays, and whether each missed sampling point still misses (across
