@@ -247,7 +247,7 @@ impl Profiler {
         }
     }
 
-    /// A warning for the results when the [`slow_stage_hook`] is set.
+    /// A warning for the results when the `slow_stage_hook` is set.
     pub fn test_hook_warning(&self) -> Option<String> {
         self.slow.as_ref().map(|(stage, ms)| {
             format!(

@@ -296,7 +296,7 @@ fn basis(n: Vec3) -> (Vec3, Vec3) {
 
 /// Cosine-weighted direction around unit `n` from `u` in [0, 1)² (concentric disk mapping,
 /// which keeps strata compact). The disk point's angle is ±π/4 · (ratio of the coordinates)
-/// off an axis, so one sine and cosine on [−π/4, π/4] ([`sin_cos_quarter`]) serve both halves
+/// off an axis, so one sine and cosine on [−π/4, π/4] (`sin_cos_quarter`) serve both halves
 /// of the mapping.
 pub fn cosine_direction(n: Vec3, u: Vec2) -> Vec3 {
     let a = 2.0 * u - Vec2::ONE;

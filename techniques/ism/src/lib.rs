@@ -7,7 +7,7 @@
 //! 2. **VPL sampling** ([`VplSampler`]): `vpls` VPLs importance-sampled by brightness, each
 //!    with luminance total / N, together the flux the map saw.
 //! 3. **Point splat** ([`PointSplat`]): each VPL's own run of `points-per-vpl` points of the
-//!    pool (the surfaces sampled uniformly by area once, in [`prepare`]; movers' points moved
+//!    pool (the surfaces sampled uniformly by area once, in `prepare`; movers' points moved
 //!    by their transforms every frame) splatted into its paraboloid map, one dispatch.
 //! 4. **Pull-push** ([`PullPush`]): holes filled in every map at once, `pull-push-levels`
 //!    levels.

@@ -50,8 +50,9 @@
 //! 256 and ~0.6 ms for 1024 points): the only non-incremental update, hit with probability
 //! 1/n per removal.
 //!
-//! Costs for n sites: the largest empty circle is kept between queries ([`crate::lec`]): O(n)
-//! after a removal, O(d log n) after inserting a site of degree d, O(1) otherwise; the
+//! Costs for n sites: the largest empty circle is kept between queries (the crate's `lec`
+//! module): O(n) after a removal, O(d log n) after inserting a site of degree d, O(1)
+//! otherwise; the
 //! shortest edge and the Voronoi areas are one pass (a run of deletions shares one pass:
 //! [`SamplingDomain::redundancy_queue`]; the areas across cores from 4096 sites); moving every
 //! site is one pass plus O(d²) per site whose motion broke the triangulation. Point location
@@ -1193,7 +1194,7 @@ impl SamplingDomain {
     ///
     /// Always `Some` for a valid domain; `None` only if no candidate had a finite radius.
     ///
-    /// Answered from candidates kept between calls ([`crate::lec`]): after an insertion only
+    /// Answered from candidates kept between calls (the crate's `lec` module): after an insertion only
     /// the slots it changed are recomputed; after a removal the next call recomputes all.
     pub fn largest_empty_circle(&self) -> Option<(DVec3, f64)> {
         self.largest_empty_circle_near().map(|(c, r, _)| (c, r))
