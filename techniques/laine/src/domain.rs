@@ -1194,8 +1194,9 @@ impl SamplingDomain {
     ///
     /// Always `Some` for a valid domain; `None` only if no candidate had a finite radius.
     ///
-    /// Answered from candidates kept between calls (the crate's `lec` module): after an insertion only
-    /// the slots it changed are recomputed; after a removal the next call recomputes all.
+    /// Answered from candidates kept between calls (the crate's `lec` module): after an
+    /// insertion only the slots it changed are recomputed; after a removal the next call
+    /// recomputes all.
     pub fn largest_empty_circle(&self) -> Option<(DVec3, f64)> {
         self.largest_empty_circle_near().map(|(c, r, _)| (c, r))
     }
