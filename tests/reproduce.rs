@@ -560,3 +560,33 @@ fn barczak2006_writes_five_figures_and_their_tables() {
     let bias: f64 = direct[direct.len() - 2].parse().unwrap();
     assert!(bias.abs() < 0.05, "direct bias {bias}");
 }
+
+/// The single-scene CPU targets refuse a list of scenes (they used the first and dropped the
+/// rest), and `--frames` past the run limit is refused before any work, naming the option.
+#[test]
+fn single_scene_targets_refuse_scene_lists_and_frames_have_a_limit() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    for (args, expect) in [
+        (
+            &["reproduce", "laine-dispersion", "--scenes", "cornell,maze"][..],
+            &["scenes", "one scene", "cornell, maze"][..],
+        ),
+        (
+            &["reproduce", "laine-management", "--scenes", "sibenik,maze"][..],
+            &["scenes", "one scene"][..],
+        ),
+        (
+            &["reproduce", "laine-management", "--frames", "10000001"][..],
+            &["frames", "limit"][..],
+        ),
+    ] {
+        let o = gibench(args, &out);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success(), "{args:?} succeeded");
+        for x in expect {
+            assert!(err.contains(x), "{args:?}: '{x}' not in: {err}");
+        }
+        assert!(!out.exists(), "{args:?} wrote {out:?}");
+    }
+}

@@ -14,7 +14,10 @@
 //! * `laine-dispersion`: the sampling points' dispersion over the animation.
 //!
 //! Paper sizes (1024×768 and 1600×1200, 256 VPLs with 256² maps, 1000 frames) are the
-//! defaults, for a GPU; `--quick` runs small sizes that finish on a CPU adapter.
+//! defaults, for a GPU; `--quick` runs small sizes that finish on a CPU adapter. The two
+//! CPU-only targets (management and dispersion) take seconds at full length and keep it with
+//! `--quick`, so the files `reproduce all --quick` writes are the ones their own commands
+//! write.
 
 use gibench_harness::ir::gather::{COMMON_STAGES, STAGE_VPL_SHADOW_MAPS};
 use gibench_harness::report::{self, Cell, Table};
@@ -53,8 +56,12 @@ pub fn describe(target: &str) -> &'static str {
         "laine-table1" => "Laine et al. 2007 Table 1: per-stage times of laine and keller-full",
         "laine-table2" => "Laine et al. 2007 Table 2: the common steps per resolution",
         "laine-tables" => "Laine et al. 2007 Tables 1 and 2 from one set of runs",
-        "laine-management" => "Laine et al. 2007 §6: VPL management cost on the CPU",
-        "laine-dispersion" => "Laine et al. 2007 §4.3: dispersion of the sampling points",
+        "laine-management" => {
+            "Laine et al. 2007 §6: VPL management cost on the CPU (the same sizes with and without --quick)"
+        }
+        "laine-dispersion" => {
+            "Laine et al. 2007 §4.3: dispersion of the sampling points (the same sizes with and without --quick)"
+        }
         _ => "",
     }
 }
@@ -91,6 +98,16 @@ fn scenes_of(target: &str, args: &ReproduceArgs) -> Vec<String> {
 pub fn check(target: &str, args: &ReproduceArgs) -> Result<()> {
     if target == "laine-dispersion" {
         dispersion_frames(args)?;
+    }
+    if matches!(target, "laine-management" | "laine-dispersion") && args.scenes.len() > 1 {
+        return Err(Error::param(
+            "scenes",
+            format!(
+                "{target} runs on one scene (got {}: {})",
+                args.scenes.len(),
+                args.scenes.join(", ")
+            ),
+        ));
     }
     for name in scenes_of(target, args) {
         load_scene(&name, args)?;
@@ -710,15 +727,15 @@ struct ManagementPasses {
     parts: [Vec<f64>; 5],
 }
 
-/// Frames of the management table.
+/// Frames of the management table (CPU only, seconds: `--quick` keeps them).
 fn management_frames(args: &ReproduceArgs) -> u32 {
-    args.frames.unwrap_or(if args.quick { 100 } else { 1000 })
+    args.frames.unwrap_or(1000)
 }
 
 /// Frames of the dispersion table (at least two: the median and maximum are over the frames
-/// after the fill frame).
+/// after the fill frame; CPU only, about a second: `--quick` keeps them).
 fn dispersion_frames(args: &ReproduceArgs) -> Result<u32> {
-    let frames = args.frames.unwrap_or(if args.quick { 120 } else { 600 });
+    let frames = args.frames.unwrap_or(600);
     if frames < 2 {
         return Err(Error::param(
             "frames",
