@@ -65,6 +65,25 @@ fn ply(positions: &[[f32; 3]], tris: &[[u32; 3]]) -> Vec<u8> {
 
 pub(crate) fn export_scene(args: &ExportArgs) -> Result<()> {
     let resolution = crate::parse_resolution(&args.resolution)?;
+    gibench_harness::runner::check_resolution(resolution)?;
+    let max_frames = gibench_harness::runner::MAX_FRAMES;
+    if args.frame > max_frames {
+        return Err(Error::param(
+            "frame",
+            format!("{} exceeds the limit of {max_frames}", args.frame),
+        ));
+    }
+    if args.rays > crate::rays::MAX_RAYS {
+        return Err(Error::param(
+            "rays",
+            format!(
+                "{} exceeds the limit of {} per set (each set is held in memory, {} bytes a ray)",
+                args.rays,
+                crate::rays::MAX_RAYS,
+                crate::rays::RAY_BYTES
+            ),
+        ));
+    }
     let desc = SceneDescriptor::resolve(&args.scene)?;
     let scene = Scene::load(&desc, &AssetPaths::standard(args.assets.as_deref()))?;
     crate::writable_dir("out", &args.out)?;
@@ -102,6 +121,9 @@ pub(crate) fn export_scene(args: &ExportArgs) -> Result<()> {
         None
     };
     let set = OutputSet::begin("out", &args.out)?;
+    // A previous export's meshes and rays that this one does not write are removed with it.
+    set.replace_files("mesh-*.ply")?;
+    set.replace_files("rays-*.bin")?;
     if let Some((closest, shadow)) = &rays {
         gibench_harness::error::write_atomic(&args.out.join(crate::rays::CLOSEST), closest)?;
         gibench_harness::error::write_atomic(&args.out.join(crate::rays::SHADOW), shadow)?;

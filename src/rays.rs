@@ -33,7 +33,11 @@ pub(crate) const CLOSEST: &str = "rays-closest.bin";
 /// File of the shadow rays.
 pub(crate) const SHADOW: &str = "rays-shadow.bin";
 /// Bytes per ray: seven `f32`.
-const RAY_BYTES: usize = 28;
+pub(crate) const RAY_BYTES: usize = 28;
+/// Rays per set `export-scene --rays` takes at most (a set is built in memory: 470 MB).
+pub(crate) const MAX_RAYS: u32 = 1 << 24;
+/// Timed passes `raycast --repeats` takes at most.
+const MAX_REPEATS: u32 = 1000;
 
 /// One ray as stored.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -167,8 +171,11 @@ pub(crate) struct RaycastArgs {
 }
 
 pub(crate) fn raycast(args: &RaycastArgs) -> Result<()> {
-    if args.repeats == 0 {
-        return Err(Error::param("repeats", "must be at least 1"));
+    if !(1..=MAX_REPEATS).contains(&args.repeats) {
+        return Err(Error::param(
+            "repeats",
+            format!("expected 1..={MAX_REPEATS} (got {})", args.repeats),
+        ));
     }
     let meta_path = args.rays.join("scene.json");
     let meta: serde_json::Value = std::fs::read(&meta_path)
@@ -204,10 +211,43 @@ pub(crate) fn raycast(args: &RaycastArgs) -> Result<()> {
                 format!("{}: 'frame' is not a frame number", meta_path.display()),
             )
         })?;
+    let recorded = field("rays")?.as_u64().ok_or_else(|| {
+        Error::param(
+            "rays",
+            format!("{}: 'rays' is not a ray count", meta_path.display()),
+        )
+    })?;
+    if recorded == 0 {
+        return Err(Error::param(
+            "rays",
+            format!(
+                "{} records no rays: export them with `gibench export-scene --rays N`",
+                meta_path.display()
+            ),
+        ));
+    }
     let closest = read_rays(&args.rays.join(CLOSEST))?;
     let shadow = read_rays(&args.rays.join(SHADOW))?;
+    for (file, set) in [(CLOSEST, &closest), (SHADOW, &shadow)] {
+        if set.len() as u64 != recorded {
+            return Err(Error::param(
+                "rays",
+                format!(
+                    "{} holds {} rays where {} records {recorded}: not the rays of this export",
+                    args.rays.join(file).display(),
+                    set.len(),
+                    meta_path.display()
+                ),
+            ));
+        }
+    }
     crate::writable_dir("out", &args.out)?;
-    let desc = SceneDescriptor::resolve(&scene_arg)?;
+    let desc = SceneDescriptor::resolve(&scene_arg).map_err(|e| {
+        Error::param(
+            "rays",
+            format!("{}: 'scene_argument': {e}", meta_path.display()),
+        )
+    })?;
     let scene = Scene::load(&desc, &AssetPaths::standard(args.assets.as_deref()))?;
     let frame = FrameClock::new(&desc).frame(frame_index);
     let (tracer, build_wall, _) = timed(|| ReferenceTracer::new(&scene, &frame));

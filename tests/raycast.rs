@@ -146,6 +146,10 @@ fn bad_ray_folders_are_refused_by_name_and_write_nothing() {
         assert!(!out.join("raycast.json").exists());
     };
     fails(&["raycast", "--rays", e, "--repeats", "0"], &["repeats"]);
+    fails(
+        &["raycast", "--rays", e, "--repeats", "1001"],
+        &["repeats", "1000"],
+    );
     let none = tmp.path().join("nothing");
     fails(
         &["raycast", "--rays", none.to_str().unwrap()],
@@ -159,4 +163,83 @@ fn bad_ray_folders_are_refused_by_name_and_write_nothing() {
         &["raycast", "--rays", e],
         &["rays", "rays-shadow.bin", "28 bytes"],
     );
+}
+
+/// A second export into a folder replaces the first one's meshes and rays (a scene of fewer
+/// materials, an export without rays), `raycast` refuses ray files that are not the export's
+/// (none recorded, or another count than `scene.json` records), and export-scene refuses a
+/// ray count past its limit and an empty image before writing anything.
+#[test]
+fn a_second_export_replaces_the_first_and_stale_rays_are_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let export = tmp.path().join("export");
+    let e = export.to_str().unwrap();
+    let files = |dir: &Path| {
+        let mut names: Vec<String> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|f| f.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        names.sort();
+        names
+    };
+    ok(&[
+        "export-scene",
+        "--scene",
+        "barczak-area",
+        "--rays",
+        "10",
+        "--out",
+        e,
+    ]);
+    let first = files(&export);
+    export_cornell(&export, 0);
+    // Exactly scene.json and the meshes it lists.
+    let meta: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(export.join("scene.json")).unwrap()).unwrap();
+    let mut want: Vec<String> = (meta["materials"].as_array().unwrap().iter())
+        .map(|m| m["file"].as_str().unwrap().to_string())
+        .chain(["scene.json".to_string()])
+        .collect();
+    want.sort();
+    assert_eq!(files(&export), want, "after {first:?}");
+    let cast = tmp.path().join("cast");
+    let refused = |expect: &[&str]| {
+        let o = gibench(&["raycast", "--rays", e, "--out", cast.to_str().unwrap()]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success());
+        for x in expect {
+            assert!(err.contains(x), "'{x}' not in: {err}");
+        }
+        assert!(!cast.join("raycast.json").exists());
+    };
+    refused(&["scene.json", "records no rays", "--rays N"]);
+    // Rays of another export (20) beside a scene.json that records 10.
+    let other = tmp.path().join("other");
+    export_cornell(&other, 20);
+    export_cornell(&export, 10);
+    std::fs::copy(
+        other.join("rays-shadow.bin"),
+        export.join("rays-shadow.bin"),
+    )
+    .unwrap();
+    refused(&["rays-shadow.bin", "holds 20 rays", "records 10"]);
+    for (args, expect) in [
+        (&["--rays", "16777217"][..], &["rays", "limit"][..]),
+        (
+            &["--resolution", "0x1"][..],
+            &["resolution", "at least 1"][..],
+        ),
+        (&["--frame", "10000001"][..], &["frame", "limit"][..]),
+    ] {
+        let out = tmp.path().join("refused");
+        let mut all = vec!["export-scene", "--out", out.to_str().unwrap()];
+        all.extend(args);
+        let o = gibench(&all);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success(), "{args:?} succeeded");
+        for x in expect {
+            assert!(err.contains(x), "{args:?}: '{x}' not in: {err}");
+        }
+        assert!(!out.exists(), "{args:?} created {out:?}");
+    }
 }

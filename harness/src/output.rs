@@ -17,7 +17,8 @@
 //! A set can also **replace** subfolders ([`OutputSet::replace`]): at publication, files under
 //! such a subfolder that this set did not write are removed, so a regenerated result holds only
 //! what its command wrote (the journal lists the replaced subfolders too, so a killed
-//! publication is finished the same way).
+//! publication is finished the same way), and **file patterns** of the folder itself
+//! ([`OutputSet::replace_files`]: `mesh-*.ply`), likewise.
 //!
 //! Files written with [`crate::error::write_atomic_direct`] (the reference cache, whose entries
 //! are shared across runs and read back within one) bypass the set.
@@ -33,15 +34,19 @@ const LOCK: &str = ".gibench.lock";
 const STAGING: &str = ".gibench-staging";
 const JOURNAL: &str = ".gibench-publish";
 
-/// The open set's folder (absolute, lexically normalised) and its staged files (relative).
+/// The open set's folder (absolute, lexically normalised), its staged files (relative), the
+/// subfolders it replaces and the file patterns it replaces in the folder itself.
 struct Active {
     dir: PathBuf,
     staged: Vec<PathBuf>,
     replaced: Vec<PathBuf>,
+    patterns: Vec<String>,
 }
 
 /// The journal's prefix for a replaced subfolder (no file gibench writes starts with it).
 const REPLACE: &str = "replace:";
+/// The journal's prefix for a replaced file pattern (`PREFIX*SUFFIX`).
+const REPLACE_FILES: &str = "replace-files:";
 
 static ACTIVE: Mutex<Option<Active>> = Mutex::new(None);
 
@@ -208,8 +213,34 @@ impl OutputSet {
             dir: dir.to_path_buf(),
             staged: Vec::new(),
             replaced: Vec::new(),
+            patterns: Vec::new(),
         });
         Ok(set)
+    }
+
+    /// Declares the files of the set's folder itself (not its subfolders) named
+    /// `PREFIX*SUFFIX` replaced: at publication those this set did not write are removed — the
+    /// numbered files of a kind a command writes a varying number of (`mesh-*.ply`).
+    pub fn replace_files(&self, pattern: &str) -> Result<()> {
+        let plain = pattern.matches('*').count() == 1
+            && !pattern.contains(['/', '\\'])
+            && pattern.len() > 1
+            && !pattern.starts_with('.');
+        if !plain {
+            return Err(Error::param(
+                &self.option,
+                format!("'{pattern}' is not a file pattern PREFIX*SUFFIX"),
+            ));
+        }
+        let mut active = ACTIVE
+            .lock()
+            .map_err(|_| Error::param(&self.option, "output state poisoned"))?;
+        if let Some(a) = active.as_mut() {
+            if !a.patterns.iter().any(|p| p == pattern) {
+                a.patterns.push(pattern.to_string());
+            }
+        }
+        Ok(())
     }
 
     /// Declares `sub` (relative to the set's folder, plain names only) replaced: at publication
@@ -245,13 +276,13 @@ impl OutputSet {
 
     /// Moves every staged file into place (see the module docs) and closes the set.
     pub fn publish(mut self) -> Result<()> {
-        let (staged, replaced) = {
+        let (staged, replaced, patterns) = {
             let mut active = ACTIVE
                 .lock()
                 .map_err(|_| Error::param(&self.option, "output state poisoned"))?;
             active
                 .take()
-                .map(|a| (a.staged, a.replaced))
+                .map(|a| (a.staged, a.replaced, a.patterns))
                 .unwrap_or_default()
         };
         // Every destination must be free to take a file before any is moved, so a failure
@@ -269,9 +300,9 @@ impl OutputSet {
             }
         }
         let journal = self.dir.join(JOURNAL);
-        let list: Vec<String> = replaced
-            .iter()
+        let list: Vec<String> = (replaced.iter())
             .map(|p| format!("{REPLACE}{}", p.to_string_lossy()))
+            .chain(patterns.iter().map(|p| format!("{REPLACE_FILES}{p}")))
             .chain(staged.iter().map(|p| p.to_string_lossy().into_owned()))
             .collect();
         crate::error::write_atomic_direct(&journal, list.join("\n").as_bytes())?;
@@ -313,9 +344,10 @@ fn move_staged(dir: &Path) -> Result<()> {
     let journal = dir.join(JOURNAL);
     let text = std::fs::read_to_string(&journal).map_err(|e| Error::io(&journal, e))?;
     let lines: Vec<&str> = text.lines().filter(|l| !l.is_empty()).collect();
+    // Both prefixes start with "replace" (no file gibench writes does).
     let listed: std::collections::HashSet<&Path> = lines
         .iter()
-        .filter(|l| !l.starts_with(REPLACE))
+        .filter(|l| !l.starts_with("replace"))
         .map(Path::new)
         .collect();
     for sub in lines.iter().filter_map(|l| l.strip_prefix(REPLACE)) {
@@ -324,7 +356,10 @@ fn move_staged(dir: &Path) -> Result<()> {
             remove_unlisted(dir, sub, &listed)?;
         }
     }
-    for rel in lines.iter().filter(|l| !l.starts_with(REPLACE)) {
+    for pattern in lines.iter().filter_map(|l| l.strip_prefix(REPLACE_FILES)) {
+        remove_unlisted_matching(dir, pattern, &listed)?;
+    }
+    for rel in lines.iter().filter(|l| !l.starts_with("replace")) {
         let rel = Path::new(rel);
         if !rel.components().all(|c| matches!(c, Component::Normal(_))) {
             // Not written by gibench: ignored.
@@ -357,6 +392,35 @@ fn remove_unlisted(dir: &Path, sub: &Path, keep: &std::collections::HashSet<&Pat
             remove_unlisted(dir, &rel, keep)?;
             let _ = std::fs::remove_dir(e.path());
         } else if !keep.contains(rel.as_path()) {
+            std::fs::remove_file(e.path()).map_err(|err| Error::io(e.path(), err))?;
+        }
+    }
+    Ok(())
+}
+
+/// Removes the files (not folders) directly in `dir` named `PREFIX*SUFFIX` (`pattern`) that
+/// are not in `keep`.
+fn remove_unlisted_matching(
+    dir: &Path,
+    pattern: &str,
+    keep: &std::collections::HashSet<&Path>,
+) -> Result<()> {
+    let Some((prefix, suffix)) = pattern.split_once('*') else {
+        return Ok(());
+    };
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return Ok(());
+    };
+    for e in entries.flatten() {
+        let name = e.file_name();
+        let Some(name) = name.to_str() else {
+            continue;
+        };
+        let matches = name.len() >= prefix.len() + suffix.len()
+            && name.starts_with(prefix)
+            && name.ends_with(suffix);
+        let file = e.file_type().is_ok_and(|t| t.is_file());
+        if matches && file && !keep.contains(Path::new(name)) {
             std::fs::remove_file(e.path()).map_err(|err| Error::io(e.path(), err))?;
         }
     }

@@ -98,22 +98,32 @@ pub struct RunConfig {
     pub shadow_size: u32,
 }
 
+/// The largest frame count or frame number a command takes (frame numbers stay representable:
+/// a run's last frame is first_frame + warmup + frames − 1).
+pub const MAX_FRAMES: u32 = 10_000_000;
+
+/// Checks an image size given as option `resolution`: both sides at least 1 and at most
+/// [`MAX_RESOLUTION`].
+pub fn check_resolution([w, h]: [u32; 2]) -> Result<()> {
+    if w == 0 || h == 0 {
+        return Err(Error::param(
+            "resolution",
+            format!("width and height must be at least 1 (got {w}x{h})"),
+        ));
+    }
+    if w > MAX_RESOLUTION || h > MAX_RESOLUTION {
+        return Err(Error::param(
+            "resolution",
+            format!("{w}x{h} exceeds the limit of {MAX_RESOLUTION} per side"),
+        ));
+    }
+    Ok(())
+}
+
 impl RunConfig {
     /// Checks the settings that need no GPU.
     pub fn validate(&self) -> Result<()> {
-        let [w, h] = self.resolution;
-        if w == 0 || h == 0 {
-            return Err(Error::param(
-                "resolution",
-                format!("width and height must be at least 1 (got {w}x{h})"),
-            ));
-        }
-        if w > MAX_RESOLUTION || h > MAX_RESOLUTION {
-            return Err(Error::param(
-                "resolution",
-                format!("{w}x{h} exceeds the limit of {MAX_RESOLUTION} per side"),
-            ));
-        }
+        check_resolution(self.resolution)?;
         if self.frames == 0 {
             return Err(Error::param(
                 "frames",
@@ -122,7 +132,6 @@ impl RunConfig {
         }
         // Frame numbers must stay representable: the last animation frame rendered is
         // first_frame + warmup + frames - 1.
-        const MAX_FRAMES: u32 = 10_000_000;
         for (name, v) in [
             ("frames", self.frames),
             ("warmup", self.warmup),
