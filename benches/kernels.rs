@@ -251,8 +251,11 @@ fn laine_management_by<M: Measurement + 'static>(c: &mut Criterion<M>, group: &s
     use gibench_harness::scene::descriptor::LightKind;
     let assets = AssetPaths::standard(None);
     let scene = Scene::load_named("sibenik", &assets)
-        .or_else(|_| Scene::load_named("cornell", &assets))
-        .expect("a scene");
+        .or_else(|e| {
+            eprintln!("{group}: sibenik not loaded ({e}); on cornell instead");
+            Scene::load_named("cornell", &assets)
+        })
+        .expect("cornell is generated");
     let bvh = gibench_harness::bvh::SceneBvh::new(&scene.mesh);
     for kind in [LightKind::Spot, LightKind::Omni] {
         let mut desc = scene.descriptor.clone();
