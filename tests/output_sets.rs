@@ -211,3 +211,33 @@ fn symlinked_out_and_a_folder_in_the_way() {
     }
     assert!(!after.keys().any(|k| k.starts_with('.')), "{after:?}");
 }
+
+/// A run replaces its stem's images: run again with `--no-images`, it leaves none of the first
+/// run's beside its results (they were of another resolution), while another stem's files in
+/// the same folder stay.
+#[test]
+fn a_rerun_without_images_removes_the_stems_old_images() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    let o = small_direct(&out);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(out.join("cornell-direct.png").exists());
+    std::fs::write(out.join("cornell-other.png"), b"another stem's image").unwrap();
+    let o = gibench()
+        .args(["run", "--technique", "direct", "--quiet", "--no-images"])
+        .args(SMALL)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let names: Vec<String> = files(&out).into_keys().collect();
+    let stems: Vec<&String> = (names.iter())
+        .filter(|n| n.starts_with("cornell-direct") || n.starts_with("cornell-other"))
+        .collect();
+    assert_eq!(
+        stems,
+        ["cornell-direct.json", "cornell-other.png"],
+        "{names:?}"
+    );
+}

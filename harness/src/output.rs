@@ -220,25 +220,14 @@ impl OutputSet {
 
     /// Declares the files of the set's folder itself (not its subfolders) named
     /// `PREFIX*SUFFIX` replaced: at publication those this set did not write are removed — the
-    /// numbered files of a kind a command writes a varying number of (`mesh-*.ply`).
+    /// numbered files of a kind a command writes a varying number of (`mesh-*.ply`). A pattern
+    /// without `*` names one file.
     pub fn replace_files(&self, pattern: &str) -> Result<()> {
-        let plain = pattern.matches('*').count() == 1
-            && !pattern.contains(['/', '\\'])
-            && pattern.len() > 1
-            && !pattern.starts_with('.');
-        if !plain {
+        if !add_pattern(pattern)? {
             return Err(Error::param(
                 &self.option,
-                format!("'{pattern}' is not a file pattern PREFIX*SUFFIX"),
+                format!("'{pattern}' is not a file name or a pattern PREFIX*SUFFIX"),
             ));
-        }
-        let mut active = ACTIVE
-            .lock()
-            .map_err(|_| Error::param(&self.option, "output state poisoned"))?;
-        if let Some(a) = active.as_mut() {
-            if !a.patterns.iter().any(|p| p == pattern) {
-                a.patterns.push(pattern.to_string());
-            }
         }
         Ok(())
     }
@@ -398,16 +387,59 @@ fn remove_unlisted(dir: &Path, sub: &Path, keep: &std::collections::HashSet<&Pat
     Ok(())
 }
 
-/// Removes the files (not folders) directly in `dir` named `PREFIX*SUFFIX` (`pattern`) that
-/// are not in `keep`.
+/// Records `pattern` (a plain file name, or `PREFIX*SUFFIX`) as replaced in the open set:
+/// `Ok(false)` if it is not such a pattern, `Ok(true)` otherwise (also with no set open).
+fn add_pattern(pattern: &str) -> Result<bool> {
+    let plain = pattern.matches('*').count() <= 1
+        && !pattern.contains(['/', '\\'])
+        && pattern.len() > 1
+        && !pattern.starts_with('.');
+    if !plain {
+        return Ok(false);
+    }
+    let mut active = ACTIVE
+        .lock()
+        .map_err(|_| Error::Invalid("output state poisoned".into()))?;
+    if let Some(a) = active.as_mut() {
+        if !a.patterns.iter().any(|p| p == pattern) {
+            a.patterns.push(pattern.to_string());
+        }
+    }
+    Ok(true)
+}
+
+/// Declares `path` replaced in the open output set, if one is open on its folder: at
+/// publication it is removed unless the set wrote it — a file a command writes only
+/// sometimes (a run's images) does not outlive the run that no longer writes it.
+pub fn replace_in_open_set(path: &Path) -> Result<()> {
+    let dir = {
+        let active = ACTIVE
+            .lock()
+            .map_err(|_| Error::Invalid("output state poisoned".into()))?;
+        match active.as_ref() {
+            Some(a) => a.dir.clone(),
+            None => return Ok(()),
+        }
+    };
+    let resolved = resolve(path);
+    if resolved.parent() != Some(dir.as_path()) {
+        return Ok(());
+    }
+    if let Some(name) = resolved.file_name().and_then(|n| n.to_str()) {
+        add_pattern(name)?;
+    }
+    Ok(())
+}
+
+/// Removes the files (not folders) directly in `dir` named `PREFIX*SUFFIX` (`pattern`; a
+/// pattern without `*` is one name) that are not in `keep`.
 fn remove_unlisted_matching(
     dir: &Path,
     pattern: &str,
     keep: &std::collections::HashSet<&Path>,
 ) -> Result<()> {
-    let Some((prefix, suffix)) = pattern.split_once('*') else {
-        return Ok(());
-    };
+    let (prefix, suffix) = pattern.split_once('*').unwrap_or((pattern, ""));
+    let exact = !pattern.contains('*');
     let Ok(entries) = std::fs::read_dir(dir) else {
         return Ok(());
     };
@@ -416,9 +448,13 @@ fn remove_unlisted_matching(
         let Some(name) = name.to_str() else {
             continue;
         };
-        let matches = name.len() >= prefix.len() + suffix.len()
-            && name.starts_with(prefix)
-            && name.ends_with(suffix);
+        let matches = if exact {
+            name == pattern
+        } else {
+            name.len() >= prefix.len() + suffix.len()
+                && name.starts_with(prefix)
+                && name.ends_with(suffix)
+        };
         let file = e.file_type().is_ok_and(|t| t.is_file());
         if matches && file && !keep.contains(Path::new(name)) {
             std::fs::remove_file(e.path()).map_err(|err| Error::io(e.path(), err))?;

@@ -32,6 +32,10 @@ pub const QUALITY_IMAGES: [&str; 5] = [
     "-reference-indirect.png",
 ];
 
+/// The run's own images, by file-name suffix after its stem: the composed image, the indirect
+/// and the direct light (HDR).
+pub const RUN_IMAGES: [&str; 3] = [".png", "-indirect.exr", "-direct.exr"];
+
 /// One technique of a run.
 pub struct TechniqueRun {
     pub info: &'static TechniqueInfo,
@@ -145,6 +149,11 @@ fn execute_one(
 ) -> Result<RunResult> {
     let (info, params, config) = (run.info, &run.params, &spec.config);
     let out = |suffix: &str| spec.out.join(format!("{}{suffix}", run.stem));
+    // Every image a run of this stem may write is replaced: one this run does not write
+    // (--no-images, no --quality) is not left from an earlier run beside this run's results.
+    for suffix in RUN_IMAGES.iter().chain(&QUALITY_IMAGES) {
+        crate::output::replace_in_open_set(&out(suffix))?;
+    }
     progress(Progress::Technique(info.name));
     let (mut result, images) = harness.run(info, params, config, prepared, &mut || {
         progress(Progress::Frame)
@@ -173,11 +182,11 @@ fn execute_one(
         }
     }
     if spec.images {
-        let png = out(".png");
+        let png = out(RUN_IMAGES[0]);
         write_png(&png, images.size, &images.display)?;
-        let exr = out("-indirect.exr");
+        let exr = out(RUN_IMAGES[1]);
         write_exr(&exr, images.size, &images.indirect)?;
-        let direct = out("-direct.exr");
+        let direct = out(RUN_IMAGES[2]);
         write_exr(&direct, images.size, &images.direct)?;
         result.images = vec![file_name(&png), file_name(&exr), file_name(&direct)];
         result.images.extend(extra_images);
