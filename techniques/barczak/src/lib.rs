@@ -230,6 +230,15 @@ impl BarczakParams {
                     format!("the resolution {w}x{h} is not a multiple of the factor {lowres} (level {})", level.name()),
                 ));
             }
+            // The interpolation reads low-resolution samples up to a factor's width away and
+            // the edge detection compares pixels `edge-step` apart: a step below the factor
+            // misses edges the interpolation reads across.
+            if edge_step < lowres {
+                return Err(Error::param(
+                    "edge-step",
+                    format!("{edge_step} is below the low-resolution factor {lowres} (level {}): expected at least the factor", level.name()),
+                ));
+            }
         }
         Ok(BarczakParams {
             renderer: RendererSettings {

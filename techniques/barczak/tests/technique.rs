@@ -101,6 +101,9 @@ fn bad_parameters_are_refused_by_name() {
     assert!(e.contains("set") && e.contains("area light"), "{e}");
     let e = err("cornell-area", [97, 72], &[("level", "vd-lp")]);
     assert!(e.contains("lowres") && e.contains("97x72"), "{e}");
+    // An edge step below the factor leaves pixels the interpolation reads unmasked.
+    let e = err("cornell-area", SIZE, &[("edge-step", "1")]);
+    assert!(e.contains("edge-step") && e.contains("factor 2"), "{e}");
     // VD has no low-resolution pass: any resolution.
     let scene = Scene::load_named("cornell-area", &AssetPaths::standard(None)).unwrap();
     let config = config([97, 72]);
