@@ -66,13 +66,7 @@ fn ply(positions: &[[f32; 3]], tris: &[[u32; 3]]) -> Vec<u8> {
 pub(crate) fn export_scene(args: &ExportArgs) -> Result<()> {
     let resolution = crate::parse_resolution(&args.resolution)?;
     gibench_harness::runner::check_resolution(resolution)?;
-    let max_frames = gibench_harness::runner::MAX_FRAMES;
-    if args.frame > max_frames {
-        return Err(Error::param(
-            "frame",
-            format!("{} exceeds the limit of {max_frames}", args.frame),
-        ));
-    }
+    crate::check_frame_number("frame", args.frame)?;
     if args.rays > crate::rays::MAX_RAYS {
         return Err(Error::param(
             "rays",

@@ -114,7 +114,7 @@ struct PlotQualityArgs {
     /// Results JSON files (or directories holding them).
     #[arg(required = true)]
     inputs: Vec<PathBuf>,
-    /// rmse, rel_mse, mae, flip or flicker.
+    /// rmse, rel_mse, mae, bias, flip or flicker.
     #[arg(long, default_value = "rmse")]
     metric: String,
     /// Output SVG.
@@ -353,9 +353,12 @@ fn parse_resolution(s: &str) -> Result<[u32; 2]> {
 }
 
 /// Splits `--param` values among the selected techniques. A bare `name=value` goes to every
-/// technique that declares `name`; it is an error if none does.
+/// technique that declares `name`; it is an error if none does, and an error if a technique
+/// would get the same parameter twice (`vpls=8` and `laine.vpls=16`: which one holds would
+/// depend on their order).
 fn assign_params(techniques: &[&TechniqueInfo], raw: &[String]) -> Result<Vec<Params>> {
-    let mut given: Vec<Vec<(String, String)>> = vec![Vec::new(); techniques.len()];
+    // Per technique: (parameter, value, the `--param` it came from).
+    let mut given: Vec<Vec<(String, String, &str)>> = vec![Vec::new(); techniques.len()];
     for p in raw {
         let (key, value) = p.split_once('=').ok_or_else(|| {
             Error::param(p.clone(), "expected name=value or technique.name=value")
@@ -405,13 +408,22 @@ fn assign_params(techniques: &[&TechniqueInfo], raw: &[String]) -> Result<Vec<Pa
             ));
         }
         for (i, name) in targets {
-            given[i].push((name.to_string(), value.to_string()));
+            if let Some((.., first)) = given[i].iter().find(|(n, ..)| n == name) {
+                return Err(Error::param(
+                    format!("{}.{name}", techniques[i].name),
+                    format!("given twice ('{first}' and '{p}'); give each parameter once"),
+                ));
+            }
+            given[i].push((name.to_string(), value.to_string(), p));
         }
     }
     techniques
         .iter()
         .zip(given)
-        .map(|(t, g)| t.parse_params(&g))
+        .map(|(t, g)| {
+            let pairs: Vec<(String, String)> = g.into_iter().map(|(n, v, _)| (n, v)).collect();
+            t.parse_params(&pairs)
+        })
         .collect()
 }
 
@@ -436,6 +448,7 @@ pub(crate) fn plan(args: &RunArgs, extra_params: &[String]) -> Result<Plan> {
         shadow_size: args.shadow_size,
     };
     config.validate()?;
+    gpu_options(args).validate()?;
     let quality = if args.quality {
         Some(QualityConfig {
             pairs: args.quality_pairs,
@@ -607,6 +620,35 @@ pub(crate) fn writable_dir(option: &str, dir: &Path) -> Result<()> {
     probe
 }
 
+/// Checks `path` can be written as a file: not a folder, in a folder that can be created and
+/// written ([`writable_dir`]); the error names `option` and suggests `example` inside a folder.
+pub(crate) fn writable_file(option: &str, path: &Path, example: &str) -> Result<()> {
+    if path.is_dir() {
+        return Err(Error::param(
+            option,
+            format!(
+                "{} is a folder; expected the path of a file to write, e.g. {}",
+                path.display(),
+                path.join(example).display()
+            ),
+        ));
+    }
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    if let Some(file) = dir.ancestors().find(|a| a.is_file()) {
+        return Err(Error::param(
+            option,
+            format!(
+                "{} is a file, not a folder; expected the path of a file to write in a folder",
+                file.display()
+            ),
+        ));
+    }
+    writable_dir(option, dir)
+}
+
 pub(crate) fn progress_bar(quiet: bool, total: u64) -> indicatif::ProgressBar {
     let bar = if quiet {
         indicatif::ProgressBar::hidden()
@@ -638,11 +680,16 @@ pub(crate) fn announcement(plan: &Plan, gpu: &GpuContext) -> String {
     )
 }
 
-pub(crate) fn open_gpu(args: &RunArgs) -> Result<GpuContext> {
-    GpuContext::new(&GpuOptions {
+/// The adapter choice `args` ask for.
+fn gpu_options(args: &RunArgs) -> GpuOptions {
+    GpuOptions {
         backend: args.gpu.backend.clone(),
         adapter: args.gpu.adapter.clone(),
-    })
+    }
+}
+
+pub(crate) fn open_gpu(args: &RunArgs) -> Result<GpuContext> {
+    GpuContext::new(&gpu_options(args))
 }
 
 fn run(args: &RunArgs) -> Result<()> {
@@ -824,24 +871,15 @@ pub(crate) fn sweep_plan(args: &SweepArgs) -> Result<SweepPlan> {
                 format!("expected name=v1,v2,... (got '{}')", args.sweep),
             )
         })?;
-    if let Some(v) = values
-        .iter()
-        .enumerate()
-        .find_map(|(i, v)| values[..i].contains(v).then_some(v))
-    {
-        return Err(Error::param(
-            "sweep",
-            format!(
-                "the value '{v}' is listed twice; its second run would overwrite the first's files"
-            ),
-        ));
-    }
     if args.run.technique.len() != 1 {
         return Err(Error::param(
             "technique",
             "a sweep runs exactly one technique",
         ));
     }
+    check_swept_not_given(&args.sweep, &name, &args.run.params)?;
+    let info = TechniqueInfo::find(registry::all(), args.run.technique[0].trim())?;
+    check_distinct_values(info, &name, &values)?;
     // Check every point before running any.
     let plans: Vec<Plan> = values
         .iter()
@@ -854,6 +892,52 @@ pub(crate) fn sweep_plan(args: &SweepArgs) -> Result<SweepPlan> {
     };
     planned.spec(args).validate()?;
     Ok(planned)
+}
+
+/// Refuses a `--param` that sets the swept parameter `name` (with or without a `technique.`
+/// prefix): every point would silently override it.
+fn check_swept_not_given(sweep: &str, name: &str, params: &[String]) -> Result<()> {
+    let bare = |key: &str| key.split_once('.').map_or(key, |(_, n)| n).to_string();
+    let swept = bare(name);
+    let given = params
+        .iter()
+        .find(|p| p.split_once('=').is_some_and(|(k, _)| bare(k) == swept));
+    if let Some(p) = given {
+        return Err(Error::param(
+            swept,
+            format!(
+                "given both as --param ('{p}') and as the swept parameter (--sweep {sweep}); \
+                 give it once"
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Refuses a sweep value listed twice, compared as the technique reads them (`08` and `8`, `1`
+/// and `1.0` are one setting): the second point would repeat the first's run, or overwrite its
+/// files.
+fn check_distinct_values(info: &TechniqueInfo, name: &str, values: &[String]) -> Result<()> {
+    let parsed: Vec<Params> = values
+        .iter()
+        .map(|v| assign_params(&[info], &[format!("{name}={v}")]).map(|mut p| p.remove(0)))
+        .collect::<Result<_>>()?;
+    for (i, p) in parsed.iter().enumerate() {
+        if let Some(j) = parsed[..i].iter().position(|q| q == p) {
+            let (a, b) = (&values[j], &values[i]);
+            let message = if a == b {
+                format!("the value '{b}' is listed twice; its second run would overwrite the first's files")
+            } else {
+                format!(
+                    "the values '{a}' and '{b}' are listed twice: {} reads both as the same \
+                     {name}, so the second run would only repeat the first",
+                    info.name
+                )
+            };
+            return Err(Error::param("sweep", message));
+        }
+    }
+    Ok(())
 }
 
 /// The work of `gibench sweep` once planned and its output set is open. Returns what it
@@ -999,6 +1083,7 @@ fn read_results_with_folders(inputs: &[PathBuf]) -> Result<Vec<(PathBuf, RunResu
             files.push(input.clone());
         }
     }
+    check_each_file_once(&files)?;
     let results: Vec<(PathBuf, RunResult)> = files
         .iter()
         .map(|f| {
@@ -1011,15 +1096,57 @@ fn read_results_with_folders(inputs: &[PathBuf]) -> Result<Vec<(PathBuf, RunResu
         })
         .collect::<Result<_>>()?;
     if results.is_empty() {
-        return Err(Error::Invalid(
-            "no results files found in the given inputs".into(),
-        ));
+        return Err(Error::Invalid(format!(
+            "no results files (*.json) in {} (folders are not searched recursively)",
+            shown_list(inputs)
+        )));
     }
     Ok(results)
 }
 
+/// The paths, comma-separated, for a message.
+fn shown_list(paths: &[PathBuf]) -> String {
+    let shown: Vec<String> = paths.iter().map(|p| p.display().to_string()).collect();
+    shown.join(", ")
+}
+
+/// Refuses a file reached twice among the inputs (`F F`, or `DIR DIR/F`; compared by canonical
+/// path): its run would be counted twice.
+fn check_each_file_once(files: &[PathBuf]) -> Result<()> {
+    let mut seen: Vec<(PathBuf, &PathBuf)> = Vec::new();
+    for f in files {
+        let canonical = f.canonicalize().map_err(|e| Error::io(f, e))?;
+        if let Some((_, first)) = seen.iter().find(|(c, _)| *c == canonical) {
+            let also = if *first == f {
+                String::new()
+            } else {
+                format!(" (also as {})", first.display())
+            };
+            return Err(Error::bad_file(
+                f,
+                format!(
+                    "given twice among the inputs{also}; its run would be counted twice, so give \
+                     each results file once"
+                ),
+            ));
+        }
+        seen.push((canonical, f));
+    }
+    Ok(())
+}
+
 fn plot_quality(args: &PlotQualityArgs) -> Result<()> {
+    report::check_per_frame_metric(&args.metric)?;
+    writable_file("out", &args.out, "quality-per-frame.svg")?;
     let results = read_results(&args.inputs)?;
+    if report::per_frame_lines(&results, &args.metric)?.is_empty() {
+        return Err(Error::Invalid(format!(
+            "{}: no results hold per-frame quality values ('{}'); `gibench run --quality \
+             --quality-all` makes them",
+            shown_list(&args.inputs),
+            args.metric
+        )));
+    }
     report::quality_over_frames_svg(
         &results,
         &args.metric,
@@ -1030,8 +1157,9 @@ fn plot_quality(args: &PlotQualityArgs) -> Result<()> {
     Ok(())
 }
 
-/// Every results file under `dir`, recursively (files that are not results are skipped).
-fn results_under(option: &str, dir: &Path) -> Result<Vec<RunResult>> {
+/// Every results file under `dir`, recursively (files that are not results are skipped), with
+/// its path.
+fn results_under(option: &str, dir: &Path) -> Result<Vec<(PathBuf, RunResult)>> {
     if !dir.is_dir() {
         return Err(Error::param(
             option,
@@ -1058,7 +1186,7 @@ fn results_under(option: &str, dir: &Path) -> Result<Vec<RunResult>> {
                 stack.push(p);
             } else if p.extension().is_some_and(|x| x == "json") {
                 if let Ok(r) = RunResult::read(&p) {
-                    found.push(r);
+                    found.push((p, r));
                 }
             }
         }
@@ -1076,6 +1204,11 @@ fn compare_cmd(args: &CompareArgs) -> Result<()> {
     check_stem(&args.stem)?;
     let base = results_under("base", &args.base)?;
     let current = results_under("current", &args.current)?;
+    check_distinct_runs(args, &base, &current)?;
+    let (base, current): (Vec<RunResult>, Vec<RunResult>) = (
+        base.into_iter().map(|(_, r)| r).collect(),
+        current.into_iter().map(|(_, r)| r).collect(),
+    );
     let rows = gibench_harness::compare::compare(&base, &current, args.tolerance)?;
     let table = gibench_harness::compare::compare_table(&rows, args.tolerance);
     println!("{}", table.to_terminal());
@@ -1089,6 +1222,65 @@ fn compare_cmd(args: &CompareArgs) -> Result<()> {
         args.out.display(),
         stem = args.stem
     );
+    Ok(())
+}
+
+/// Refuses a comparison of runs with themselves: BASE and CURRENT the same folder, a results
+/// file reached from both sides or twice from one (through a link), or two byte-identical
+/// copies of one run (counted as two repeats, a copy would narrow the noise band falsely).
+fn check_distinct_runs(
+    args: &CompareArgs,
+    base: &[(PathBuf, RunResult)],
+    current: &[(PathBuf, RunResult)],
+) -> Result<()> {
+    let folder = |p: &Path| p.canonicalize().map_err(|e| Error::io(p, e));
+    if folder(&args.base)? == folder(&args.current)? {
+        return Err(Error::param(
+            "current",
+            format!(
+                "{} is the same folder as BASE ({}); compare needs two different sets of runs",
+                args.current.display(),
+                args.base.display()
+            ),
+        ));
+    }
+    let side = |i: usize| if i < base.len() { "BASE" } else { "CURRENT" };
+    // Each file's canonical path and a hash of its bytes; equal hashes are confirmed on the bytes.
+    let mut seen: Vec<(PathBuf, u64, &Path)> = Vec::new();
+    for (i, (path, _)) in base.iter().chain(current).enumerate() {
+        let canonical = folder(path)?;
+        let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+        let hash = {
+            use std::hash::{Hash, Hasher};
+            let mut h = std::hash::DefaultHasher::new();
+            bytes.hash(&mut h);
+            h.finish()
+        };
+        for (j, (c, other_hash, other)) in seen.iter().enumerate() {
+            let same_file = *c == canonical;
+            let same_bytes = !same_file
+                && *other_hash == hash
+                && std::fs::read(other).map_err(|e| Error::io(*other, e))? == bytes;
+            if same_file || same_bytes {
+                return Err(Error::bad_file(
+                    path,
+                    format!(
+                        "in {}, {} {} in {}; compare needs distinct runs (every repeat run anew, \
+                         BASE and CURRENT different folders)",
+                        side(i),
+                        if same_file {
+                            "the same file as"
+                        } else {
+                            "a byte-identical copy of"
+                        },
+                        other.display(),
+                        side(j)
+                    ),
+                ));
+            }
+        }
+        seen.push((canonical, hash, path));
+    }
     Ok(())
 }
 
@@ -1315,6 +1507,19 @@ fn reference_cmd(args: &ReferenceArgs) -> Result<()> {
     Ok(())
 }
 
+/// Checks a frame number or count given as option `option` against the limit every command
+/// shares ([`gibench_harness::runner::MAX_FRAMES`]).
+pub(crate) fn check_frame_number(option: &str, frame: u32) -> Result<()> {
+    let max = gibench_harness::runner::MAX_FRAMES;
+    if frame > max {
+        return Err(Error::param(
+            option,
+            format!("{frame} exceeds the limit of {max}"),
+        ));
+    }
+    Ok(())
+}
+
 /// A reference render checked before it runs.
 pub(crate) struct ReferencePlan {
     resolution: [u32; 2],
@@ -1325,16 +1530,8 @@ pub(crate) struct ReferencePlan {
 
 pub(crate) fn reference_plan(args: &ReferenceArgs) -> Result<ReferencePlan> {
     let resolution = parse_resolution(&args.resolution)?;
-    RunConfig {
-        resolution,
-        frames: 1,
-        warmup: 0,
-        first_frame: args.frame,
-        timing: TimingMode::Stages,
-        seed: 1,
-        shadow_size: 256,
-    }
-    .validate()?;
+    gibench_harness::runner::check_resolution(resolution)?;
+    check_frame_number("frame", args.frame)?;
     let settings = args.reference.settings()?;
     let desc = SceneDescriptor::resolve(&args.scene)?;
     let scene = Scene::load(&desc, &AssetPaths::standard(args.assets.as_deref()))?;

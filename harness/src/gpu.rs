@@ -36,6 +36,22 @@ pub struct GpuContext {
     errors: Arc<Mutex<Vec<String>>>,
 }
 
+/// The environment variable the command line reads `--backend` from when it is not given.
+pub const BACKEND_ENV: &str = "GIBENCH_BACKEND";
+
+impl GpuOptions {
+    /// Checks what needs no adapter (the backend's name), so that a bad one is refused before
+    /// any work.
+    pub fn validate(&self) -> Result<()> {
+        if let Some(b) = &self.backend {
+            parse_backend(b)?;
+        }
+        Ok(())
+    }
+}
+
+/// The backends `name` selects. An unknown name is refused naming `--backend`, or
+/// [`BACKEND_ENV`] when that is where the name came from.
 fn parse_backend(name: &str) -> Result<wgpu::Backends> {
     Ok(match name.to_ascii_lowercase().as_str() {
         "vulkan" | "vk" => wgpu::Backends::VULKAN,
@@ -44,10 +60,17 @@ fn parse_backend(name: &str) -> Result<wgpu::Backends> {
         "dx12" | "d3d12" => wgpu::Backends::DX12,
         "all" | "" => wgpu::Backends::all(),
         other => {
+            let expected = "expected one of vulkan, gl, metal, dx12";
+            if std::env::var(BACKEND_ENV).is_ok_and(|v| v == name) {
+                return Err(Error::Invalid(format!(
+                    "environment variable {BACKEND_ENV}: unknown backend '{other}'; {expected} \
+                     (or unset it; --backend overrides it)"
+                )));
+            }
             return Err(Error::param(
                 "backend",
-                format!("unknown backend '{other}'; expected one of vulkan, gl, metal, dx12"),
-            ))
+                format!("unknown backend '{other}'; {expected}"),
+            ));
         }
     })
 }

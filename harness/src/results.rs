@@ -154,12 +154,63 @@ impl RunResult {
                 ),
             ));
         }
+        r.check().map_err(|e| Error::bad_file(path, e))?;
         Ok(r)
+    }
+
+    /// What tables would print wrong from a file that parses: an empty scene or technique
+    /// name, an unnamed or repeated stage (its time would count twice), a negative time.
+    fn check(&self) -> std::result::Result<(), String> {
+        for (field, value) in [("scene", &self.scene), ("technique", &self.technique)] {
+            if value.trim().is_empty() {
+                return Err(format!("'{field}' is empty"));
+            }
+        }
+        let mut seen = std::collections::HashSet::new();
+        for (i, st) in self.stages.iter().enumerate() {
+            if st.name.trim().is_empty() {
+                return Err(format!("stages[{i}] has no name"));
+            }
+            if !seen.insert(st.name.as_str()) {
+                return Err(format!("stage '{}' is listed twice", st.name));
+            }
+            for (field, stats) in [
+                ("gpu_ms", &st.gpu_ms),
+                ("wall_ms", &st.wall_ms),
+                ("cpu_ms", &st.cpu_ms),
+            ] {
+                if let Some(s) = stats {
+                    non_negative(s).map_err(|v| format!("stage '{}': {field}.{v}", st.name))?;
+                }
+            }
+        }
+        if let Some(f) = &self.frame {
+            non_negative(&f.frame_ms).map_err(|v| format!("frame.frame_ms.{v}"))?;
+        }
+        Ok(())
     }
 
     /// The stage named `name`, if any.
     pub fn stage(&self, name: &str) -> Option<&StageResult> {
         self.stages.iter().find(|s| s.name == name)
+    }
+}
+
+/// `Err("NAME is V (times are not negative)")` for the first statistic of `s` below zero
+/// (missing ones, read as NaN, pass).
+fn non_negative(s: &Stats) -> std::result::Result<(), String> {
+    let named = [
+        ("mean", s.mean),
+        ("median", s.median),
+        ("p5", s.p5),
+        ("p95", s.p95),
+        ("p99", s.p99),
+        ("min", s.min),
+        ("max", s.max),
+    ];
+    match named.into_iter().find(|(_, v)| *v < 0.0) {
+        Some((name, v)) => Err(format!("{name} is {v} (times are not negative)")),
+        None => Ok(()),
     }
 }
 

@@ -233,12 +233,8 @@ pub fn reproduce(args: &ReproduceArgs) -> Result<()> {
             "at least one frame is needed (got 0)",
         ));
     }
-    let max = gibench_harness::runner::MAX_FRAMES;
-    if let Some(frames) = args.frames.filter(|&f| f > max) {
-        return Err(Error::param(
-            "frames",
-            format!("{frames} exceeds the limit of {max}"),
-        ));
+    if let Some(frames) = args.frames {
+        crate::check_frame_number("frames", frames)?;
     }
     all::reproduce(args)
 }

@@ -515,8 +515,25 @@ impl SceneDescriptor {
                 builtin_names().join(", ")
             )));
         }
+        let what = "--scene takes a built-in scene name or a scene descriptor JSON; glTF files \
+                    are referenced from a descriptor's `mesh.file` (see scenes/cornell-gltf.json)";
+        let gltf = path
+            .extension()
+            .is_some_and(|x| x.eq_ignore_ascii_case("glb") || x.eq_ignore_ascii_case("gltf"));
+        if gltf {
+            return Err(Error::bad_file(
+                path,
+                format!("a glTF file, not a scene descriptor: {what}"),
+            ));
+        }
         // A descriptor is a few kilobytes; 16 MiB bounds the read (`--scene /dev/zero`).
-        let text = crate::error::read_bounded_text(path, 16 << 20)?;
+        let bytes = crate::error::read_bounded(path, 16 << 20)?;
+        let text = String::from_utf8(bytes).map_err(|_| {
+            Error::bad_file(
+                path,
+                format!("not UTF-8 text, so not a scene descriptor: {what}"),
+            )
+        })?;
         let desc = Self::from_json(path, &text)?;
         desc.validate(path)?;
         Ok(desc)
