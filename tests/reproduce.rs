@@ -590,3 +590,47 @@ fn single_scene_targets_refuse_scene_lists_and_frames_have_a_limit() {
         assert!(!out.exists(), "{args:?} wrote {out:?}");
     }
 }
+
+/// A target `reproduce all` did not run keeps its manifest entry with the commit its files
+/// record — here as if regenerated on its own since the last `all` — not the earlier run's.
+#[test]
+fn carried_targets_name_the_commit_their_files_record() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("all");
+    let run = |only: &str| {
+        let args = [
+            "reproduce",
+            "all",
+            "--quick",
+            "--quiet",
+            "--only",
+            only,
+            "--frames",
+            "2",
+        ];
+        let o = gibench_in(tmp.path(), &args, &out);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    };
+    run("laine-management,laine-dispersion");
+    let file = out.join("laine/laine-management.json");
+    let mut v: serde_json::Value = serde_json::from_slice(&std::fs::read(&file).unwrap()).unwrap();
+    v["git_commit"] = serde_json::json!("0123abc");
+    std::fs::write(&file, serde_json::to_vec(&v).unwrap()).unwrap();
+    run("laine-dispersion");
+    let manifest: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("reproduce-all.json")).unwrap()).unwrap();
+    let entry = |name: &str| {
+        manifest["targets"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|t| t["name"] == name)
+            .unwrap()
+            .clone()
+    };
+    assert_eq!(entry("laine-management")["carried_from"], "0123abc");
+    assert!(entry("laine-dispersion")["carried_from"].is_null());
+    let md = std::fs::read_to_string(out.join("reproduce-all.md")).unwrap();
+    assert!(md.contains("from git 0123abc"), "{md}");
+    assert!(!md.contains("(driver )"), "{md}");
+}

@@ -688,11 +688,23 @@ pub fn reproduce(args: &ReproduceArgs) -> Result<()> {
             .as_ref()
             .filter(|p| p.source == root.join(format!("{MANIFEST}.json"))),
     );
+    let manifest = manifest.dated_by_their_files(&root);
     manifest.write(&root)?;
     manifest.write_index(&root)?;
     set.publish()?;
     println!("{}", manifest.listing(&root));
     Ok(())
+}
+
+/// The `git_commit` the first of `files` (relative to `root`) that is a JSON object naming one
+/// records: the commit that made a target's files.
+fn recorded_commit(root: &Path, files: &[String]) -> Option<String> {
+    files.iter().filter(|f| f.ends_with(".json")).find_map(|f| {
+        let bytes = gibench_harness::error::read_bounded(&root.join(f), 64 << 20).ok()?;
+        let v: serde_json::Value = serde_json::from_slice(&bytes).ok()?;
+        let commit = v.get("git_commit")?.as_str()?;
+        (!commit.is_empty()).then(|| commit.to_string())
+    })
 }
 
 /// "12m03s" (one word, for scripts reading `--list`).
@@ -953,6 +965,20 @@ impl Manifest {
         }
     }
 
+    /// The entries carried from an earlier run dated by the commit their files record, where
+    /// they record one: a target regenerated on its own since that run was made by another
+    /// commit than the one the earlier manifest names.
+    fn dated_by_their_files(mut self, root: &Path) -> Manifest {
+        for r in &mut self.targets {
+            if r.carried_from.is_some() {
+                if let Some(commit) = recorded_commit(root, &r.files) {
+                    r.carried_from = Some(commit);
+                }
+            }
+        }
+        self
+    }
+
     /// Tables (`.md`, with `.csv` and `.tex` beside) and figures (`.svg`, `--html`'s pages, the
     /// reference's `.png` images) of a record.
     fn outputs(r: &Record) -> (Vec<&str>, Vec<&str>, usize) {
@@ -980,12 +1006,16 @@ impl Manifest {
         let json = serde_json::to_vec_pretty(self).map_err(|e| Error::Invalid(e.to_string()))?;
         gibench_harness::error::write_atomic(&root.join(format!("{MANIFEST}.json")), &json)?;
         let mut md = format!(
-            "# gibench reproduce all ({} sizes)\n\nLast run: on {} (driver {}), git {}, {} CPU threads: {} ({}). \
+            "# gibench reproduce all ({} sizes)\n\nLast run: on {}{}, git {}, {} CPU threads: {} ({}). \
              Targets it did not run keep the entry of the run that made their files (\"from git …\").\n\n\
              | target | what | command | ran on | time (estimate) | tables | figures | files |\n|---|---|---|---|---|---|---|---|\n",
             self.mode,
             self.adapter,
-            self.driver,
+            if self.driver.is_empty() {
+                String::new()
+            } else {
+                format!(" (driver {})", self.driver)
+            },
             self.git_commit,
             self.cpu_threads,
             duration(self.seconds),
