@@ -141,18 +141,27 @@ struct ReferenceOpts {
     no_cache: bool,
 }
 
+/// The most reference samples per pixel a command takes (at 256x192 and 8 bounces, hours on
+/// two cores already).
+const MAX_SPP: u32 = 1 << 16;
+/// The most reference bounces a command takes.
+const MAX_BOUNCES: u32 = 64;
+
 impl ReferenceOpts {
     fn settings(&self) -> Result<ReferenceSettings> {
-        if self.spp == 0 {
+        if !(1..=MAX_SPP).contains(&self.spp) {
             return Err(Error::param(
                 "spp",
-                "at least one sample per pixel is needed (got 0)",
+                format!(
+                    "expected 1..={MAX_SPP} samples per pixel (got {})",
+                    self.spp
+                ),
             ));
         }
-        if self.bounces == 0 {
+        if !(1..=MAX_BOUNCES).contains(&self.bounces) {
             return Err(Error::param(
                 "bounces",
-                "at least one bounce is needed (got 0)",
+                format!("expected 1..={MAX_BOUNCES} bounces (got {})", self.bounces),
             ));
         }
         Ok(ReferenceSettings {
@@ -252,9 +261,9 @@ pub(crate) struct RunArgs {
     /// flicker) on consecutive frame pairs spread over the measured frames.
     #[arg(long)]
     quality: bool,
-    /// Frame pairs compared with the reference when --quality is given.
-    #[arg(long, default_value_t = 2)]
-    quality_pairs: u32,
+    /// Frame pairs compared with the reference when --quality is given [default: 2].
+    #[arg(long)]
+    quality_pairs: Option<u32>,
     /// With --quality, compare every measured frame (per-frame error and lag plots).
     #[arg(long)]
     quality_all: bool,
@@ -449,9 +458,30 @@ pub(crate) fn plan(args: &RunArgs, extra_params: &[String]) -> Result<Plan> {
     };
     config.validate()?;
     gpu_options(args).validate()?;
+    let quality_options = [
+        ("quality-pairs", args.quality_pairs.is_some()),
+        ("quality-all", args.quality_all),
+        ("quality-reference", args.quality_reference.is_some()),
+    ];
+    if let Some((name, _)) = quality_options
+        .iter()
+        .find(|(_, given)| *given && !args.quality)
+    {
+        return Err(Error::param(
+            *name,
+            "applies to the error measurement: add --quality (without it nothing is compared)",
+        ));
+    }
+    let pairs = args.quality_pairs.unwrap_or(2);
+    if args.quality && pairs == 0 {
+        return Err(Error::param(
+            "quality-pairs",
+            "at least one frame pair is needed (got 0)",
+        ));
+    }
     let quality = if args.quality {
         Some(QualityConfig {
-            pairs: args.quality_pairs,
+            pairs,
             all: args.quality_all,
             reference: args.reference.settings()?,
             component: args

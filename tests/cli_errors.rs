@@ -878,3 +878,71 @@ fn results_files_with_impossible_values_are_refused() {
         assert!(!dir.join("o").exists(), "{what}: {err}");
     }
 }
+
+/// Options of the error measurement given without `--quality` are refused (they used to be
+/// ignored: nothing was compared), as are zero frame pairs, and reference sample and bounce
+/// counts past their limits (a run that would not end in hours), before any work. The sizes
+/// are tiny, so that without the checks each command would succeed at once.
+#[test]
+fn quality_options_need_quality_and_reference_sizes_have_limits() {
+    let tmp = tempfile::tempdir().unwrap();
+    let run = [
+        "run",
+        "--technique",
+        "direct",
+        "--resolution",
+        "16x12",
+        "--frames",
+        "1",
+        "--warmup",
+        "0",
+        "--timing",
+        "stages",
+        "--no-images",
+        "--quiet",
+        "--spp",
+        "1",
+        "--no-cache",
+        "--out",
+        "o",
+    ];
+    for (extra, expect) in [
+        (
+            &["--quality-all"][..],
+            &["quality-all", "add --quality"][..],
+        ),
+        (
+            &["--quality-pairs", "3"][..],
+            &["quality-pairs", "add --quality"][..],
+        ),
+        (
+            &["--quality-reference", "direct"][..],
+            &["quality-reference", "add --quality"][..],
+        ),
+        (
+            &["--quality", "--quality-pairs", "0"][..],
+            &["quality-pairs", "at least one"][..],
+        ),
+    ] {
+        let mut args = run.to_vec();
+        args.extend(extra);
+        command_fails(tmp.path(), &[], &args, expect);
+    }
+    let reference = [
+        "reference",
+        "--resolution",
+        "1x1",
+        "--no-cache",
+        "--out",
+        "r",
+    ];
+    for (extra, expect) in [
+        (["--spp", "65537"], &["spp", "1..=65536"][..]),
+        (["--bounces", "65"], &["bounces", "1..=64"][..]),
+    ] {
+        let mut args = reference.to_vec();
+        args.extend(extra);
+        command_fails(tmp.path(), &[], &args, expect);
+    }
+    assert!(!tmp.path().join("o").exists() && !tmp.path().join("r").exists());
+}
