@@ -946,3 +946,18 @@ fn quality_options_need_quality_and_reference_sizes_have_limits() {
     }
     assert!(!tmp.path().join("o").exists() && !tmp.path().join("r").exists());
 }
+
+/// Files whose names start like the publication journal's directives ("replace…") are
+/// published like any other (a broader test of the journal's lines once kept them staged).
+#[test]
+fn files_named_like_journal_directives_are_published() {
+    let tmp = tempfile::tempdir().unwrap();
+    copy_baseline(tmp.path());
+    let o = Command::new(env!("CARGO_BIN_EXE_gibench"))
+        .current_dir(tmp.path())
+        .args(["report", "r1", "--stem", "replaced", "--out", "o"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(tmp.path().join("o/replaced.md").is_file());
+}

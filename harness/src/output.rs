@@ -333,10 +333,11 @@ fn move_staged(dir: &Path) -> Result<()> {
     let journal = dir.join(JOURNAL);
     let text = std::fs::read_to_string(&journal).map_err(|e| Error::io(&journal, e))?;
     let lines: Vec<&str> = text.lines().filter(|l| !l.is_empty()).collect();
-    // Both prefixes start with "replace" (no file gibench writes does).
+    // The directives' prefixes end in ':', which no file gibench writes has.
+    let directive = |l: &&&str| l.starts_with(REPLACE) || l.starts_with(REPLACE_FILES);
     let listed: std::collections::HashSet<&Path> = lines
         .iter()
-        .filter(|l| !l.starts_with("replace"))
+        .filter(|l| !directive(l))
         .map(Path::new)
         .collect();
     for sub in lines.iter().filter_map(|l| l.strip_prefix(REPLACE)) {
@@ -348,7 +349,7 @@ fn move_staged(dir: &Path) -> Result<()> {
     for pattern in lines.iter().filter_map(|l| l.strip_prefix(REPLACE_FILES)) {
         remove_unlisted_matching(dir, pattern, &listed)?;
     }
-    for rel in lines.iter().filter(|l| !l.starts_with("replace")) {
+    for rel in lines.iter().filter(|l| !directive(l)) {
         let rel = Path::new(rel);
         if !rel.components().all(|c| matches!(c, Component::Normal(_))) {
             // Not written by gibench: ignored.
