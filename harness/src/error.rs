@@ -131,8 +131,3 @@ pub fn read_bounded(path: &std::path::Path, max: u64) -> Result<Vec<u8>> {
     }
     Ok(bytes)
 }
-
-/// [`read_bounded`] as UTF-8 text.
-pub fn read_bounded_text(path: &std::path::Path, max: u64) -> Result<String> {
-    String::from_utf8(read_bounded(path, max)?).map_err(|_| Error::bad_file(path, "not UTF-8 text"))
-}
