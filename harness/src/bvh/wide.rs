@@ -593,24 +593,32 @@ impl WideBvh {
                         code = node.child[near_lane];
                         continue;
                     }
-                    // Sort the entered children by entry distance; walk the nearest, push the
-                    // rest farthest first.
-                    let mut hits = [Entry::default(); W];
+                    // Sort the entered children by entry distance (ties: the lower lane first);
+                    // walk the nearest, push the rest farthest first. Each child goes straight
+                    // to its rank, counted without branches (an insertion sort's data-dependent
+                    // branches made closest-hit rays on Sibenik 2-4 % slower). Entered lanes'
+                    // distances are never NaN (`near <= far` held), so the ranks are distinct.
+                    let mut codes = [0u32; W];
+                    let mut ts = [0f32; W];
                     let mut n = 0;
                     while mask != 0 {
                         let lane = mask.trailing_zeros() as usize;
                         mask &= mask - 1;
-                        let e = Entry {
-                            code: node.child[lane],
-                            t: near[lane],
-                        };
-                        let mut i = n;
-                        while i > 0 && hits[i - 1].t > e.t {
-                            hits[i] = hits[i - 1];
-                            i -= 1;
-                        }
-                        hits[i] = e;
+                        codes[n] = node.child[lane];
+                        ts[n] = near[lane];
                         n += 1;
+                    }
+                    let mut hits = [Entry::default(); W];
+                    for i in 0..n {
+                        let mut rank = 0;
+                        for j in 0..n {
+                            rank += ((ts[j] < ts[i]) | ((ts[j] == ts[i]) & (j < i))) as usize;
+                        }
+                        // (`& (W - 1)`: rank < n ≤ W; lets the compiler drop the bounds check.)
+                        hits[rank & (W - 1)] = Entry {
+                            code: codes[i],
+                            t: ts[i],
+                        };
                     }
                     for e in hits[1..n].iter().rev() {
                         stack.push(*e);
