@@ -10,7 +10,7 @@
 //! runs each once as a test.
 
 use criterion::measurement::{Measurement, ValueFormatter};
-use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use criterion::{criterion_group, Criterion, Throughput};
 use gibench_harness::assets::AssetPaths;
 use gibench_harness::glam::Vec3;
 use gibench_harness::gpu::{GpuContext, GpuOptions};
@@ -327,4 +327,11 @@ criterion_group! {
     config = Criterion::default().with_measurement(ProcessCpuTime).sample_size(20);
     targets = laine_management_cpu, reference_paths_cpu
 }
-criterion_main!(benches, cpu_benches);
+// `criterion_main!`'s `main`, with this thread made a worker of the CPU pool first (as the
+// gibench binary does: see `gibench_harness::threads`).
+fn main() {
+    gibench_harness::threads::join_global_pool();
+    benches();
+    cpu_benches();
+    Criterion::default().configure_from_args().final_summary();
+}

@@ -303,6 +303,7 @@ struct ReportArgs {
 }
 
 fn main() -> ExitCode {
+    gibench_harness::threads::join_global_pool();
     let cli = Cli::parse();
     let outcome = match cli.command {
         None => run(&RunArgs::parse_default()),

@@ -50,6 +50,7 @@ pub mod scene;
 pub mod session;
 pub mod stats;
 pub mod technique;
+pub mod threads;
 pub mod vpl;
 
 pub use error::{Error, Result};

@@ -157,6 +157,7 @@ pub extern "Rust" fn gibench_kernel_body(name: &str, s: &mut Setup, round: u64) 
 }
 
 fn main() -> std::process::ExitCode {
+    gibench_harness::threads::join_global_pool();
     let args: Vec<String> = std::env::args().skip(1).collect();
     match args
         .iter()
