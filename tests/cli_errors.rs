@@ -365,6 +365,37 @@ fn tessellation_past_the_cap() {
     fails(&["--scene", d.to_str().unwrap()], "shadow_mesh.tessellate");
 }
 
+/// A `tessellate` length finer than the tessellation's per-edge limit (256 rows or cells) is
+/// refused, naming the field and the smallest length that fits, where it used to be coarsened
+/// without a word: a generated Cornell box (about 960 mm corner to corner) at 1 mm cells, and
+/// one triangle (longest edge √2) at 0.005 — 283 rows, 80,089 triangles, well under the total
+/// cap, so only the per-edge limit catches it.
+#[test]
+fn tessellation_finer_than_the_per_edge_limit() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = descriptor(tmp.path(), "fine-generated.json", |v| {
+        v["shadow_mesh"] = serde_json::json!({"generated": "cornell-box", "tessellate": 1.0});
+    });
+    fails(
+        &["--scene", d.to_str().unwrap()],
+        "shadow_mesh.tessellate: 1 would split the generated mesh 'cornell-box'",
+    );
+    let d = one_triangle_gltf(tmp.path(), "tri.bin");
+    std::fs::write(
+        tmp.path().join("tri.bin"),
+        corners([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]),
+    )
+    .unwrap();
+    let mut v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&d).unwrap()).unwrap();
+    v["shadow_mesh"] = serde_json::json!({"file": v["mesh"]["file"].clone(), "tessellate": 0.005});
+    std::fs::write(&d, serde_json::to_string(&v).unwrap()).unwrap();
+    fails(
+        &["--scene", d.to_str().unwrap()],
+        "shadow_mesh.tessellate = 0.005 would split its longest triangle edge",
+    );
+}
+
 /// Irradiance past the half-float limit of the irradiance buffers is reported, in the results
 /// file and on standard error, instead of being clamped silently.
 #[test]

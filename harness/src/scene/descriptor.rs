@@ -590,6 +590,23 @@ fn validate_mesh_source(p: &Path, field: &str, src: &MeshSource) -> Result<()> {
                 format!("must be a positive cell size, got {cell}"),
             ));
         }
+        if let (None, Some(name)) = (&src.file, &src.generated) {
+            // A generator caps each quad edge at MAX_CELLS_PER_EDGE cells: refuse a cell
+            // that could hit the cap instead of letting it be coarsened without a word.
+            let most = super::cornell::MAX_CELLS_PER_EDGE;
+            let diagonal = super::generated_diagonal(name)?;
+            let cells = (diagonal / cell).round();
+            if !(cells <= most as f32) {
+                return Err(invalid(
+                    p,
+                    &format!("{field}.tessellate"),
+                    format!(
+                        "{cell} would split the generated mesh '{name}' ({diagonal} corner to corner) into up to {cells} cells along an edge; at most {most} are allowed (use a cell of at least {})",
+                        diagonal / most as f32
+                    ),
+                ));
+            }
+        }
     }
     Ok(())
 }

@@ -123,6 +123,19 @@ impl Mesh {
             .fold(0u64, u64::saturating_add)
     }
 
+    /// The longest edge of any triangle (0 without triangles).
+    pub fn longest_edge(&self) -> f32 {
+        (0..self.triangle_count())
+            .map(|t| {
+                let p = self.triangle(t);
+                (p[1] - p[0])
+                    .length()
+                    .max((p[2] - p[1]).length())
+                    .max((p[0] - p[2]).length())
+            })
+            .fold(0.0, f32::max)
+    }
+
     /// A copy in which every triangle whose longest edge exceeds `max_edge` is split into an
     /// n×n grid of sub-triangles (n = ceil(longest edge / max_edge)) with attributes
     /// interpolated linearly; smaller triangles are kept. Neighbours split differently meet at
@@ -289,11 +302,16 @@ impl SceneExtent {
 /// refused before any memory is asked for.
 pub const MAX_TESSELLATED_TRIANGLES: u64 = 1 << 23;
 
+/// Most rows a triangle is split into along its longest edge by [`Mesh::tessellated`]: a
+/// `tessellate` edge that would need more for some triangle is refused when the scene loads,
+/// not quietly coarsened.
+pub const MAX_TESSELLATION_ROWS: usize = 256;
+
 /// Rows of the barycentric grid a triangle with longest edge `longest` is split into.
 fn tessellation_factor(longest: f32, max_edge: f32) -> usize {
     let n = (longest / max_edge).ceil();
     if n.is_finite() {
-        (n as usize).clamp(1, 256)
+        (n as usize).clamp(1, MAX_TESSELLATION_ROWS)
     } else {
         1
     }
@@ -394,6 +412,16 @@ fn generate(name: &str, tessellate: Option<f32>) -> Result<(Mesh, Vec<Material>,
     })
 }
 
+/// The corner-to-corner length of generated mesh `name`'s bounding box, untessellated: no quad
+/// edge a generator splits is longer, so a `tessellate` cell that fits
+/// [`cornell::MAX_CELLS_PER_EDGE`] times along it is never coarsened (the descriptor's
+/// validation refuses a finer one).
+pub(crate) fn generated_diagonal(name: &str) -> Result<f32> {
+    let (mesh, _, _) = generate(name, None)?;
+    let (lo, hi) = mesh.bounds();
+    Ok((hi - lo).length())
+}
+
 /// Builds `src`; `field` names it in errors (`mesh`, `shadow_mesh`, `statics[0].mesh`, ...).
 fn build_mesh(src: &MeshSource, assets: &AssetPaths, field: &str) -> Result<BuiltMesh> {
     match (&src.file, &src.generated) {
@@ -402,6 +430,17 @@ fn build_mesh(src: &MeshSource, assets: &AssetPaths, field: &str) -> Result<Buil
             let g = gltf_load::load_gltf(&path, 0)?;
             let mesh = match src.tessellate {
                 Some(edge) => {
+                    let longest = g.mesh.longest_edge();
+                    let rows = (longest / edge).ceil();
+                    if !(rows <= MAX_TESSELLATION_ROWS as f32) {
+                        return Err(crate::Error::bad_file(
+                            &path,
+                            format!(
+                                "{field}.tessellate = {edge} would split its longest triangle edge ({longest}) into {rows} rows; at most {MAX_TESSELLATION_ROWS} are allowed (use an edge of at least {})",
+                                longest / MAX_TESSELLATION_ROWS as f32
+                            ),
+                        ));
+                    }
                     let n = g.mesh.tessellated_triangle_count(edge);
                     if n > MAX_TESSELLATED_TRIANGLES {
                         return Err(crate::Error::bad_file(
