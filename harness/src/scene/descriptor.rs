@@ -596,7 +596,7 @@ fn validate_mesh_source(p: &Path, field: &str, src: &MeshSource) -> Result<()> {
             let most = super::cornell::MAX_CELLS_PER_EDGE;
             let diagonal = super::generated_diagonal(name)?;
             let cells = (diagonal / cell).round();
-            if !(cells <= most as f32) {
+            if cells.is_nan() || cells > most as f32 {
                 return Err(invalid(
                     p,
                     &format!("{field}.tessellate"),

@@ -432,7 +432,7 @@ fn build_mesh(src: &MeshSource, assets: &AssetPaths, field: &str) -> Result<Buil
                 Some(edge) => {
                     let longest = g.mesh.longest_edge();
                     let rows = (longest / edge).ceil();
-                    if !(rows <= MAX_TESSELLATION_ROWS as f32) {
+                    if rows.is_nan() || rows > MAX_TESSELLATION_ROWS as f32 {
                         return Err(crate::Error::bad_file(
                             &path,
                             format!(
