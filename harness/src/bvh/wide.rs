@@ -596,7 +596,7 @@ impl WideBvh {
                     // Sort the entered children by entry distance (ties: the lower lane first);
                     // walk the nearest, push the rest farthest first. Each child goes straight
                     // to its rank, counted without branches (an insertion sort's data-dependent
-                    // branches made closest-hit rays on Sibenik 2-4 % slower). Entered lanes'
+                    // branches made closest-hit rays on Sibenik 1-4 % slower). Entered lanes'
                     // distances are never NaN (`near <= far` held), so the ranks are distinct.
                     let mut codes = [0u32; W];
                     let mut ts = [0f32; W];
