@@ -110,11 +110,7 @@ impl Mesh {
         }
         (0..self.triangle_count())
             .map(|t| {
-                let p = self.triangle(t);
-                let longest = (p[1] - p[0])
-                    .length()
-                    .max((p[2] - p[1]).length())
-                    .max((p[0] - p[2]).length());
+                let longest = longest_edge_of(self.triangle(t));
                 // Unclamped: an edge so short that `tessellated` would clamp it is refused.
                 let n = (longest / max_edge).ceil();
                 let n = if n.is_finite() { n.max(1.0) } else { f32::MAX };
@@ -126,13 +122,7 @@ impl Mesh {
     /// The longest edge of any triangle (0 without triangles).
     pub fn longest_edge(&self) -> f32 {
         (0..self.triangle_count())
-            .map(|t| {
-                let p = self.triangle(t);
-                (p[1] - p[0])
-                    .length()
-                    .max((p[2] - p[1]).length())
-                    .max((p[0] - p[2]).length())
-            })
+            .map(|t| longest_edge_of(self.triangle(t)))
             .fold(0.0, f32::max)
     }
 
@@ -152,11 +142,7 @@ impl Mesh {
                 self.indices[3 * t + 2] as usize,
             ];
             let p = idx.map(|i| self.positions[i]);
-            let longest = (p[1] - p[0])
-                .length()
-                .max((p[2] - p[1]).length())
-                .max((p[0] - p[2]).length());
-            let n = tessellation_factor(longest, max_edge);
+            let n = tessellation_factor(longest_edge_of(p), max_edge);
             let base = out.positions.len() as u32;
             // Vertices of the barycentric grid: row i (0..=n) has n - i + 1 vertices.
             let mut row_start = Vec::with_capacity(n + 1);
@@ -306,6 +292,14 @@ pub const MAX_TESSELLATED_TRIANGLES: u64 = 1 << 23;
 /// `tessellate` edge that would need more for some triangle is refused when the scene loads,
 /// not quietly coarsened.
 pub const MAX_TESSELLATION_ROWS: usize = 256;
+
+/// The longest edge of the triangle with corners `p`.
+fn longest_edge_of(p: [Vec3; 3]) -> f32 {
+    (p[1] - p[0])
+        .length()
+        .max((p[2] - p[1]).length())
+        .max((p[0] - p[2]).length())
+}
 
 /// Rows of the barycentric grid a triangle with longest edge `longest` is split into.
 fn tessellation_factor(longest: f32, max_edge: f32) -> usize {
