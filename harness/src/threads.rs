@@ -4,12 +4,13 @@
 //! A parallel section started from a thread outside the pool hands all of its work to the
 //! pool's workers and sleeps until they finish; when the workers are asleep too, every section
 //! pays for waking one and then for being woken, and on a virtual machine an idle virtual CPU
-//! can take hundreds of microseconds to wake. Laine's VPL management runs four such sections a
-//! frame: called from outside the pool, its median frame at 1024 VPLs (omni) on Sibenik took
-//! 0.43 ms wall on the 2-core development machine, its p99 1.3 to 2.0 times that; with the
-//! calling thread a worker, 0.35 ms and 1.2 to 1.3 times (three runs each, alternating). A worker runs its own first
-//! part at once and takes back any part no other worker has taken yet, so a slow wake-up costs
-//! at most the parallelism, never a wait.
+//! can take hundreds of microseconds to wake. Laine's VPL management runs two or three such
+//! sections a frame (validity rays, miss rays, creation rays from 64 on): called from outside
+//! the pool, its median frame at 1024 VPLs (omni) on Sibenik took 0.43 ms wall on the 2-core
+//! development machine, its p99 1.3 to 2.0 times that; with the calling thread a worker,
+//! 0.35 ms and 1.2 to 1.3 times (three runs each, alternating; `results/laine` holds the
+//! latter). A worker runs its own first part at once and takes back any part no other worker
+//! has taken yet, so a slow wake-up costs at most the parallelism, never a wait.
 
 /// Makes the calling thread a worker of rayon's global pool (of `RAYON_NUM_THREADS` threads, or
 /// as many as the machine has). Call it first thing in `main`, before anything runs in

@@ -24,8 +24,8 @@ pub const GREEN: u32 = 3;
 
 /// The largest number of cells along one edge of a quad when tessellating; keeps a tiny cell
 /// size from exhausting memory (at most 2 · 256² triangles per quad). A scene that asks for
-/// finer cells is refused when it loads (`build_mesh`); the generators' own cap only guards
-/// direct callers.
+/// finer cells is refused when it loads (the descriptor's validation, against the generated
+/// mesh's bounding-box diagonal); the generators' own cap only guards direct callers.
 pub const MAX_CELLS_PER_EDGE: u32 = 256;
 
 /// Which way a quad's normal must point.
