@@ -849,6 +849,12 @@ pub(crate) fn page_line(page: &Path) -> String {
 fn sweep(args: &SweepArgs) -> Result<()> {
     let planned = sweep_plan(args)?;
     let set = OutputSet::begin("out", &args.run.out)?;
+    // The folder's points of this scene, technique and parameter are this sweep's alone: an
+    // earlier sweep's points at values this one does not run are removed when it publishes
+    // (they would otherwise sit beside its table as if part of it).
+    for stale in planned.earlier_points(&args.run.out) {
+        gibench_harness::output::replace_in_open_set(&stale)?;
+    }
     let gpu = open_gpu(&args.run)?;
     let done = sweep_planned(args, &planned, &gpu, &Bars::Own(args.run.quiet))?;
     set.publish()?;
@@ -876,10 +882,44 @@ impl SweepPlan {
             .map(|(v, p)| TechniqueRun {
                 info,
                 params: p.params[0].clone(),
-                stem: format!("{}-{}-{}-{v}", first.desc.name, info.name, self.name),
+                stem: format!("{}{v}", self.point_prefix()),
             })
             .collect();
         spec
+    }
+
+    /// What every point's files are named after: `SCENE-TECHNIQUE-PARAMETER-` (the value
+    /// follows).
+    fn point_prefix(&self) -> String {
+        let first = &self.plans[0];
+        let info = first.techniques[0];
+        format!("{}-{}-{}-", first.desc.name, info.name, self.name)
+    }
+
+    /// The files in `dir` named as points of a sweep of this scene, technique and parameter
+    /// (any value) — not those of a parameter whose name extends this one's (`vpl-map-size`
+    /// beside `vpl-map`).
+    fn earlier_points(&self, dir: &Path) -> Vec<PathBuf> {
+        let prefix = self.point_prefix();
+        let first = &self.plans[0];
+        let info = first.techniques[0];
+        let bare = self.name.rsplit('.').next().unwrap_or(&self.name);
+        let longer: Vec<String> = (info.params.iter().flat_map(|g| g.iter()))
+            .filter(|p| p.name.starts_with(&format!("{bare}-")))
+            .map(|p| format!("{}-{}-{}-", first.desc.name, info.name, p.name))
+            .collect();
+        let Ok(entries) = std::fs::read_dir(dir) else {
+            return Vec::new();
+        };
+        entries
+            .flatten()
+            .filter(|e| e.file_type().is_ok_and(|t| t.is_file()))
+            .filter(|e| {
+                let name = e.file_name().to_string_lossy().into_owned();
+                name.starts_with(&prefix) && !longer.iter().any(|l| name.starts_with(l))
+            })
+            .map(|e| e.path())
+            .collect()
     }
 }
 

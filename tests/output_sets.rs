@@ -241,3 +241,59 @@ fn a_rerun_without_images_removes_the_stems_old_images() {
         "{names:?}"
     );
 }
+
+/// A sweep into a folder holding an earlier sweep of the same parameter leaves only its own
+/// points there (the earlier sweep's extra value is gone); other files, among them the points
+/// of a parameter whose name extends the swept one's (`vpl-map-size` beside `vpl-map`), stay.
+#[test]
+fn a_sweep_replaces_an_earlier_sweeps_points() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    let sweep = |values: &str| {
+        let o = gibench()
+            .args([
+                "sweep",
+                "--technique",
+                "keller-full",
+                "--quiet",
+                "--no-images",
+            ])
+            .args(["--sweep", values])
+            .args(SMALL)
+            .arg("--out")
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    };
+    sweep("vpls=8,16");
+    assert!(out.join("cornell-keller-full-vpls-16.json").exists());
+    let others = [
+        "cornell-keller-full.json",
+        "cornell-keller-full-tiles-2x2.json",
+        "cornell-keller-full-vpl-map-size-64.json",
+    ];
+    for f in others {
+        std::fs::write(out.join(f), b"another command's").unwrap();
+    }
+    std::fs::write(
+        out.join("cornell-keller-full-vpl-map-cube.json"),
+        b"an earlier point",
+    )
+    .unwrap();
+    sweep("vpls=8");
+    sweep("vpl-map=paraboloid");
+    let names: Vec<String> = files(&out).into_keys().collect();
+    let mut kept: Vec<&str> = (names.iter())
+        .filter(|n| n.starts_with("cornell-keller-full") && n.ends_with(".json"))
+        .map(String::as_str)
+        .collect();
+    kept.sort_unstable();
+    let mut want = vec![
+        "cornell-keller-full-vpl-map-paraboloid.json",
+        "cornell-keller-full-vpls-8.json",
+    ];
+    want.extend(others);
+    want.sort_unstable();
+    assert_eq!(kept, want, "{names:?}");
+}
