@@ -571,6 +571,37 @@ mod tests {
         assert!(hits > 1500, "{hits}");
     }
 
+    /// Rays aimed exactly at corners and edge points of a soup's triangles: where a corner is
+    /// extreme in its leaf group, the ray meets the group's box on its boundary, in two or three
+    /// axes at once, and rounding can put the computed entry past the computed exit. The
+    /// traversal's widened exit (`wide::ROBUST`) keeps those boxes entered: without it, the
+    /// tree misses hits the scalar test finds.
+    #[test]
+    fn rays_through_corners_and_edges_find_what_brute_force_finds() {
+        let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+        let mut mesh = Mesh::default();
+        for _ in 0..2000 {
+            let c = Vec3::new(rng.next(), rng.next(), rng.next()) * 100.0;
+            let size = 0.5 + 5.0 * rng.next();
+            push_triangle(&mut mesh, [0, 1, 2].map(|_| c + rng.unit_vector() * size));
+        }
+        let corners: Vec<[Vec3; 3]> = (0..mesh.triangle_count())
+            .map(|t| mesh.triangle(t))
+            .collect();
+        let hits = check_against_brute_force(&mesh, 6000, &mut rng, |rng| {
+            let tri = corners[(rng.next() * corners.len() as f32) as usize % corners.len()];
+            let k = (rng.next() * 3.0) as usize % 3;
+            let target = if rng.next() < 0.5 {
+                tri[k]
+            } else {
+                tri[k].lerp(tri[(k + 1) % 3], rng.next())
+            };
+            let origin = Vec3::new(rng.next(), rng.next(), rng.next()) * 140.0 - 20.0;
+            (origin, (target - origin).normalize())
+        });
+        assert!(hits > 3000, "{hits}");
+    }
+
     /// Triangles across the x axis at distances growing geometrically (up to 2¹²⁵) nest each
     /// box in the next: a tree deeper than the scenes' (a ray along the axis needs 115 stack
     /// entries), whose traversal outgrows the stack's fixed part and must still find every hit.
