@@ -36,6 +36,18 @@ fn small_direct(out: &Path) -> std::process::Output {
         .unwrap()
 }
 
+/// `gibench ARGS` at the small size into `out`, which must succeed.
+fn small_ok(args: &[&str], out: &Path) {
+    let o = gibench()
+        .args(args)
+        .args(SMALL)
+        .arg("--out")
+        .arg(out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+}
+
 /// Every file under `dir` (relative path → bytes), hidden ones too.
 fn files(dir: &Path) -> BTreeMap<String, Vec<u8>> {
     let mut out = BTreeMap::new();
@@ -223,14 +235,10 @@ fn a_rerun_without_images_removes_the_stems_old_images() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(out.join("cornell-direct.png").exists());
     std::fs::write(out.join("cornell-other.png"), b"another stem's image").unwrap();
-    let o = gibench()
-        .args(["run", "--technique", "direct", "--quiet", "--no-images"])
-        .args(SMALL)
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    small_ok(
+        &["run", "--technique", "direct", "--quiet", "--no-images"],
+        &out,
+    );
     let names: Vec<String> = files(&out).into_keys().collect();
     let stems: Vec<&String> = (names.iter())
         .filter(|n| n.starts_with("cornell-direct") || n.starts_with("cornell-other"))
@@ -250,21 +258,18 @@ fn a_sweep_replaces_an_earlier_sweeps_points() {
     let tmp = tempfile::tempdir().unwrap();
     let out = tmp.path().join("out");
     let sweep = |values: &str| {
-        let o = gibench()
-            .args([
+        small_ok(
+            &[
                 "sweep",
                 "--technique",
                 "keller-full",
                 "--quiet",
                 "--no-images",
-            ])
-            .args(["--sweep", values])
-            .args(SMALL)
-            .arg("--out")
-            .arg(&out)
-            .output()
-            .unwrap();
-        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+                "--sweep",
+                values,
+            ],
+            &out,
+        );
     };
     sweep("vpls=8,16");
     assert!(out.join("cornell-keller-full-vpls-16.json").exists());
