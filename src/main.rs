@@ -210,6 +210,10 @@ struct GpuArgs {
     /// Use the adapter whose name contains this (case-insensitive).
     #[arg(long, env = "GIBENCH_ADAPTER")]
     adapter: Option<String>,
+    /// Fail when the GPU takes longer than this many seconds over one submission (default:
+    /// wait as long as the work takes; a note is printed after 30 s).
+    #[arg(long, env = "GIBENCH_GPU_TIMEOUT", value_name = "SECONDS")]
+    gpu_timeout: Option<f64>,
 }
 
 #[derive(Args, Clone)]
@@ -716,6 +720,7 @@ fn gpu_options(args: &RunArgs) -> GpuOptions {
     GpuOptions {
         backend: args.gpu.backend.clone(),
         adapter: args.gpu.adapter.clone(),
+        gpu_timeout: args.gpu.gpu_timeout,
     }
 }
 
@@ -773,6 +778,12 @@ pub(crate) fn run_planned(
             .filter(|m| *m == "rmse" || flicker)
         {
             let svg = args.out.join(format!("{name}-{metric}-per-frame.svg"));
+            if report::per_frame_lines(&results, metric)?.is_empty() {
+                // Every value is not a number (each run's warnings say why): what is valid
+                // is still written.
+                eprintln!("note: no {metric} value is a number; {} not drawn", file_name(&svg));
+                continue;
+            }
             report::quality_over_frames_svg(
                 &results,
                 metric,
@@ -784,8 +795,12 @@ pub(crate) fn run_planned(
     }
     if plan.quality.is_some() {
         let svg = args.out.join(format!("{name}-time-vs-error.svg"));
-        report::time_vs_error_svg(&results, &svg, &format!("Time versus error on {name}"))?;
-        written.push(file_name(&svg));
+        if report::time_error_points(&results).is_empty() {
+            eprintln!("note: no run has an error that is a number; {} not drawn", file_name(&svg));
+        } else {
+            report::time_vs_error_svg(&results, &svg, &format!("Time versus error on {name}"))?;
+            written.push(file_name(&svg));
+        }
     }
     let mut done = format!(
         "wrote {} results, images and {} to {}",
@@ -1228,8 +1243,10 @@ fn plot_quality(args: &PlotQualityArgs) -> Result<()> {
     Ok(())
 }
 
-/// Every results file under `dir`, recursively (files that are not results are skipped), with
-/// its path.
+/// Every results file under `dir`, recursively, with its path. JSON files that are not results
+/// (no `schema_version` and `technique`) are passed over; a results file that cannot be read
+/// (truncated, newer schema, invalid values) is named on standard error, and is an error when
+/// its scene and technique are in no file read from `dir` (the side would lose that run).
 fn results_under(option: &str, dir: &Path) -> Result<Vec<(PathBuf, RunResult)>> {
     if !dir.is_dir() {
         return Err(Error::param(
@@ -1238,6 +1255,7 @@ fn results_under(option: &str, dir: &Path) -> Result<Vec<(PathBuf, RunResult)>> 
         ));
     }
     let mut found = Vec::new();
+    let mut unreadable: Vec<(PathBuf, String, Option<String>)> = Vec::new();
     let mut stack = vec![dir.to_path_buf()];
     while let Some(d) = stack.pop() {
         let mut entries: Vec<PathBuf> = std::fs::read_dir(&d)
@@ -1256,11 +1274,47 @@ fn results_under(option: &str, dir: &Path) -> Result<Vec<(PathBuf, RunResult)>> 
             if p.is_dir() {
                 stack.push(p);
             } else if p.extension().is_some_and(|x| x == "json") {
-                if let Ok(r) = RunResult::read(&p) {
-                    found.push((p, r));
+                match RunResult::read(&p) {
+                    Ok(r) => found.push((p, r)),
+                    Err(e) => {
+                        if let Some(run) = results_like(&p) {
+                            unreadable.push((p, e.to_string(), run));
+                        }
+                    }
                 }
             }
         }
+    }
+    for (p, why, _) in &unreadable {
+        eprintln!("warning: {option}: skipped {}: {why}", p.display());
+    }
+    let lost: Vec<String> = unreadable
+        .iter()
+        .filter(|(_, _, run)| {
+            run.as_ref().is_none_or(|run| {
+                !found
+                    .iter()
+                    .any(|(_, r)| &format!("{}/{}", r.scene, r.technique) == run)
+            })
+        })
+        .map(|(p, _, run)| {
+            format!(
+                "{} ({})",
+                p.display(),
+                run.as_deref().unwrap_or("its run unknown")
+            )
+        })
+        .collect();
+    if !lost.is_empty() {
+        return Err(Error::param(
+            option,
+            format!(
+                "results files that cannot be read hold runs no other file under {} has: {} \
+                 (their errors are above; fix or remove them)",
+                dir.display(),
+                lost.join(", ")
+            ),
+        ));
     }
     if found.is_empty() {
         return Err(Error::param(
@@ -1269,6 +1323,43 @@ fn results_under(option: &str, dir: &Path) -> Result<Vec<(PathBuf, RunResult)>> 
         ));
     }
     Ok(found)
+}
+
+/// `Some("scene/technique")` (its run, `None` inside where unknown) when `path` looks like a
+/// gibench results file — a truncated or damaged one included — and `None` when it is another
+/// JSON file (a comparison, a reproduction's summary).
+fn results_like(path: &Path) -> Option<Option<String>> {
+    let bytes = gibench_harness::error::read_bounded(path, 1 << 30).ok()?;
+    let head = String::from_utf8_lossy(&bytes[..bytes.len().min(4096)]).into_owned();
+    let v: Option<serde_json::Value> = serde_json::from_slice(&bytes).ok();
+    match v {
+        Some(v) => {
+            let o = v.as_object()?;
+            if !(o.contains_key("schema_version") && o.contains_key("technique")) {
+                return None;
+            }
+            let run = o
+                .get("scene")
+                .and_then(|s| s.as_str())
+                .zip(o.get("technique").and_then(|t| t.as_str()))
+                .map(|(s, t)| format!("{s}/{t}"));
+            Some(run)
+        }
+        // Not JSON (truncated): a results file if it begins like one, its run read from the
+        // fields near its start where they are there.
+        None => {
+            if !head.contains("\"schema_version\"") {
+                return None;
+            }
+            let field = |name: &str| {
+                let key = format!("\"{name}\": \"");
+                let start = head.find(&key)? + key.len();
+                let len = head[start..].find('"')?;
+                Some(head[start..start + len].to_string())
+            };
+            Some(field("scene").zip(field("technique")).map(|(s, t)| format!("{s}/{t}")))
+        }
+    }
 }
 
 fn compare_cmd(args: &CompareArgs) -> Result<()> {

@@ -128,8 +128,10 @@ pub(crate) fn make_rays(
 
 /// Reads a ray file, refusing one whose size is not a whole, non-zero number of rays.
 fn read_rays(path: &Path) -> Result<Vec<Ray>> {
-    let bytes = std::fs::read(path)
-        .map_err(|e| Error::param("rays", format!("cannot read {}: {e}", path.display())))?;
+    let bytes =
+        gibench_harness::error::read_bounded(path, MAX_RAYS as u64 * RAY_BYTES as u64).map_err(
+            |e| Error::param("rays", format!("cannot read {}: {e}", path.display())),
+        )?;
     if bytes.is_empty() || bytes.len() % RAY_BYTES != 0 {
         return Err(Error::param(
             "rays",
@@ -178,7 +180,7 @@ pub(crate) fn raycast(args: &RaycastArgs) -> Result<()> {
         ));
     }
     let meta_path = args.rays.join("scene.json");
-    let meta: serde_json::Value = std::fs::read(&meta_path)
+    let meta: serde_json::Value = gibench_harness::error::read_bounded(&meta_path, 1 << 20)
         .map_err(|e| Error::param("rays", format!("cannot read {}: {e}", meta_path.display())))
         .and_then(|b| {
             serde_json::from_slice(&b).map_err(|e| {

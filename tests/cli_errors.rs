@@ -306,10 +306,9 @@ fn huge_coordinates() {
         corners([[0.0, 0.0, 0.0], [3.0e38, 0.0, 0.0], [0.0, 1.0, 0.0]]),
     )
     .unwrap();
-    fails(
-        &["--scene", d.to_str().unwrap()],
-        "the static mesh (with its statics): a vertex at",
-    );
+    // The glTF file is named (before: only the scene and "the static mesh").
+    fails(&["--scene", d.to_str().unwrap()], "mesh: a vertex at");
+    fails(&["--scene", d.to_str().unwrap()], "tri.gltf");
     let statue = |scale: f64, at: f64| {
         move |v: &mut serde_json::Value| {
             v["statics"] = serde_json::json!([{
@@ -991,4 +990,46 @@ fn files_named_like_journal_directives_are_published() {
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(tmp.path().join("o/replaced.md").is_file());
+}
+
+/// Parameters past what the image or the device allows are refused by name before any frame:
+/// a tile grid with more tiles along an axis than the image has pixels (before: an all-zero
+/// image for `laine` and `ism`, +20 % with hot spots for `keller-full`), an `ism` point pool or
+/// reflective shadow map larger than the adapter's largest storage buffer (before: a raw GPU
+/// validation error after seconds of sampling, or the blame put on `vpl-map-size`).
+#[test]
+fn parameters_past_the_image_or_the_device() {
+    for t in ["laine", "ism", "keller-full"] {
+        fails(
+            &["--technique", t, "--resolution", "64x48", "--param", "tiles=64x64"],
+            "parameter 'tiles'",
+        );
+    }
+    fails(
+        &["--technique", "laine", "--resolution", "64x48", "--param", "tiles=8x49"],
+        "8x49 tiles on a 64x48 image",
+    );
+    let gpu = gibench_harness::gpu::GpuContext::new(&Default::default()).expect("an adapter");
+    let limits = gpu.device.limits();
+    let max = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
+    drop(gpu);
+    if (1u64 << 24) * 16 > max {
+        fails(
+            &[
+                "--technique", "ism", "--resolution", "32x24",
+                "--param", "point-pool=16777216", "--param", "points-per-vpl=1",
+            ],
+            "parameter 'point-pool'",
+        );
+    } else {
+        gibench_harness::gpu::say_uncaptured(&format!(
+            "cli_errors: this adapter's storage buffers ({max} bytes) take ism's largest point pool; the pool's check was not tried"
+        ));
+    }
+    if 6 * 2048u64 * 2048 * 16 > max {
+        fails(
+            &["--technique", "ism", "--resolution", "32x24", "--param", "rsm-size=2048"],
+            "parameter 'rsm-size'",
+        );
+    }
 }

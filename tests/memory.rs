@@ -62,7 +62,7 @@ fn memory_stays_flat_over_long_runs() {
     for backend in present {
         let gpu = GpuContext::new(&GpuOptions {
             backend: Some(backend.into()),
-            adapter: None,
+            ..Default::default()
         })
         .expect("a GPU adapter");
         let h = Harness::new(&gpu, &scene, &config).unwrap();

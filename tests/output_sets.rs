@@ -302,3 +302,66 @@ fn a_sweep_replaces_an_earlier_sweeps_points() {
     want.sort_unstable();
     assert_eq!(kept, want, "{names:?}");
 }
+
+/// A run killed and not yet reaped (a zombie, which keeps its `/proc` entry) holds no folder:
+/// the operating system released its lock when it died, so the next command runs. With the
+/// process-id lock this replaced, the zombie's entry kept the folder locked.
+#[cfg(unix)]
+#[test]
+fn a_killed_unreaped_run_does_not_hold_the_folder() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (out, cache) = (tmp.path().join("out"), tmp.path().join("cache"));
+    let mut first = spawn_long(&out, &cache);
+    let start = Instant::now();
+    while !out.join(".gibench.lock").exists() && start.elapsed() < Duration::from_secs(60) {
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    // SIGKILL without waiting: the child stays a zombie until `wait` below.
+    let pid = first.id();
+    std::process::Command::new("kill")
+        .args(["-KILL", &pid.to_string()])
+        .status()
+        .unwrap();
+    while std::fs::read_to_string(format!("/proc/{pid}/stat"))
+        .is_ok_and(|s| !s.split(") ").nth(1).unwrap_or("").starts_with('Z'))
+    {
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    let o = small_direct(&out);
+    let _ = first.wait();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    complete_sets(&out);
+}
+
+/// A folder below `--out` that is a symbolic link is refused by name before any work, and
+/// nothing in the link's target changes — before, `reproduce … --only keller-tiles` with
+/// `keller/tiles` a link deleted every file in its target, and `laine-dispersion` with `laine`
+/// a link wrote outside the staging folder.
+#[cfg(unix)]
+#[test]
+fn a_link_below_out_is_refused_and_its_target_untouched() {
+    let tmp = tempfile::tempdir().unwrap();
+    let outside = tmp.path().join("outside");
+    std::fs::create_dir_all(&outside).unwrap();
+    std::fs::write(outside.join("precious.txt"), b"a user's file").unwrap();
+    for (link, only) in [("keller/tiles", "keller-tiles"), ("laine", "laine-dispersion")] {
+        let out = tmp.path().join(format!("out-{only}"));
+        let at = out.join(link);
+        std::fs::create_dir_all(at.parent().unwrap()).unwrap();
+        std::os::unix::fs::symlink(&outside, &at).unwrap();
+        let o = gibench()
+            .args(["reproduce", "all", "--quick", "--quiet", "--only", only])
+            .arg("--out")
+            .arg(&out)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success(), "{only}: {stderr}");
+        assert!(
+            stderr.contains("symbolic link") && stderr.contains(link) && stderr.contains("'out'"),
+            "{only}: {stderr}"
+        );
+        let names: Vec<String> = files(&outside).into_keys().collect();
+        assert_eq!(names, ["precious.txt"], "{only}");
+    }
+}

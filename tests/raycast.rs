@@ -163,6 +163,18 @@ fn bad_ray_folders_are_refused_by_name_and_write_nothing() {
         &["raycast", "--rays", e],
         &["rays", "rays-shadow.bin", "28 bytes"],
     );
+    // Links to a device that never ends: refused without reading (before, each grew until
+    // the address space ran out).
+    #[cfg(unix)]
+    for name in ["rays-shadow.bin", "scene.json"] {
+        let f = export.join(name);
+        let _ = std::fs::remove_file(&f);
+        std::os::unix::fs::symlink("/dev/zero", &f).unwrap();
+        fails(
+            &["raycast", "--rays", e],
+            &["rays", name, "not a regular file"],
+        );
+    }
 }
 
 /// A second export into a folder replaces the first one's meshes and rays (a scene of fewer

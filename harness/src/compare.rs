@@ -7,13 +7,16 @@
 //! figure: flushed wall time, else GPU timestamps), and for the whole frame where it was timed:
 //!
 //! * each repeat's median is divided by the calibration workload timed in the same session
-//!   ([`crate::calibrate`]; raw when a file has none), so drift between sessions cancels;
+//!   ([`crate::calibrate`]), so drift between sessions cancels — when every repeat of the run
+//!   on both sides has one; otherwise both sides are compared raw (the row says so);
 //! * the **ratio** is median(CURRENT) / median(BASE) over the repeats, normalised (and raw
 //!   beside it);
 //! * the **band** is [min CURRENT / max BASE, max CURRENT / min BASE]: every pairing of a
 //!   CURRENT repeat with a BASE repeat lies in it;
 //! * the **verdict** is *slower* when the whole band lies above 1 + tolerance, *faster* when it
-//!   lies below 1 / (1 + tolerance), and *unchanged* otherwise.
+//!   lies below 1 / (1 + tolerance), and *unchanged* otherwise. A stage timed at 0 ms in some
+//!   BASE repeat has no ratio: it is *slower* when every CURRENT repeat took time and every
+//!   BASE repeat none, *unchanged* otherwise (and the reverse for *faster*).
 //!
 //! CPU stages also report the median thread CPU time of each side.
 
@@ -56,12 +59,15 @@ pub struct CompareRow {
     /// Median over the repeats of each repeat's median, milliseconds.
     pub base_ms: f64,
     pub current_ms: f64,
-    /// current / base, raw.
-    pub ratio_raw: f64,
-    /// current / base, each repeat divided by its session's calibration.
-    pub ratio: f64,
-    /// The band of normalised ratios (see the module docs).
-    pub band: [f64; 2],
+    /// current / base, raw; `None` where a time is 0.
+    pub ratio_raw: Option<f64>,
+    /// current / base, each repeat divided by its session's calibration (raw where a repeat
+    /// has none: see `calibrated`); `None` where a time is 0.
+    pub ratio: Option<f64>,
+    /// Whether `ratio` and `band` are calibrated (every repeat on both sides has a calibration).
+    pub calibrated: bool,
+    /// The band of ratios (see the module docs); `None` where a time is 0.
+    pub band: Option<[f64; 2]>,
     pub verdict: Verdict,
     pub repeats: [usize; 2],
     /// CPU stages: median thread CPU time, base and current.
@@ -97,15 +103,23 @@ fn run_key(r: &RunResult) -> String {
     key
 }
 
-/// One stage of one run: (raw ms, calibrated, thread CPU ms).
+/// One stage of one run: (raw ms, calibrated or raw, thread CPU ms).
 type Figure = (f64, f64, Option<f64>);
 
-/// Per stage (and "frame"): the [`Figure`] of one run.
-fn figures(r: &RunResult) -> BTreeMap<String, Figure> {
-    let scale = r
-        .calibration_ms
-        .filter(|c| c.is_finite() && *c > 0.0)
-        .map_or(1.0, |c| 1.0 / c);
+/// Whether `r` carries a calibration that can be divided by.
+fn has_calibration(r: &RunResult) -> bool {
+    r.calibration_ms.is_some_and(|c| {
+        (crate::results::CALIBRATION_MS.0..=crate::results::CALIBRATION_MS.1).contains(&c)
+    })
+}
+
+/// Per stage (and "frame"): the [`Figure`] of one run, its second value divided by the run's
+/// calibration when `calibrated`.
+fn figures(r: &RunResult, calibrated: bool) -> BTreeMap<String, Figure> {
+    let scale = match r.calibration_ms {
+        Some(c) if calibrated => 1.0 / c,
+        _ => 1.0,
+    };
     let mut out = BTreeMap::new();
     for s in &r.stages {
         if let Some(ms) = stage_ms(s).filter(|m| m.is_finite()) {
@@ -120,6 +134,37 @@ fn figures(r: &RunResult) -> BTreeMap<String, Figure> {
         }
     }
     out
+}
+
+/// The band and verdict for one stage's repeats (see the module docs): `base` and `current`
+/// are each repeat's figure, non-negative.
+pub fn judge(base: &[f64], current: &[f64], tolerance: f64) -> (Option<[f64; 2]>, Verdict) {
+    let max_of = |v: &[f64]| v.iter().copied().fold(0.0, f64::max);
+    let min_of = |v: &[f64]| v.iter().copied().fold(f64::INFINITY, f64::min);
+    if min_of(base) <= 0.0 || min_of(current) <= 0.0 {
+        let verdict = if max_of(base) == 0.0 && min_of(current) > 0.0 {
+            Verdict::Slower
+        } else if max_of(current) == 0.0 && min_of(base) > 0.0 {
+            Verdict::Faster
+        } else {
+            Verdict::Unchanged
+        };
+        return (None, verdict);
+    }
+    let band = [min_of(current) / max_of(base), max_of(current) / min_of(base)];
+    let verdict = if band[0] > 1.0 + tolerance {
+        Verdict::Slower
+    } else if band[1] < 1.0 / (1.0 + tolerance) {
+        Verdict::Faster
+    } else {
+        Verdict::Unchanged
+    };
+    (Some(band), verdict)
+}
+
+/// `a / b`, or `None` when either is 0.
+fn ratio(a: f64, b: f64) -> Option<f64> {
+    (a > 0.0 && b > 0.0).then(|| a / b)
 }
 
 /// Runs grouped by [`run_key`].
@@ -164,8 +209,9 @@ pub fn compare(
                 )));
             }
         }
-        let bf: Vec<_> = bs.iter().map(|r| figures(r)).collect();
-        let cf: Vec<_> = cs.iter().map(|r| figures(r)).collect();
+        let calibrated = bs.iter().chain(cs.iter()).all(|r| has_calibration(r));
+        let bf: Vec<_> = bs.iter().map(|r| figures(r, calibrated)).collect();
+        let cf: Vec<_> = cs.iter().map(|r| figures(r, calibrated)).collect();
         let mut stages: Vec<String> = Vec::new();
         for f in bf.iter().chain(&cf) {
             for name in f.keys() {
@@ -191,23 +237,16 @@ pub fn compare(
                 (!c.is_empty()).then(|| median(&c))
             };
             let (bn, cn) = (norm(&bv), norm(&cv));
-            let max_of = |v: &[f64]| v.iter().copied().fold(f64::MIN, f64::max);
-            let min_of = |v: &[f64]| v.iter().copied().fold(f64::MAX, f64::min);
-            let band = [min_of(&cn) / max_of(&bn), max_of(&cn) / min_of(&bn)];
-            let verdict = if band[0] > 1.0 + tolerance {
-                Verdict::Slower
-            } else if band[1] < 1.0 / (1.0 + tolerance) {
-                Verdict::Faster
-            } else {
-                Verdict::Unchanged
-            };
+            let (band, verdict) = judge(&bn, &cn, tolerance);
+            let (base_ms, current_ms) = (median(&raw(&bv)), median(&raw(&cv)));
             rows.push(CompareRow {
                 run: key.clone(),
                 stage,
-                base_ms: median(&raw(&bv)),
-                current_ms: median(&raw(&cv)),
-                ratio_raw: median(&raw(&cv)) / median(&raw(&bv)),
-                ratio: median(&cn) / median(&bn),
+                base_ms,
+                current_ms,
+                ratio_raw: ratio(current_ms, base_ms),
+                ratio: ratio(median(&cn), median(&bn)),
+                calibrated,
                 band,
                 verdict,
                 repeats: [bv.len(), cv.len()],
@@ -241,9 +280,16 @@ pub fn compare_table(rows: &[CompareRow], tolerance: f64) -> Table {
                 Cell::text(&r.stage),
                 Cell::Ms(Some(r.base_ms)),
                 Cell::Ms(Some(r.current_ms)),
-                Cell::Num(Some(r.ratio_raw), 3),
-                Cell::Num(Some(r.ratio), 3),
-                Cell::text(format!("{:.3}–{:.3}", r.band[0], r.band[1])),
+                Cell::Num(r.ratio_raw, 3),
+                Cell::Num(r.ratio.filter(|_| r.calibrated), 3),
+                Cell::text(r.band.map_or("–".to_string(), |[a, b]| {
+                    format!(
+                        "{}–{}{}",
+                        Cell::Num(Some(a), 3).display(),
+                        Cell::Num(Some(b), 3).display(),
+                        if r.calibrated { "" } else { " (raw)" }
+                    )
+                })),
                 Cell::text(r.verdict.name()),
                 Cell::text(
                     r.cpu_ms
@@ -264,8 +310,10 @@ pub fn compare_table(rows: &[CompareRow], tolerance: f64) -> Table {
         notes: vec![format!(
             "Per stage, the median over the repeats of each repeat's median (ms). Ratios are CURRENT / BASE; \
              \"calibrated\" divides each repeat by the calibration workload timed in its session. Band: every \
-             pairing of a CURRENT repeat with a BASE repeat (calibrated). Verdict: slower when the whole band \
-             is above {:.2}, faster when it is below {:.3}, else unchanged (tolerance {tolerance}).",
+             pairing of a CURRENT repeat with a BASE repeat (calibrated; \"(raw)\" where a repeat on either side has \
+             no calibration, and then both sides are compared raw). Verdict: slower when the whole band \
+             is above {:.2}, faster when it is below {:.3}, else unchanged (tolerance {tolerance}); a stage \
+             timed at 0 ms has no ratio.",
             1.0 + tolerance,
             1.0 / (1.0 + tolerance)
         )],
@@ -278,7 +326,7 @@ mod tests {
     use crate::results::{StageKind, StageResult};
     use crate::stats::Stats;
 
-    fn run(stages: &[(&str, f64)], calibration: f64) -> RunResult {
+    fn run(stages: &[(&str, f64)], calibration: impl Into<Option<f64>>) -> RunResult {
         let mut r: RunResult = serde_json::from_value(serde_json::json!({
             "schema_version": crate::results::SCHEMA_VERSION,
             "gibench_version": "0", "git_commit": "x", "timestamp": 0, "scene": "cornell",
@@ -289,7 +337,7 @@ mod tests {
             "stages": [], "frame": null
         }))
         .unwrap();
-        r.calibration_ms = Some(calibration);
+        r.calibration_ms = calibration.into();
         r.stages = stages
             .iter()
             .map(|(name, ms)| StageResult {
@@ -340,6 +388,73 @@ mod tests {
         assert!(
             e.contains("BASE has 2 repeat(s) of cornell/direct/64x48"),
             "{e}"
+        );
+    }
+
+    /// The band's edges decide exactly: a band wholly above 1 + tolerance is slower, one
+    /// touching it is not; wholly below 1 / (1 + tolerance) is faster.
+    #[test]
+    fn the_verdict_is_decided_by_the_band_edges() {
+        let (band, v) = judge(&[1.0, 2.0, 1.5], &[2.4, 2.5, 2.45], 0.1);
+        assert_eq!(band, Some([1.2, 2.5]));
+        assert_eq!(v, Verdict::Slower);
+        let (_, v) = judge(&[1.0, 2.0], &[2.2, 3.0], 0.1);
+        assert_eq!(v, Verdict::Unchanged, "band [1.1, 3]: its lower edge is not above 1.1");
+        let (_, v) = judge(&[2.0, 2.0], &[1.0, 1.8], 0.1);
+        assert_eq!(v, Verdict::Faster, "band [0.5, 0.9] lies below 1/1.1");
+        let (_, v) = judge(&[2.0, 2.0], &[1.0, 1.85], 0.1);
+        assert_eq!(v, Verdict::Unchanged, "band [0.5, 0.925]");
+    }
+
+    /// A side whose files carry no calibration: both sides are compared raw. Before, the
+    /// calibrated side was divided by its 10 ms and the other not, and every stage was
+    /// "slower" (or "faster") although the times were the same.
+    #[test]
+    fn a_side_without_calibration_is_compared_raw() {
+        let side = |calibration: Option<f64>| -> Vec<RunResult> {
+            [1.0, 1.02, 0.99]
+                .iter()
+                .map(|n| run(&[("a", 2.0 * n), ("b", 5.0 * n)], calibration))
+                .collect()
+        };
+        for (base, current) in [(Some(10.0), None), (None, Some(10.0))] {
+            let rows = compare(&side(base), &side(current), 0.1).unwrap();
+            assert_eq!(rows.len(), 2);
+            for r in &rows {
+                assert_eq!(r.verdict, Verdict::Unchanged, "{r:?}");
+                assert!(!r.calibrated);
+                assert!((r.ratio.unwrap() - 1.0).abs() < 1e-12, "{r:?}");
+            }
+        }
+        // One repeat without calibration among calibrated ones: raw as well.
+        let mut mixed = side(Some(10.0));
+        mixed[1].calibration_ms = None;
+        let rows = compare(&side(Some(10.0)), &mixed, 0.1).unwrap();
+        assert!(rows.iter().all(|r| !r.calibrated && r.verdict == Verdict::Unchanged));
+        let table = compare_table(&rows, 0.1).to_terminal();
+        assert!(table.contains("(raw)"), "{table}");
+    }
+
+    /// A stage timed at 0 ms has no ratio (before: "inf–inf" and a verdict from it); a stage
+    /// that took no time before and takes some now is slower, and the reverse faster.
+    #[test]
+    fn zero_ms_stages_have_no_ratio() {
+        let side = |a: f64, b: f64| -> Vec<RunResult> {
+            (0..3).map(|_| run(&[("a", a), ("b", b)], 10.0)).collect()
+        };
+        let rows = compare(&side(0.0, 0.0), &side(0.0, 1.0), 0.1).unwrap();
+        let row = |s: &str| rows.iter().find(|r| r.stage == s).unwrap();
+        assert_eq!(row("a").verdict, Verdict::Unchanged);
+        assert_eq!(row("b").verdict, Verdict::Slower);
+        for r in &rows {
+            assert!(r.ratio.is_none() && r.ratio_raw.is_none() && r.band.is_none(), "{r:?}");
+        }
+        let table = compare_table(&rows, 0.1).to_terminal();
+        assert!(!table.contains("inf"), "{table}");
+        let rows = compare(&side(1.0, 1.0), &side(0.0, 1.0), 0.1).unwrap();
+        assert_eq!(
+            rows.iter().find(|r| r.stage == "a").unwrap().verdict,
+            Verdict::Faster
         );
     }
 }

@@ -63,7 +63,7 @@ impl Error {
 /// [`crate::output::OutputSet`] is open on a folder holding `path`, the file is staged there and
 /// appears at `path` when the set is published.
 pub fn write_atomic(path: &std::path::Path, bytes: &[u8]) -> Result<()> {
-    match crate::output::staged_path(path) {
+    match crate::output::staged_path(path)? {
         Some(staged) => write_atomic_direct(&staged, bytes),
         None => write_atomic_direct(path, bytes),
     }
@@ -99,6 +99,20 @@ pub fn write_atomic_direct(path: &std::path::Path, bytes: &[u8]) -> Result<()> {
     }
     tmp.persist(path).map_err(|e| Error::io(path, e.error))?;
     Ok(())
+}
+
+/// Parses JSON `bytes` as `T`. A failure says where: the path of the field that failed
+/// (`light.path.keys[1].position`) before serde's message (which gives the line and column).
+pub fn from_json<T: serde::de::DeserializeOwned>(bytes: &[u8]) -> std::result::Result<T, String> {
+    let mut de = serde_json::Deserializer::from_slice(bytes);
+    serde_path_to_error::deserialize(&mut de).map_err(|e| {
+        let path = e.path().to_string();
+        if path == "." || path.is_empty() {
+            e.into_inner().to_string()
+        } else {
+            format!("{path}: {}", e.into_inner())
+        }
+    })
 }
 
 /// Reads the regular file `path` whole, refusing anything else (a device such as `/dev/zero`, a

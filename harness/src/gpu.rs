@@ -7,6 +7,7 @@
 //! adapter (Mesa lavapipe), then GL (Mesa llvmpipe), then anything else.
 
 use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
 
 use crate::results::DeviceInfo;
 use crate::{Error, Result};
@@ -18,7 +19,18 @@ pub struct GpuOptions {
     pub backend: Option<String>,
     /// Case-insensitive substring of the adapter name.
     pub adapter: Option<String>,
+    /// The longest one wait for the GPU may last before it fails, seconds (`--gpu-timeout`);
+    /// `None` waits as long as the work takes.
+    pub gpu_timeout: Option<f64>,
 }
+
+/// One blocking wait is at most this long and is then renewed: wgpu's GL backend caps a fence
+/// wait at `u32::MAX` nanoseconds (about 4.3 s) and reports a timeout past it even when asked to
+/// wait indefinitely, while one submission on a CPU driver (llvmpipe) can take longer than that.
+const WAIT_SLICE: Duration = Duration::from_secs(1);
+
+/// After this long waiting for one submission, a line on standard error says so (once).
+const WAIT_NOTICE: Duration = Duration::from_secs(30);
 
 /// Optional features the harness uses when the adapter has them.
 const OPTIONAL_FEATURES: wgpu::Features =
@@ -34,6 +46,7 @@ pub struct GpuContext {
     /// Timestamp queries can be written between passes (`write_timestamp` on encoders).
     pub timestamps: bool,
     errors: Arc<Mutex<Vec<String>>>,
+    wait_limit: Option<Duration>,
 }
 
 /// The environment variable the command line reads `--backend` from when it is not given.
@@ -46,7 +59,20 @@ impl GpuOptions {
         if let Some(b) = &self.backend {
             parse_backend(b)?;
         }
+        self.wait_limit()?;
         Ok(())
+    }
+
+    /// `gpu_timeout` as a duration; refused unless a number of seconds in (0, 1e6].
+    fn wait_limit(&self) -> Result<Option<Duration>> {
+        match self.gpu_timeout {
+            None => Ok(None),
+            Some(s) if s.is_finite() && s > 0.0 && s <= 1e6 => Ok(Some(Duration::from_secs_f64(s))),
+            Some(s) => Err(Error::param(
+                "gpu-timeout",
+                format!("expected a number of seconds above 0 and at most 1e6 (got {s})"),
+            )),
+        }
     }
 }
 
@@ -99,7 +125,7 @@ pub fn available_backends() -> Vec<&'static str> {
         .filter(|b| {
             GpuContext::new(&GpuOptions {
                 backend: Some(b.to_string()),
-                adapter: None,
+                ..Default::default()
             })
             .is_ok()
         })
@@ -116,6 +142,7 @@ pub fn say_uncaptured(message: &str) {
 impl GpuContext {
     /// Picks an adapter and creates the device.
     pub fn new(opts: &GpuOptions) -> Result<GpuContext> {
+        let wait_limit = opts.wait_limit()?;
         let backends = match &opts.backend {
             Some(b) => parse_backend(b)?,
             None => wgpu::Backends::all(),
@@ -218,27 +245,60 @@ impl GpuContext {
             info,
             timestamps,
             errors,
+            wait_limit,
         })
     }
 
     /// Blocks until all submitted GPU work has finished. Only the profiler and explicit
     /// readbacks call this.
     pub fn flush(&self) -> Result<()> {
-        self.device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| Error::Gpu(format!("waiting for the GPU failed: {e}")))?;
+        self.wait(None)?;
         self.check_errors()
     }
 
     /// Blocks until the given submission has finished.
     pub fn wait_for(&self, index: wgpu::SubmissionIndex) -> Result<()> {
-        self.device
-            .poll(wgpu::PollType::Wait {
-                submission_index: Some(index),
-                timeout: None,
-            })
-            .map_err(|e| Error::Gpu(format!("waiting for the GPU failed: {e}")))?;
-        Ok(())
+        self.wait(Some(index))
+    }
+
+    /// Waits for `index` (the latest submission when `None`) in slices of [`WAIT_SLICE`], as
+    /// long as the work takes or up to the user's `--gpu-timeout`; a long wait is announced
+    /// once on standard error.
+    fn wait(&self, index: Option<wgpu::SubmissionIndex>) -> Result<()> {
+        let start = Instant::now();
+        let mut announced = false;
+        loop {
+            let poll = wgpu::PollType::Wait {
+                submission_index: index.clone(),
+                timeout: Some(WAIT_SLICE),
+            };
+            match self.device.poll(poll) {
+                Ok(_) => return Ok(()),
+                Err(wgpu::PollError::Timeout) => {
+                    let waited = start.elapsed();
+                    if let Some(limit) = self.wait_limit.filter(|l| waited >= *l) {
+                        return Err(Error::param(
+                            "gpu-timeout",
+                            format!(
+                                "the GPU ({}) did not finish one submission within {:.1} s",
+                                self.info.adapter,
+                                limit.as_secs_f64()
+                            ),
+                        ));
+                    }
+                    if !announced && waited >= WAIT_NOTICE {
+                        announced = true;
+                        eprintln!(
+                            "note: still waiting for the GPU ({}) after {:.0} s on one submission; \
+                             gibench waits as long as it takes (--gpu-timeout sets a limit)",
+                            self.info.adapter,
+                            waited.as_secs_f64()
+                        );
+                    }
+                }
+                Err(e) => return Err(Error::Gpu(format!("waiting for the GPU failed: {e}"))),
+            }
+        }
     }
 
     /// Turns GPU validation errors collected so far into an error.

@@ -2,9 +2,13 @@
 //!
 //! A command that writes into a folder opens an [`OutputSet`] on it before any expensive work:
 //!
-//! * it takes the folder's lock (`.gibench.lock`, holding the process id): a second command
-//!   into a folder in use is refused, naming `--out`; a lock whose process is gone (a killed
-//!   run) is taken over, after finishing or undoing what that run left (below);
+//! * it refuses a folder below it that is a symbolic link, naming it, so that no file outside
+//!   the folder is written, moved or removed through one;
+//! * it takes the folder's lock: the operating system's exclusive lock on `.gibench.lock`
+//!   (which also holds the process id, for messages). A second command into a folder in use is
+//!   refused, naming `--out`; the lock of a killed run is released by the operating system
+//!   when its process ends (a zombie too), and the next command finishes or undoes what that
+//!   run left (below);
 //! * while the set is open, every file written with [`crate::error::write_atomic`] under the
 //!   folder goes to a hidden staging folder (`.gibench-staging/`) instead;
 //! * [`OutputSet::publish`] lists the staged files in a journal (`.gibench-publish`), moves them
@@ -38,6 +42,8 @@ const JOURNAL: &str = ".gibench-publish";
 /// subfolders it replaces and the file patterns it replaces in the folder itself.
 struct Active {
     dir: PathBuf,
+    /// The folder as the command named it, made absolute lexically (links not resolved).
+    given: PathBuf,
     staged: Vec<PathBuf>,
     replaced: Vec<PathBuf>,
     patterns: Vec<String>,
@@ -59,6 +65,8 @@ pub struct OutputSet {
     published: bool,
     /// The folders `begin` created, deepest first (an unpublished set removes them if empty).
     created: Vec<PathBuf>,
+    /// Held until the set is closed.
+    lock: Option<FolderLock>,
 }
 
 /// `path` made absolute against the working directory and with `.` and `..` resolved lexically.
@@ -97,8 +105,8 @@ pub fn without_cur_dirs(path: &Path) -> PathBuf {
 }
 
 /// Whether process `pid` is alive and runs the same program as this one (Linux: `/proc/PID`
-/// and its `comm`, so a pid reused by another program does not hold a folder; elsewhere every
-/// lock is taken as live).
+/// and its `comm`, so a pid reused by another program is not taken for it; elsewhere every
+/// process is taken as live): a temporary file of a live process is left alone.
 fn alive(pid: u32) -> bool {
     if cfg!(target_os = "linux") {
         if pid == std::process::id() {
@@ -138,6 +146,162 @@ fn resolve(path: &Path) -> PathBuf {
     }
 }
 
+/// Why the folder's lock could not be taken.
+#[derive(Debug)]
+enum LockError {
+    /// Another process holds it (its process id, if it has written it yet).
+    InUse(Option<u32>),
+    Other(String),
+}
+
+/// The operating system's exclusive lock on a folder's `.gibench.lock`, held while the file is
+/// open and released by the operating system when the process ends, however it ends.
+#[derive(Debug)]
+struct FolderLock {
+    file: std::fs::File,
+    path: PathBuf,
+}
+
+impl FolderLock {
+    /// Takes the lock of `dir` (which exists), writing this process's id into the lock file.
+    fn take(dir: &Path) -> std::result::Result<FolderLock, LockError> {
+        use std::io::Write;
+        let path = dir.join(LOCK);
+        if path.is_dir() {
+            return Err(LockError::Other(format!(
+                "{} is a folder, not gibench's lock file; remove it",
+                path.display()
+            )));
+        }
+        let other = |what: &str, e: std::io::Error| {
+            LockError::Other(format!("cannot {what} {}: {e}", path.display()))
+        };
+        loop {
+            let mut file = std::fs::OpenOptions::new()
+                .read(true)
+                .write(true)
+                .create(true)
+                .truncate(false)
+                .open(&path)
+                .map_err(|e| other("open", e))?;
+            match file.try_lock() {
+                Ok(()) => {}
+                Err(std::fs::TryLockError::WouldBlock) => {
+                    let pid = std::fs::read_to_string(&path)
+                        .ok()
+                        .and_then(|s| s.trim().parse::<u32>().ok());
+                    return Err(LockError::InUse(pid));
+                }
+                Err(std::fs::TryLockError::Error(e)) => return Err(other("lock", e)),
+            }
+            // A command that finishes removes its lock file while holding the lock; one that
+            // opened the file before that holds the lock of a removed file, and tries again.
+            if !same_file(&file, &path) {
+                continue;
+            }
+            file.set_len(0).map_err(|e| other("write", e))?;
+            file.write_all(std::process::id().to_string().as_bytes())
+                .map_err(|e| other("write", e))?;
+            return Ok(FolderLock { file, path });
+        }
+    }
+
+    /// Removes the lock file (where the platform lets a lock's file be identified, so that a
+    /// removed one is never mistaken for the current one), then releases the lock.
+    fn release(self) {
+        if cfg!(unix) {
+            let _ = std::fs::remove_file(&self.path);
+        }
+        drop(self.file);
+    }
+}
+
+/// Whether the open `file` is the file now at `path`.
+#[cfg(unix)]
+fn same_file(file: &std::fs::File, path: &Path) -> bool {
+    use std::os::unix::fs::MetadataExt;
+    match (file.metadata(), std::fs::metadata(path)) {
+        (Ok(a), Ok(b)) => a.dev() == b.dev() && a.ino() == b.ino(),
+        _ => false,
+    }
+}
+
+/// Elsewhere the lock file is never removed, so the open file is the one at `path`.
+#[cfg(not(unix))]
+fn same_file(_: &std::fs::File, path: &Path) -> bool {
+    path.is_file()
+}
+
+/// Refuses `dir` if a folder below it (not `dir` itself) is a symbolic link: a command writes,
+/// replaces and removes files under `--out`, and through a link those would be another
+/// folder's. The error names the link and `option`.
+fn refuse_links_below(dir: &Path, option: &str) -> Result<()> {
+    if let Some(link) = first_link_below(dir) {
+        return Err(Error::param(
+            option,
+            format!(
+                "{} is a symbolic link; gibench writes and replaces files below the output folder \
+                 and does not follow links out of it (replace the link by a folder, or give its \
+                 target as the output folder)",
+                link.display()
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// The first symbolic link found below `dir` (links are not followed; the staging folder is
+/// skipped), if any.
+fn first_link_below(dir: &Path) -> Option<PathBuf> {
+    let mut stack = vec![dir.to_path_buf()];
+    let mut seen = 0usize;
+    while let Some(d) = stack.pop() {
+        // A huge tree (`--out` a home folder) is not walked whole: the writes and replacements
+        // themselves refuse links too (`staged_path`, `replace`, publication).
+        seen += 1;
+        if seen > MAX_FOLDERS_WALKED {
+            return None;
+        }
+        let Ok(entries) = std::fs::read_dir(&d) else {
+            continue;
+        };
+        let mut entries: Vec<_> = entries.flatten().collect();
+        entries.sort_by_key(|e| e.file_name());
+        for e in entries {
+            if d == dir && e.file_name() == STAGING {
+                continue;
+            }
+            let Ok(kind) = e.file_type() else { continue };
+            if kind.is_symlink() {
+                // A link to a file is replaced, not written through, by every write; a link to
+                // a folder (or a dangling one, which a write would create a folder through) is
+                // refused.
+                if !e.path().is_file() {
+                    return Some(e.path());
+                }
+            } else if kind.is_dir() {
+                stack.push(e.path());
+            }
+        }
+    }
+    None
+}
+
+/// Folders [`first_link_below`] looks into at most.
+const MAX_FOLDERS_WALKED: usize = 20_000;
+
+/// Whether a component of `rel` below `dir` (`dir` itself excluded) is a symbolic link.
+fn link_on_the_way(dir: &Path, rel: &Path) -> bool {
+    let mut at = dir.to_path_buf();
+    for c in rel.components() {
+        at.push(c);
+        if std::fs::symlink_metadata(&at).is_ok_and(|m| m.file_type().is_symlink()) {
+            return true;
+        }
+    }
+    false
+}
+
 impl OutputSet {
     /// Opens the set on `dir` (created if needed); `option` names the command-line option in
     /// errors (`out`).
@@ -147,6 +311,7 @@ impl OutputSet {
             return Err(fail("another output set is open in this process".into()));
         }
         let dir = &without_cur_dirs(dir);
+        let given = dir.clone();
         let created: Vec<PathBuf> = dir
             .ancestors()
             .take_while(|a| !a.as_os_str().is_empty() && !a.exists())
@@ -158,50 +323,20 @@ impl OutputSet {
         let dir = &dir
             .canonicalize()
             .map_err(|e| fail(format!("{shown} is not a writable folder: {e}")))?;
-        let lock = dir.join(LOCK);
-        if lock.is_dir() {
-            return Err(fail(format!(
-                "{} is a folder, not gibench's lock file; remove it",
-                lock.display()
-            )));
-        }
-        loop {
-            match std::fs::OpenOptions::new()
-                .write(true)
-                .create_new(true)
-                .open(&lock)
-            {
-                Ok(mut f) => {
-                    use std::io::Write;
-                    f.write_all(std::process::id().to_string().as_bytes())
-                        .map_err(|e| fail(format!("cannot write {}: {e}", lock.display())))?;
-                    break;
-                }
-                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
-                    let owner = std::fs::read_to_string(&lock)
-                        .ok()
-                        .and_then(|s| s.trim().parse::<u32>().ok());
-                    match owner {
-                        Some(pid) if alive(pid) => {
-                            return Err(fail(format!(
-                                "{shown} is in use by another gibench command (process {pid}); wait for it or choose another folder"
-                            )))
-                        }
-                        _ => {
-                            // Left by a killed run: finish or undo it, then take the lock.
-                            recover(dir)?;
-                            std::fs::remove_file(&lock).map_err(|e| Error::io(&lock, e))?;
-                        }
-                    }
-                }
-                Err(e) => return Err(fail(format!("{shown} is not a writable folder: {e}"))),
-            }
-        }
+        refuse_links_below(dir, option)?;
+        let lock = FolderLock::take(dir).map_err(|e| match e {
+            LockError::InUse(pid) => fail(format!(
+                "{shown} is in use by another gibench command ({}); wait for it or choose another folder",
+                pid.map_or("process unknown".to_string(), |p| format!("process {p}"))
+            )),
+            LockError::Other(what) => fail(format!("{shown}: {what}")),
+        })?;
         let set = OutputSet {
             dir: dir.to_path_buf(),
             option: option.to_string(),
             published: false,
             created,
+            lock: Some(lock),
         };
         recover(dir)?;
         let staging = dir.join(STAGING);
@@ -211,6 +346,7 @@ impl OutputSet {
             .map_err(|_| fail("output state poisoned".into()))?;
         *active = Some(Active {
             dir: dir.to_path_buf(),
+            given: absolute(&given),
             staged: Vec::new(),
             replaced: Vec::new(),
             patterns: Vec::new(),
@@ -241,6 +377,15 @@ impl OutputSet {
             return Err(Error::param(
                 &self.option,
                 format!("{} is not a plain subfolder name", sub.display()),
+            ));
+        }
+        if link_on_the_way(&self.dir, sub) {
+            return Err(Error::param(
+                &self.option,
+                format!(
+                    "{} is or lies under a symbolic link; gibench does not replace files through links",
+                    self.dir.join(sub).display()
+                ),
             ));
         }
         let mut active = ACTIVE
@@ -303,10 +448,12 @@ impl OutputSet {
 
     /// Removes the staging folder, the journal and the lock (and, unpublished, the folder
     /// itself if this set created it and it is empty).
-    fn close(&self) {
+    fn close(&mut self) {
         let _ = std::fs::remove_dir_all(self.dir.join(STAGING));
         let _ = std::fs::remove_file(self.dir.join(JOURNAL));
-        let _ = std::fs::remove_file(self.dir.join(LOCK));
+        if let Some(lock) = self.lock.take() {
+            lock.release();
+        }
         if !self.published {
             for d in &self.created {
                 let _ = std::fs::remove_dir(d);
@@ -360,6 +507,12 @@ fn move_staged(dir: &Path) -> Result<()> {
         if !from.exists() {
             continue;
         }
+        if rel.parent().is_some_and(|p| link_on_the_way(dir, p)) {
+            return Err(Error::Invalid(format!(
+                "{} lies under a symbolic link; gibench does not write through links",
+                to.display()
+            )));
+        }
         if let Some(parent) = to.parent() {
             std::fs::create_dir_all(parent).map_err(|e| Error::io(parent, e))?;
         }
@@ -372,6 +525,12 @@ fn move_staged(dir: &Path) -> Result<()> {
 /// path relative to `dir` is not in `keep`, then the folders left empty.
 fn remove_unlisted(dir: &Path, sub: &Path, keep: &std::collections::HashSet<&Path>) -> Result<()> {
     let folder = dir.join(sub);
+    if link_on_the_way(dir, sub) {
+        return Err(Error::Invalid(format!(
+            "{} is or lies under a symbolic link; gibench does not remove files through links",
+            folder.display()
+        )));
+    }
     let Ok(entries) = std::fs::read_dir(&folder) else {
         return Ok(());
     };
@@ -484,19 +643,40 @@ fn recover(dir: &Path) -> Result<()> {
 }
 
 /// Where a write to `path` must go while a set is open: its staged path, recorded for
-/// publication; `None` when `path` is outside the open set's folder (or none is open).
-pub(crate) fn staged_path(path: &Path) -> Option<PathBuf> {
-    let mut active = ACTIVE.lock().ok()?;
-    let a = active.as_mut()?;
-    let rel = resolve(path).strip_prefix(&a.dir).ok()?.to_path_buf();
+/// publication; `None` when `path` is outside the open set's folder (or none is open). A path
+/// named below the folder that a symbolic link takes out of it is an error.
+pub(crate) fn staged_path(path: &Path) -> Result<Option<PathBuf>> {
+    let Ok(mut active) = ACTIVE.lock() else {
+        return Ok(None);
+    };
+    let Some(a) = active.as_mut() else {
+        return Ok(None);
+    };
+    let Ok(rel) = resolve(path).strip_prefix(&a.dir).map(Path::to_path_buf) else {
+        if absolute(path).starts_with(&a.given) {
+            return Err(Error::Invalid(format!(
+                "{} lies under a symbolic link out of the output folder {}; gibench does not \
+                 write through links",
+                path.display(),
+                a.given.display()
+            )));
+        }
+        return Ok(None);
+    };
     if rel.as_os_str().is_empty() || rel.starts_with(STAGING) {
-        return None;
+        return Ok(None);
+    }
+    if rel.parent().is_some_and(|p| link_on_the_way(&a.dir, p)) {
+        return Err(Error::Invalid(format!(
+            "{} lies under a symbolic link; gibench does not write through links",
+            path.display()
+        )));
     }
     let staged = a.dir.join(STAGING).join(&rel);
     if !a.staged.contains(&rel) {
         a.staged.push(rel);
     }
-    Some(staged)
+    Ok(Some(staged))
 }
 
 /// Removes temporary files (`.gibench-tmp-PID-*`) in `dir` whose process is gone: what a killed
@@ -519,3 +699,85 @@ pub fn remove_stale_temporaries(dir: &Path) {
 
 /// Prefix of every temporary file gibench writes (then `PID-`).
 pub(crate) const TEMP_PREFIX: &str = ".gibench-tmp-";
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Threads started together on a folder with a stale lock file (a dead run's process id):
+    /// exactly one holds the lock at a time. The process-id lock this replaced let two take over
+    /// the stale lock together (each removed the other's), or failed on the removed file.
+    #[test]
+    fn one_lock_owner_among_racing_takers() {
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path();
+        for round in 0..40 {
+            std::fs::write(dir.join(LOCK), b"999999999").unwrap();
+            let threads = 6;
+            let barrier = std::sync::Barrier::new(threads);
+            let held = std::sync::atomic::AtomicUsize::new(0);
+            let most = std::sync::atomic::AtomicUsize::new(0);
+            let errors = Mutex::new(Vec::new());
+            std::thread::scope(|s| {
+                for _ in 0..threads {
+                    s.spawn(|| {
+                        use std::sync::atomic::Ordering::SeqCst;
+                        barrier.wait();
+                        match FolderLock::take(dir) {
+                            Ok(lock) => {
+                                let now = held.fetch_add(1, SeqCst) + 1;
+                                most.fetch_max(now, SeqCst);
+                                std::thread::sleep(std::time::Duration::from_millis(2));
+                                held.fetch_sub(1, SeqCst);
+                                lock.release();
+                            }
+                            Err(LockError::InUse(_)) => {}
+                            Err(e) => errors.lock().unwrap().push(format!("{e:?}")),
+                        }
+                    });
+                }
+            });
+            let errors = errors.into_inner().unwrap();
+            assert!(errors.is_empty(), "round {round}: {errors:?}");
+            assert_eq!(
+                most.load(std::sync::atomic::Ordering::SeqCst),
+                1,
+                "round {round}: two held the lock at once"
+            );
+        }
+    }
+
+    /// A replaced subfolder that is a symbolic link to a folder outside: publication removes
+    /// nothing there (before, every file in the link's target was deleted).
+    #[cfg(unix)]
+    #[test]
+    fn nothing_is_removed_through_a_link() {
+        let tmp = tempfile::tempdir().unwrap();
+        let (out, outside) = (tmp.path().join("out"), tmp.path().join("outside"));
+        std::fs::create_dir_all(&out).unwrap();
+        std::fs::create_dir_all(&outside).unwrap();
+        std::fs::write(outside.join("precious.txt"), b"mine").unwrap();
+        // Declared while the link is absent, made a link before publication (another process
+        // could do this mid-run): the declaration check cannot see it, publication must.
+        let set = OutputSet::begin("out", &out).unwrap();
+        set.replace(Path::new("tiles")).unwrap();
+        std::os::unix::fs::symlink(&outside, out.join("tiles")).unwrap();
+        let e = set.publish().unwrap_err().to_string();
+        assert!(e.contains("symbolic link"), "{e}");
+        assert!(outside.join("precious.txt").exists());
+        // With the link present before the command: refused when the set opens, naming it.
+        let e = OutputSet::begin("out", &out).err().unwrap().to_string();
+        assert!(e.contains("'out'") && e.contains("tiles"), "{e}");
+        // And a write below the link is refused rather than made outside.
+        std::fs::remove_file(out.join("tiles")).unwrap();
+        let set = OutputSet::begin("out", &out).unwrap();
+        std::os::unix::fs::symlink(&outside, out.join("tiles")).unwrap();
+        let e = crate::error::write_atomic(&out.join("tiles/new.txt"), b"x")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("symbolic link"), "{e}");
+        assert!(!outside.join("new.txt").exists());
+        drop(set);
+        assert!(outside.join("precious.txt").exists());
+    }
+}

@@ -83,11 +83,13 @@ impl Cell {
         match self {
             Cell::Text(s) => s.clone(),
             Cell::Ms(v) => match finite(*v) {
+                Some(v) if v.abs() >= LARGE => format!("{v:.3e}"),
                 Some(v) if v != 0.0 && v.abs() < 0.1 => format!("{v:.3}"),
                 Some(v) => format!("{v:.2}"),
                 None => MISSING.to_string(),
             },
             Cell::Num(v, d) => match finite(*v) {
+                Some(v) if v.abs() >= LARGE => format!("{v:.3e}"),
                 Some(v) => format!("{v:.*}", *d as usize),
                 None => MISSING.to_string(),
             },
@@ -98,9 +100,17 @@ impl Cell {
     fn csv(&self) -> String {
         match self {
             Cell::Text(s) => s.clone(),
-            Cell::Ms(v) => finite(*v).map(|v| format!("{v:.4}")).unwrap_or_default(),
+            Cell::Ms(v) => finite(*v)
+                .map(|v| match v.abs() >= LARGE {
+                    true => format!("{v:e}"),
+                    false => format!("{v:.4}"),
+                })
+                .unwrap_or_default(),
             Cell::Num(v, d) => finite(*v)
-                .map(|v| format!("{v:.*}", *d as usize))
+                .map(|v| match v.abs() >= LARGE {
+                    true => format!("{v:e}"),
+                    false => format!("{v:.*}", *d as usize),
+                })
                 .unwrap_or_default(),
         }
     }
@@ -108,6 +118,10 @@ impl Cell {
 
 /// Shown for a missing value.
 const MISSING: &str = "–";
+
+/// From this magnitude on, a number is written with an exponent (`1.000e308`, not a cell of
+/// 300 digits).
+const LARGE: f64 = 1e9;
 
 fn finite(v: Option<f64>) -> Option<f64> {
     v.filter(|v| v.is_finite())
@@ -1020,7 +1034,7 @@ pub fn per_frame_lines(results: &[RunResult], metric: &str) -> Result<Vec<Line>>
             let pts: Vec<(f64, f64)> = q
                 .frames
                 .iter()
-                .filter_map(|f| pick(f).map(|v| (f.frame as f64, v)))
+                .filter_map(|f| pick(f).filter(|v| v.is_finite()).map(|v| (f.frame as f64, v)))
                 .collect();
             (!pts.is_empty()).then(|| (run_label(r), pts))
         })
@@ -1446,6 +1460,19 @@ mod tests {
             ),
             "{notes}"
         );
+    }
+
+    /// A huge value (a results file may say 1e308 ms) is written with an exponent, not as a
+    /// cell of 300 digits; ordinary values keep their decimals.
+    #[test]
+    fn huge_values_are_written_with_an_exponent() {
+        for cell in [Cell::Ms(Some(1e308)), Cell::Num(Some(-1e308), 1)] {
+            assert!(cell.display().len() <= 12, "{}", cell.display());
+            assert!(cell.csv().len() <= 12, "{}", cell.csv());
+            assert!(cell.display().contains("e308"), "{}", cell.display());
+        }
+        assert_eq!(Cell::Ms(Some(12.345)).display(), "12.35");
+        assert_eq!(Cell::Num(Some(123456.0), 1).display(), "123456.0");
     }
 
     #[test]

@@ -143,7 +143,7 @@ impl RunResult {
     /// Reads and checks a results file.
     pub fn read(path: &Path) -> Result<RunResult> {
         let bytes = crate::error::read_bounded(path, 1 << 30)?;
-        let r: RunResult = serde_json::from_slice(&bytes)
+        let r: RunResult = crate::error::from_json(&bytes)
             .map_err(|e| Error::bad_file(path, format!("not a gibench results file: {e}")))?;
         if r.schema_version != SCHEMA_VERSION {
             return Err(Error::bad_file(
@@ -180,12 +180,54 @@ impl RunResult {
                 ("cpu_ms", &st.cpu_ms),
             ] {
                 if let Some(s) = stats {
-                    non_negative(s).map_err(|v| format!("stage '{}': {field}.{v}", st.name))?;
+                    non_negative(s).map_err(|v| {
+                        format!("stage '{}': {field}.{v} (times are not negative)", st.name)
+                    })?;
                 }
             }
         }
         if let Some(f) = &self.frame {
-            non_negative(&f.frame_ms).map_err(|v| format!("frame.frame_ms.{v}"))?;
+            non_negative(&f.frame_ms)
+                .map_err(|v| format!("frame.frame_ms.{v} (times are not negative)"))?;
+        }
+        if let Some(c) = self.calibration_ms {
+            if !(CALIBRATION_MS.0..=CALIBRATION_MS.1).contains(&c) {
+                return Err(format!(
+                    "calibration_ms is {}; the calibration workload takes between {:e} and {:e} \
+                     ms on any machine gibench runs on",
+                    shown(c),
+                    CALIBRATION_MS.0,
+                    CALIBRATION_MS.1
+                ));
+            }
+        }
+        if let Some(q) = &self.quality {
+            // Errors are not negative (the bias is signed).
+            for (field, stats) in [
+                ("rmse", &q.rmse),
+                ("rel_mse", &q.rel_mse),
+                ("mae", &q.mae),
+                ("flip_mean", &q.flip_mean),
+            ] {
+                non_negative(stats)
+                    .map_err(|v| format!("quality.{field}.{v} (errors are not negative)"))?;
+            }
+            for (i, f) in q.frames.iter().enumerate() {
+                for (field, v) in [
+                    ("rmse", Some(f.rmse)),
+                    ("rel_mse", Some(f.rel_mse)),
+                    ("mae", Some(f.mae)),
+                    ("flip_mean", Some(f.flip_mean)),
+                    ("temporal", f.temporal),
+                ] {
+                    if v.is_some_and(|v| v < 0.0) {
+                        return Err(format!(
+                            "quality.frames[{i}].{field} is {} (errors are not negative)",
+                            shown(v.unwrap_or_default())
+                        ));
+                    }
+                }
+            }
         }
         Ok(())
     }
@@ -196,7 +238,20 @@ impl RunResult {
     }
 }
 
-/// `Err("NAME is V (times are not negative)")` for the first statistic of `s` below zero
+/// `v` for a message: with an exponent when very large or small (`1e-300`, not 300 digits).
+fn shown(v: f64) -> String {
+    if v != 0.0 && !(1e-3..1e9).contains(&v.abs()) {
+        format!("{v:e}")
+    } else {
+        format!("{v}")
+    }
+}
+
+/// The range a valid `calibration_ms` lies in, milliseconds: the workload takes about 10 ms on
+/// the CI machine; these bounds are a thousand times either way and more.
+pub const CALIBRATION_MS: (f64, f64) = (1e-3, 1e5);
+
+/// `Err("NAME is V")` for the first statistic of `s` below zero
 /// (missing ones, read as NaN, pass).
 fn non_negative(s: &Stats) -> std::result::Result<(), String> {
     let named = [
@@ -209,7 +264,7 @@ fn non_negative(s: &Stats) -> std::result::Result<(), String> {
         ("max", s.max),
     ];
     match named.into_iter().find(|(_, v)| *v < 0.0) {
-        Some((name, v)) => Err(format!("{name} is {v} (times are not negative)")),
+        Some((name, v)) => Err(format!("{name} is {}", shown(v))),
         None => Ok(()),
     }
 }

@@ -198,22 +198,29 @@ pub const HALF_MAX: f32 = 65504.0;
 
 impl FrameImages {
     /// A warning for each irradiance image (indirect, direct) with pixels at or past
-    /// [`HALF_MAX`], where the stored value is clamped.
+    /// [`HALF_MAX`], where the stored value is clamped, and for each with pixels that are not
+    /// numbers (an overflow inside the technique): their error metrics are then not numbers
+    /// either.
     pub fn saturation_warnings(&self) -> Vec<String> {
-        [("indirect", &self.indirect), ("direct", &self.direct)]
-            .into_iter()
-            .filter_map(|(what, img)| {
-                let n = img
-                    .iter()
-                    .filter(|p| p.iter().any(|c| c.abs() >= HALF_MAX))
-                    .count();
-                (n > 0).then(|| {
-                    format!(
-                        "{what} irradiance reached the half-float limit ({HALF_MAX}) in {n} pixels of the last frame, where it is clamped: lower the light's power or use larger scene units"
-                    )
-                })
-            })
-            .collect()
+        let mut out = Vec::new();
+        for (what, img) in [("indirect", &self.indirect), ("direct", &self.direct)] {
+            let nan = img.iter().filter(|p| p.iter().any(|c| c.is_nan())).count();
+            if nan > 0 {
+                out.push(format!(
+                    "{what} irradiance is not a number in {nan} pixels of the last frame (an overflow in the technique): lower the light's power or use larger scene units"
+                ));
+            }
+            let n = img
+                .iter()
+                .filter(|p| p.iter().any(|c| c.abs() >= HALF_MAX))
+                .count();
+            if n > 0 {
+                out.push(format!(
+                    "{what} irradiance reached the half-float limit ({HALF_MAX}) in {n} pixels of the last frame, where it is clamped: lower the light's power or use larger scene units"
+                ));
+            }
+        }
+        out
     }
 }
 

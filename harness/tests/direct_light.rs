@@ -14,7 +14,7 @@ fn direct_irradiance(backend: &str, frame_index: u32) -> Vec<Option<(f32, f32)>>
     let scene = Scene::load_named("cornell", &AssetPaths::standard(None)).unwrap();
     let gpu = GpuContext::new(&GpuOptions {
         backend: Some(backend.into()),
-        adapter: None,
+        ..Default::default()
     })
     .expect("a GPU adapter (install mesa-vulkan-drivers)");
     let config = RunConfig {

@@ -60,7 +60,7 @@ fn edge_mask_matches_the_rule_and_finds_the_boundaries() {
     for backend in present {
         let gpu = GpuContext::new(&GpuOptions {
             backend: Some(backend.into()),
-            adapter: None,
+            ..Default::default()
         })
         .unwrap();
         let config = RunConfig {

@@ -11,7 +11,7 @@ fn check_backend(backend: Option<&str>) {
     let scene = Scene::load_named("cornell", &AssetPaths::standard(None)).unwrap();
     let gpu = GpuContext::new(&GpuOptions {
         backend: backend.map(String::from),
-        adapter: None,
+        ..Default::default()
     })
     .expect("a GPU adapter (install mesa-vulkan-drivers)");
     let config = RunConfig {

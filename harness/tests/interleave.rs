@@ -38,7 +38,7 @@ const PERMISSIVE: FilterSettings = FilterSettings {
 fn gpu(backend: &str) -> GpuContext {
     let gpu = GpuContext::new(&GpuOptions {
         backend: Some(backend.into()),
-        adapter: None,
+        ..Default::default()
     })
     .expect("a GPU adapter (install mesa-vulkan-drivers)");
     eprintln!("{backend}: {} ({})", gpu.info.adapter, gpu.info.backend);

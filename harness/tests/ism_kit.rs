@@ -29,7 +29,7 @@ fn backends() -> Vec<&'static str> {
 fn gpu(backend: &str) -> GpuContext {
     GpuContext::new(&GpuOptions {
         backend: Some(backend.into()),
-        adapter: None,
+        ..Default::default()
     })
     .expect("a GPU adapter")
 }

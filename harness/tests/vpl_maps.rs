@@ -69,7 +69,7 @@ fn one_vpl_in(
     let off = 5e-4 * scene.extent.diagonal;
     let gpu = GpuContext::new(&GpuOptions {
         backend: Some(backend.into()),
-        adapter: None,
+        ..Default::default()
     })
     .expect("a GPU adapter");
     let [w, h] = [96u32, 72];

@@ -70,6 +70,10 @@ pub struct ReproduceArgs {
     /// Use the adapter whose name contains this.
     #[arg(long, env = "GIBENCH_ADAPTER")]
     pub adapter: Option<String>,
+    /// Fail when the GPU takes longer than this many seconds over one submission (default:
+    /// wait as long as the work takes).
+    #[arg(long, env = "GIBENCH_GPU_TIMEOUT", value_name = "SECONDS")]
+    pub gpu_timeout: Option<f64>,
 }
 
 /// A table and the file stem it is written under.
@@ -119,6 +123,7 @@ pub fn open_gpu(args: &ReproduceArgs) -> Result<GpuContext> {
     GpuContext::new(&GpuOptions {
         backend: args.backend.clone(),
         adapter: args.adapter.clone(),
+        gpu_timeout: args.gpu_timeout,
     })
 }
 

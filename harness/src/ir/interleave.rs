@@ -148,6 +148,17 @@ impl Interleave {
             ));
         }
         let full = gbuffer.size;
+        if tiles[0] > full[0] || tiles[1] > full[1] {
+            // Tiles without a pixel would take their VPLs' light away (or, filtered, spread
+            // others' into hot spots).
+            return Err(Error::param(
+                "tiles",
+                format!(
+                    "{}x{} tiles on a {}x{} image: a tile grid cannot have more tiles along an axis than the image has pixels",
+                    tiles[0], tiles[1], full[0], full[1]
+                ),
+            ));
+        }
         let out_size = [output.width(), output.height()];
         if out_size != full || output.depth_or_array_layers() != 1 {
             return Err(Error::param(

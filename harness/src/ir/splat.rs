@@ -44,18 +44,28 @@ pub struct PointSplat {
 }
 
 /// Bytes of one buffer of `texels` 4-byte values, checked against the device's limits; the
-/// error names the parameters that set its size.
-pub(crate) fn texel_buffer_size(gpu: &GpuContext, texels: u64, what: &str) -> Result<u64> {
+/// error names `param`, the parameter that sets its size.
+pub(crate) fn texel_buffer_size(
+    gpu: &GpuContext,
+    texels: u64,
+    what: &str,
+    param: &str,
+) -> Result<u64> {
     let bytes = texels * 4;
     let limits = gpu.device.limits();
     let max = limits
         .max_storage_buffer_binding_size
         .min(limits.max_buffer_size);
     if bytes > max {
+        let advice = if param == "vpl-map-size" {
+            "use fewer VPLs or smaller maps"
+        } else {
+            "use a smaller value"
+        };
         return Err(Error::param(
-            "vpl-map-size",
+            param,
             format!(
-                "{what} of {bytes} bytes exceeds this adapter's largest storage buffer ({max} bytes); use fewer VPLs or smaller maps"
+                "{what} of {bytes} bytes exceeds this adapter's largest storage buffer ({max} bytes); {advice}"
             ),
         ));
     }
@@ -90,7 +100,7 @@ impl PointSplat {
         let device = &gpu.device;
         let (slots, size) = (store.capacity(), atlas.settings.size);
         let texels = slots as u64 * size as u64 * size as u64;
-        let bytes = texel_buffer_size(gpu, texels, "the imperfect depth buffer")?;
+        let bytes = texel_buffer_size(gpu, texels, "the imperfect depth buffer", "vpl-map-size")?;
         let depth = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("ism depth"),
             size: bytes,

@@ -272,6 +272,12 @@ const BUILTINS: &[(&str, &str)] = &[
     ),
 ];
 
+/// Largest light power (flux, or a sun's irradiance) per component. The shipped scenes use at
+/// most 1e7; a light's flux reaches a pixel multiplied by 1/(π d²) and summed over thousands of
+/// VPLs or paths, all in 32-bit floats (largest 3.4e38), and 1e20 leaves eighteen orders of
+/// magnitude for those factors. (1e33 gave NaN pixels in the VPL techniques' indirect images.)
+pub const MAX_LIGHT_POWER: f32 = 1e20;
+
 /// Names of the built-in scene descriptors, in a fixed order.
 pub fn builtin_names() -> Vec<&'static str> {
     BUILTINS.iter().map(|(name, _)| *name).collect()
@@ -304,7 +310,7 @@ impl SceneDescriptor {
     /// types become [`Error::BadFile`] with serde's message (which names the field and gives
     /// the line and column) reported against `path_for_errors`. Does not [`validate`](Self::validate).
     pub fn from_json(path_for_errors: &Path, text: &str) -> Result<Self> {
-        serde_json::from_str(text).map_err(|e| Error::bad_file(path_for_errors, e.to_string()))
+        crate::error::from_json(text.as_bytes()).map_err(|e| Error::bad_file(path_for_errors, e))
     }
 
     /// Checks the values serde cannot: mesh sources, key times, camera and light parameters and
@@ -390,6 +396,18 @@ impl SceneDescriptor {
                 ),
             ));
         }
+        if light.power.iter().any(|c| *c > MAX_LIGHT_POWER) {
+            return Err(invalid(
+                p,
+                "light.power",
+                format!(
+                    "every component must be at most {MAX_LIGHT_POWER:e}, got {:?}: past it the \
+                     irradiance the techniques and the reference compute in 32-bit floats \
+                     overflows (use larger scene units)",
+                    light.power
+                ),
+            ));
+        }
         if light.power.iter().all(|c| *c == 0.0) {
             return Err(invalid(
                 p,
@@ -414,6 +432,26 @@ impl SceneDescriptor {
             }
             (LightKind::Spot | LightKind::Omni | LightKind::Sun, Some(_)) => {
                 return Err(invalid(p, "light.size", "only area lights have a size"));
+            }
+            (LightKind::Area, Some([w, h])) => {
+                // Its corners, at any key and facing any way, lie within half its diagonal of
+                // the key's position: they obey the coordinate limit as positions do.
+                let half = 0.5 * (w as f64).hypot(h as f64);
+                for (i, key) in light.path.keys.iter().enumerate() {
+                    let far = key.position.iter().map(|c| c.abs() as f64).fold(0.0, f64::max);
+                    if far + half > super::MAX_COORDINATE as f64 {
+                        return Err(invalid(
+                            p,
+                            "light.size",
+                            format!(
+                                "[{w:e}, {h:e}] puts the light's corners up to {half:.3e} from its \
+                                 position at light.path.keys[{i}] ({:?}), past ±{:e} scene units",
+                                key.position,
+                                super::MAX_COORDINATE
+                            ),
+                        ));
+                    }
+                }
             }
             _ => {}
         }
@@ -753,6 +791,24 @@ mod tests {
         .contains("unknown variant `laser`"));
     }
 
+    /// A wrong value deep in the file is named by its field's path, not only a line and column.
+    #[test]
+    fn descriptor_errors_give_the_fields_path() {
+        let mut v: serde_json::Value = serde_json::to_value(cornell()).unwrap();
+        v["light"]["path"]["keys"][1]["position"] = serde_json::json!("up");
+        let e = message(
+            SceneDescriptor::from_json(Path::new("k.json"), &v.to_string()).unwrap_err(),
+        );
+        assert!(e.starts_with("light.path.keys[1].position: "), "{e}");
+        assert!(e.contains("line"), "{e}");
+        v["light"]["path"]["keys"][1]["position"] = serde_json::json!([0, 1, 2]);
+        v["movers"] = serde_json::json!([{"name": "m", "mesh": {}, "scale": "big"}]);
+        let e = message(
+            SceneDescriptor::from_json(Path::new("k.json"), &v.to_string()).unwrap_err(),
+        );
+        assert!(e.starts_with("movers[0].scale: "), "{e}");
+    }
+
     #[test]
     fn descriptor_resolve_errors() {
         match SceneDescriptor::resolve("atlantis") {
@@ -879,6 +935,17 @@ mod tests {
             (
                 "light.power: is zero",
                 Box::new(|d| d.light.power = [0.0; 3]),
+            ),
+            (
+                "light.power: every component must be at most 1e20",
+                Box::new(|d| d.light.power = [1e33, 1.0, 1.0]),
+            ),
+            (
+                "light.size: [3e38, 1e0] puts the light's corners",
+                Box::new(|d| {
+                    d.light.kind = LightKind::Area;
+                    d.light.size = Some([3e38, 1.0]);
+                }),
             ),
             (
                 "light.size: area lights need a [width, height] size",

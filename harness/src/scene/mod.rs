@@ -315,13 +315,23 @@ fn tessellation_factor(longest: f32, max_edge: f32) -> usize {
 /// and every vertex after its transforms. Beyond it f32 bounds and BVH arithmetic overflow.
 pub const MAX_COORDINATE: f32 = 1e9;
 
+/// Whether a position is past [`MAX_COORDINATE`] (or not finite).
+fn out_of_range(p: Vec3) -> bool {
+    !p.is_finite() || p.abs().max_element() > MAX_COORDINATE
+}
+
+/// The file (or generated mesh) a mesh source names, for messages.
+fn source_label(src: &MeshSource) -> String {
+    match (&src.file, &src.generated) {
+        (Some(file), _) => format!("file {file}"),
+        (None, Some(name)) => format!("generated '{name}'"),
+        (None, None) => "no source".to_string(),
+    }
+}
+
 /// Checks every vertex of `mesh` against [`MAX_COORDINATE`]; `what` names the mesh.
 fn check_coordinates(scene: &str, what: &str, mesh: &Mesh) -> Result<()> {
-    match mesh
-        .positions
-        .iter()
-        .find(|p| !p.is_finite() || p.abs().max_element() > MAX_COORDINATE)
-    {
+    match mesh.positions.iter().find(|p| out_of_range(**p)) {
         None => Ok(()),
         Some(p) => Err(crate::Error::bad_file(
             format!("scene '{scene}'"),
@@ -422,6 +432,16 @@ fn build_mesh(src: &MeshSource, assets: &AssetPaths, field: &str) -> Result<Buil
         (Some(file), _) => {
             let path = assets.find(file)?;
             let g = gltf_load::load_gltf(&path, 0)?;
+            // The file's own vertices, named by the file (placed copies are checked again
+            // after their transforms, named by the descriptor's field and the file).
+            if let Some(p) = g.mesh.positions.iter().find(|p| out_of_range(**p)) {
+                return Err(crate::Error::bad_file(
+                    &path,
+                    format!(
+                        "{field}: a vertex at {p} (after the file's node transforms); every coordinate must be finite and within ±{MAX_COORDINATE:e} scene units"
+                    ),
+                ));
+            }
             let mesh = match src.tessellate {
                 Some(edge) => {
                     let longest = g.mesh.longest_edge();
@@ -560,6 +580,11 @@ impl Scene {
             for p in &mut placed.positions {
                 *p = rot * (*p * st.scale) + Vec3::from(st.position);
             }
+            check_coordinates(
+                &desc.name,
+                &format!("statics[{i}] ({}, placed)", source_label(&st.mesh)),
+                &placed,
+            )?;
             for n in &mut placed.normals {
                 *n = (rot * *n).normalize_or_zero();
             }
@@ -595,7 +620,11 @@ impl Scene {
             check_coordinates(name, "the shadow mesh (with its statics)", s)?;
         }
         for (m, d) in movers.iter().zip(&desc.movers) {
-            check_coordinates(name, &format!("mover '{}' (scaled)", m.name), &m.mesh)?;
+            check_coordinates(
+                name,
+                &format!("mover '{}' ({}, scaled)", m.name, source_label(&d.mesh)),
+                &m.mesh,
+            )?;
             // Placed along its path: its farthest vertex from its origin plus the farthest key.
             let reach = m
                 .mesh

@@ -172,6 +172,47 @@ impl IsmParams {
         Ok(p)
     }
 
+    /// Checks the sizes the parameters give against `gpu`'s limits, naming the parameter, before
+    /// any work (the pool's sampling takes seconds at its largest): the point pool's storage
+    /// buffer (16 bytes a point), the reflective shadow map's texel buffers (16 bytes a texel,
+    /// six faces) and its 3 × 2 faces' texture.
+    pub fn check_device(&self, gpu: &gibench_harness::gpu::GpuContext) -> Result<()> {
+        let limits = gpu.device.limits();
+        let max = limits
+            .max_storage_buffer_binding_size
+            .min(limits.max_buffer_size);
+        let pool_bytes = self.pool as u64 * 16;
+        if pool_bytes > max {
+            return Err(Error::param(
+                "point-pool",
+                format!(
+                    "{} points take {pool_bytes} bytes, more than this adapter's largest storage \
+                     buffer ({max} bytes): at most {} points here",
+                    self.pool,
+                    max / 16
+                ),
+            ));
+        }
+        let size = self.rsm_size as u64;
+        let rsm_bytes = 6 * size * size * 16;
+        let max_texture = gpu.max_texture_2d() as u64;
+        let largest = ((max / 96) as f64).sqrt() as u64;
+        if rsm_bytes > max || 3 * size > max_texture {
+            return Err(Error::param(
+                "rsm-size",
+                format!(
+                    "a reflective shadow map of {size}² per face needs {rsm_bytes}-byte texel \
+                     buffers and a {}×{} texture; this adapter allows {max} bytes and {max_texture} \
+                     texels: at most {} here",
+                    3 * size,
+                    2 * size,
+                    largest.min(max_texture / 3)
+                ),
+            ));
+        }
+        Ok(())
+    }
+
     /// `ism-classic`'s parameters (no points, no pull-push: those fields are 0).
     pub fn classic_from_params(params: &Params) -> IsmParams {
         IsmParams {
@@ -203,13 +244,15 @@ struct IsmPrepared {
 
 fn prepare(params: &Params, ctx: &PrepareContext) -> Result<Prepared> {
     let p = IsmParams::from_params(params)?;
+    p.check_device(ctx.gpu)?;
     Ok(Box::new(IsmPrepared {
         pool: points::sample_scene(ctx.scene, p.pool, ctx.seed)?,
     }))
 }
 
-/// `ism-classic` prepares nothing.
-fn prepare_classic(_: &Params, _: &PrepareContext) -> Result<Prepared> {
+/// `ism-classic` prepares nothing (it checks its sizes against the device).
+fn prepare_classic(params: &Params, ctx: &PrepareContext) -> Result<Prepared> {
+    IsmParams::classic_from_params(params).check_device(ctx.gpu)?;
     Ok(Box::new(()))
 }
 

@@ -216,7 +216,7 @@ pub fn each_backend(
     for backend in gibench_harness::gpu::available_backends() {
         let gpu = GpuContext::new(&GpuOptions {
             backend: Some(backend.into()),
-            adapter: None,
+            ..Default::default()
         })
         .unwrap();
         let config = RunConfig {
