@@ -125,7 +125,14 @@ fn alive(pid: u32) -> bool {
 /// `path` with its longest existing ancestor canonicalised (symlinks and `..` resolved the way
 /// the OS will resolve them) and the rest appended.
 fn resolve(path: &Path) -> PathBuf {
-    let abs = absolute(path);
+    // `..` is left to the OS (after a link it leads to the link target's parent).
+    let abs = if path.is_absolute() {
+        path.to_path_buf()
+    } else {
+        std::env::current_dir()
+            .unwrap_or_else(|_| PathBuf::from("/"))
+            .join(path)
+    };
     let mut existing = abs.as_path();
     let mut rest = Vec::new();
     loop {
