@@ -781,7 +781,10 @@ pub(crate) fn run_planned(
             if report::per_frame_lines(&results, metric)?.is_empty() {
                 // Every value is not a number (each run's warnings say why): what is valid
                 // is still written.
-                eprintln!("note: no {metric} value is a number; {} not drawn", file_name(&svg));
+                eprintln!(
+                    "note: no {metric} value is a number; {} not drawn",
+                    file_name(&svg)
+                );
                 continue;
             }
             report::quality_over_frames_svg(
@@ -796,7 +799,10 @@ pub(crate) fn run_planned(
     if plan.quality.is_some() {
         let svg = args.out.join(format!("{name}-time-vs-error.svg"));
         if report::time_error_points(&results).is_empty() {
-            eprintln!("note: no run has an error that is a number; {} not drawn", file_name(&svg));
+            eprintln!(
+                "note: no run has an error that is a number; {} not drawn",
+                file_name(&svg)
+            );
         } else {
             report::time_vs_error_svg(&results, &svg, &format!("Time versus error on {name}"))?;
             written.push(file_name(&svg));
@@ -1357,7 +1363,11 @@ fn results_like(path: &Path) -> Option<Option<String>> {
                 let len = head[start..].find('"')?;
                 Some(head[start..start + len].to_string())
             };
-            Some(field("scene").zip(field("technique")).map(|(s, t)| format!("{s}/{t}")))
+            Some(
+                field("scene")
+                    .zip(field("technique"))
+                    .map(|(s, t)| format!("{s}/{t}")),
+            )
         }
     }
 }

@@ -128,10 +128,8 @@ pub(crate) fn make_rays(
 
 /// Reads a ray file, refusing one whose size is not a whole, non-zero number of rays.
 fn read_rays(path: &Path) -> Result<Vec<Ray>> {
-    let bytes =
-        gibench_harness::error::read_bounded(path, MAX_RAYS as u64 * RAY_BYTES as u64).map_err(
-            |e| Error::param("rays", format!("cannot read {}: {e}", path.display())),
-        )?;
+    let bytes = gibench_harness::error::read_bounded(path, MAX_RAYS as u64 * RAY_BYTES as u64)
+        .map_err(|e| Error::param("rays", format!("cannot read {}: {e}", path.display())))?;
     if bytes.is_empty() || bytes.len() % RAY_BYTES != 0 {
         return Err(Error::param(
             "rays",

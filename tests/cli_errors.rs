@@ -1001,23 +1001,45 @@ fn files_named_like_journal_directives_are_published() {
 fn parameters_past_the_image_or_the_device() {
     for t in ["laine", "ism", "keller-full"] {
         fails(
-            &["--technique", t, "--resolution", "64x48", "--param", "tiles=64x64"],
+            &[
+                "--technique",
+                t,
+                "--resolution",
+                "64x48",
+                "--param",
+                "tiles=64x64",
+            ],
             "parameter 'tiles'",
         );
     }
     fails(
-        &["--technique", "laine", "--resolution", "64x48", "--param", "tiles=8x49"],
+        &[
+            "--technique",
+            "laine",
+            "--resolution",
+            "64x48",
+            "--param",
+            "tiles=8x49",
+        ],
         "8x49 tiles on a 64x48 image",
     );
     let gpu = gibench_harness::gpu::GpuContext::new(&Default::default()).expect("an adapter");
     let limits = gpu.device.limits();
-    let max = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
+    let max = limits
+        .max_storage_buffer_binding_size
+        .min(limits.max_buffer_size);
     drop(gpu);
     if (1u64 << 24) * 16 > max {
         fails(
             &[
-                "--technique", "ism", "--resolution", "32x24",
-                "--param", "point-pool=16777216", "--param", "points-per-vpl=1",
+                "--technique",
+                "ism",
+                "--resolution",
+                "32x24",
+                "--param",
+                "point-pool=16777216",
+                "--param",
+                "points-per-vpl=1",
             ],
             "parameter 'point-pool'",
         );
@@ -1028,7 +1050,14 @@ fn parameters_past_the_image_or_the_device() {
     }
     if 6 * 2048u64 * 2048 * 16 > max {
         fails(
-            &["--technique", "ism", "--resolution", "32x24", "--param", "rsm-size=2048"],
+            &[
+                "--technique",
+                "ism",
+                "--resolution",
+                "32x24",
+                "--param",
+                "rsm-size=2048",
+            ],
             "parameter 'rsm-size'",
         );
     }

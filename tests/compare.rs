@@ -98,7 +98,12 @@ fn verdicts_on_synthetic_results_are_exact() {
     synthetic(&dir.join("slow"), &[1.0, 1.02, 0.99], slow, cal.clone());
     // The same times in a session whose machine was twice as slow, and whose calibration
     // says so.
-    synthetic(&dir.join("busy"), &[2.0, 2.04, 1.98], |_| 1.0, serde_json::json!(20.0));
+    synthetic(
+        &dir.join("busy"),
+        &[2.0, 2.04, 1.98],
+        |_| 1.0,
+        serde_json::json!(20.0),
+    );
     let (ok, same, stderr) = compare(dir, "base", "same");
     assert!(ok, "{stderr}");
     assert_eq!(same.len(), STAGES.len(), "{same:?}");
@@ -115,7 +120,10 @@ fn verdicts_on_synthetic_results_are_exact() {
     }
     let (ok, back, _) = compare(dir, "slow", "base");
     assert!(ok);
-    assert!(back.contains(&("compose".into(), "faster".into())), "{back:?}");
+    assert!(
+        back.contains(&("compose".into(), "faster".into())),
+        "{back:?}"
+    );
     let (ok, busy, stderr) = compare(dir, "base", "busy");
     assert!(ok, "{stderr}");
     assert!(busy.iter().all(|(_, v)| v == "unchanged"), "{busy:?}");
@@ -129,23 +137,47 @@ fn unreadable_results_are_named_and_a_lost_run_fails() {
     let cal = serde_json::json!(10.0);
     synthetic(&dir.join("base"), &[1.0, 1.03, 0.98], |_| 1.0, cal.clone());
     let edits: [(&str, fn(&mut Value), &str); 7] = [
-        ("no-calibration", |v| v["calibration_ms"] = 0.0.into(), "calibration_ms is 0"),
-        ("negative-calibration", |v| v["calibration_ms"] = (-5.0).into(), "calibration_ms is -5"),
-        ("tiny-calibration", |v| v["calibration_ms"] = 1e-300.into(), "calibration_ms is 1e-300"),
+        (
+            "no-calibration",
+            |v| v["calibration_ms"] = 0.0.into(),
+            "calibration_ms is 0",
+        ),
+        (
+            "negative-calibration",
+            |v| v["calibration_ms"] = (-5.0).into(),
+            "calibration_ms is -5",
+        ),
+        (
+            "tiny-calibration",
+            |v| v["calibration_ms"] = 1e-300.into(),
+            "calibration_ms is 1e-300",
+        ),
         (
             "negative-median",
             |v| v["stages"][1]["wall_ms"]["median"] = (-1.0).into(),
             "median is -1",
         ),
-        ("unknown-kind", |v| v["stages"][0]["kind"] = "quantum".into(), "quantum"),
-        ("newer-schema", |v| v["schema_version"] = 999.into(), "schema version 999"),
-        ("negative-rmse", |v| {
-            v["quality"] = serde_json::json!({"reference": "r", "frames": [],
+        (
+            "unknown-kind",
+            |v| v["stages"][0]["kind"] = "quantum".into(),
+            "quantum",
+        ),
+        (
+            "newer-schema",
+            |v| v["schema_version"] = 999.into(),
+            "schema version 999",
+        ),
+        (
+            "negative-rmse",
+            |v| {
+                v["quality"] = serde_json::json!({"reference": "r", "frames": [],
                 "rmse": {"count": 1, "mean": -1.0, "median": -1.0, "p5": -1.0, "p95": -1.0, "min": -1.0, "max": -1.0},
                 "rel_mse": {"count": 0, "mean": null, "median": null, "p5": null, "p95": null, "min": null, "max": null},
                 "mae": {"count": 0, "mean": null, "median": null, "p5": null, "p95": null, "min": null, "max": null},
                 "flip_mean": {"count": 0, "mean": null, "median": null, "p5": null, "p95": null, "min": null, "max": null}});
-        }, "errors are not negative"),
+            },
+            "errors are not negative",
+        ),
     ];
     for (name, edit, why) in edits {
         let side = dir.join(name);
@@ -162,7 +194,10 @@ fn unreadable_results_are_named_and_a_lost_run_fails() {
             "{name}: {stderr}"
         );
         assert!(stderr.contains(why), "{name}: {stderr}");
-        assert!(stderr.contains("CURRENT has 2 repeat(s)"), "{name}: {stderr}");
+        assert!(
+            stderr.contains("CURRENT has 2 repeat(s)"),
+            "{name}: {stderr}"
+        );
     }
     // Truncated, beside a run of another technique: named, and the side lost `direct`.
     let side = dir.join("truncated");
@@ -182,7 +217,8 @@ fn unreadable_results_are_named_and_a_lost_run_fails() {
     // (These files' keys are written sorted, so `technique` lies past the cut and the run is
     // unknown: the side fails all the same, naming each file.)
     assert!(
-        stderr.contains("parameter 'current'") && stderr.contains("truncated/r0/cornell-direct.json"),
+        stderr.contains("parameter 'current'")
+            && stderr.contains("truncated/r0/cornell-direct.json"),
         "{stderr}"
     );
     // Other JSON files (a comparison's own output) are passed over without a word.
@@ -203,7 +239,14 @@ fn compare_runs_end_to_end() {
     let run_into = |out: &Path, slow: bool| {
         let mut c = Command::new(env!("CARGO_BIN_EXE_gibench"));
         c.args(["run", "--technique", "direct", "--frames", "10"])
-            .args(["--warmup", "2", "--timing", "stages", "--resolution", "64x48"])
+            .args([
+                "--warmup",
+                "2",
+                "--timing",
+                "stages",
+                "--resolution",
+                "64x48",
+            ])
             .args(["--quiet", "--no-images", "--out"])
             .arg(out);
         if slow {

@@ -344,7 +344,10 @@ fn a_link_below_out_is_refused_and_its_target_untouched() {
     let outside = tmp.path().join("outside");
     std::fs::create_dir_all(&outside).unwrap();
     std::fs::write(outside.join("precious.txt"), b"a user's file").unwrap();
-    for (link, only) in [("keller/tiles", "keller-tiles"), ("laine", "laine-dispersion")] {
+    for (link, only) in [
+        ("keller/tiles", "keller-tiles"),
+        ("laine", "laine-dispersion"),
+    ] {
         let out = tmp.path().join(format!("out-{only}"));
         let at = out.join(link);
         std::fs::create_dir_all(at.parent().unwrap()).unwrap();

@@ -61,7 +61,11 @@ fn laine_tables_have_the_papers_columns_and_figures() {
         )
         .unwrap()
     };
-    let maps = |technique: &str| run(technique)["counters"]["shadow-maps"]["mean"].as_f64().unwrap();
+    let maps = |technique: &str| {
+        run(technique)["counters"]["shadow-maps"]["mean"]
+            .as_f64()
+            .unwrap()
+    };
     assert!(maps("keller-full") >= 250.0, "{}", maps("keller-full"));
     assert!(maps("laine") <= 16.0, "{}", maps("laine"));
     // The speedup column is the ratio of the runs' unrounded FPS, printed to one decimal (the
@@ -77,7 +81,10 @@ fn laine_tables_have_the_papers_columns_and_figures() {
     let row2 = gibench_row(&tmp.path().join("laine-table2.csv"));
     let steps = row2["split"] + row2["accum."] + row2["combine"] + row2["filter"];
     // Five values written to four decimals: their rounding adds up to at most 2.5e-4 ms.
-    assert!((steps - row2["Σ common"]).abs() <= 2.5e-4 + 1e-9, "{row2:?}");
+    assert!(
+        (steps - row2["Σ common"]).abs() <= 2.5e-4 + 1e-9,
+        "{row2:?}"
+    );
     assert_eq!(row1["Σ common"], row2["Σ common"]);
     for f in [
         "laine-table1.csv",

@@ -151,7 +151,10 @@ pub fn judge(base: &[f64], current: &[f64], tolerance: f64) -> (Option<[f64; 2]>
         };
         return (None, verdict);
     }
-    let band = [min_of(current) / max_of(base), max_of(current) / min_of(base)];
+    let band = [
+        min_of(current) / max_of(base),
+        max_of(current) / min_of(base),
+    ];
     let verdict = if band[0] > 1.0 + tolerance {
         Verdict::Slower
     } else if band[1] < 1.0 / (1.0 + tolerance) {
@@ -399,7 +402,11 @@ mod tests {
         assert_eq!(band, Some([1.2, 2.5]));
         assert_eq!(v, Verdict::Slower);
         let (_, v) = judge(&[1.0, 2.0], &[2.2, 3.0], 0.1);
-        assert_eq!(v, Verdict::Unchanged, "band [1.1, 3]: its lower edge is not above 1.1");
+        assert_eq!(
+            v,
+            Verdict::Unchanged,
+            "band [1.1, 3]: its lower edge is not above 1.1"
+        );
         let (_, v) = judge(&[2.0, 2.0], &[1.0, 1.8], 0.1);
         assert_eq!(v, Verdict::Faster, "band [0.5, 0.9] lies below 1/1.1");
         let (_, v) = judge(&[2.0, 2.0], &[1.0, 1.85], 0.1);
@@ -430,7 +437,9 @@ mod tests {
         let mut mixed = side(Some(10.0));
         mixed[1].calibration_ms = None;
         let rows = compare(&side(Some(10.0)), &mixed, 0.1).unwrap();
-        assert!(rows.iter().all(|r| !r.calibrated && r.verdict == Verdict::Unchanged));
+        assert!(rows
+            .iter()
+            .all(|r| !r.calibrated && r.verdict == Verdict::Unchanged));
         let table = compare_table(&rows, 0.1).to_terminal();
         assert!(table.contains("(raw)"), "{table}");
     }
@@ -447,7 +456,10 @@ mod tests {
         assert_eq!(row("a").verdict, Verdict::Unchanged);
         assert_eq!(row("b").verdict, Verdict::Slower);
         for r in &rows {
-            assert!(r.ratio.is_none() && r.ratio_raw.is_none() && r.band.is_none(), "{r:?}");
+            assert!(
+                r.ratio.is_none() && r.ratio_raw.is_none() && r.band.is_none(),
+                "{r:?}"
+            );
         }
         let table = compare_table(&rows, 0.1).to_terminal();
         assert!(!table.contains("inf"), "{table}");

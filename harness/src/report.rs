@@ -1034,7 +1034,11 @@ pub fn per_frame_lines(results: &[RunResult], metric: &str) -> Result<Vec<Line>>
             let pts: Vec<(f64, f64)> = q
                 .frames
                 .iter()
-                .filter_map(|f| pick(f).filter(|v| v.is_finite()).map(|v| (f.frame as f64, v)))
+                .filter_map(|f| {
+                    pick(f)
+                        .filter(|v| v.is_finite())
+                        .map(|v| (f.frame as f64, v))
+                })
                 .collect();
             (!pts.is_empty()).then(|| (run_label(r), pts))
         })

@@ -78,7 +78,12 @@ impl PullPush {
             let s = (size >> k) as u64;
             items += slots as u64 * s * s;
         }
-        let bytes = texel_buffer_size(gpu, items.max(1) * 2, "the pull-push pyramid", "vpl-map-size")?;
+        let bytes = texel_buffer_size(
+            gpu,
+            items.max(1) * 2,
+            "the pull-push pyramid",
+            "vpl-map-size",
+        )?;
         let pyramid = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("pull-push pyramid"),
             size: bytes,

@@ -64,7 +64,12 @@ impl ReflectiveShadowMap {
             Some(("fs_gbuffer", &[NORMAL_FORMAT, ALBEDO_FORMAT])),
         );
         let texels = 6 * size as u64 * size as u64;
-        let bytes = texel_buffer_size(gpu, texels * 4, "the reflective shadow map's texels", "rsm-size")?;
+        let bytes = texel_buffer_size(
+            gpu,
+            texels * 4,
+            "the reflective shadow map's texels",
+            "rsm-size",
+        )?;
         let buffer = |label: &str| {
             device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),

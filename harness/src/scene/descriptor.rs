@@ -438,7 +438,11 @@ impl SceneDescriptor {
                 // the key's position: they obey the coordinate limit as positions do.
                 let half = 0.5 * (w as f64).hypot(h as f64);
                 for (i, key) in light.path.keys.iter().enumerate() {
-                    let far = key.position.iter().map(|c| c.abs() as f64).fold(0.0, f64::max);
+                    let far = key
+                        .position
+                        .iter()
+                        .map(|c| c.abs() as f64)
+                        .fold(0.0, f64::max);
                     if far + half > super::MAX_COORDINATE as f64 {
                         return Err(invalid(
                             p,
@@ -796,16 +800,14 @@ mod tests {
     fn descriptor_errors_give_the_fields_path() {
         let mut v: serde_json::Value = serde_json::to_value(cornell()).unwrap();
         v["light"]["path"]["keys"][1]["position"] = serde_json::json!("up");
-        let e = message(
-            SceneDescriptor::from_json(Path::new("k.json"), &v.to_string()).unwrap_err(),
-        );
+        let e =
+            message(SceneDescriptor::from_json(Path::new("k.json"), &v.to_string()).unwrap_err());
         assert!(e.starts_with("light.path.keys[1].position: "), "{e}");
         assert!(e.contains("line"), "{e}");
         v["light"]["path"]["keys"][1]["position"] = serde_json::json!([0, 1, 2]);
         v["movers"] = serde_json::json!([{"name": "m", "mesh": {}, "scale": "big"}]);
-        let e = message(
-            SceneDescriptor::from_json(Path::new("k.json"), &v.to_string()).unwrap_err(),
-        );
+        let e =
+            message(SceneDescriptor::from_json(Path::new("k.json"), &v.to_string()).unwrap_err());
         assert!(e.starts_with("movers[0].scale: "), "{e}");
     }
 
