@@ -70,14 +70,19 @@ pub struct OutputSet {
 }
 
 /// `path` made absolute against the working directory and with `.` and `..` resolved lexically.
-pub(crate) fn absolute(path: &Path) -> PathBuf {
-    let joined = if path.is_absolute() {
+/// `path` joined to the working directory when relative, nothing resolved.
+fn joined_to_cwd(path: &Path) -> PathBuf {
+    if path.is_absolute() {
         path.to_path_buf()
     } else {
         std::env::current_dir()
             .unwrap_or_else(|_| PathBuf::from("/"))
             .join(path)
-    };
+    }
+}
+
+pub(crate) fn absolute(path: &Path) -> PathBuf {
+    let joined = joined_to_cwd(path);
     let mut out = PathBuf::new();
     for c in joined.components() {
         match c {
@@ -126,13 +131,7 @@ fn alive(pid: u32) -> bool {
 /// the OS will resolve them) and the rest appended.
 fn resolve(path: &Path) -> PathBuf {
     // `..` is left to the OS (after a link it leads to the link target's parent).
-    let abs = if path.is_absolute() {
-        path.to_path_buf()
-    } else {
-        std::env::current_dir()
-            .unwrap_or_else(|_| PathBuf::from("/"))
-            .join(path)
-    };
+    let abs = joined_to_cwd(path);
     let mut existing = abs.as_path();
     let mut rest = Vec::new();
     loop {
