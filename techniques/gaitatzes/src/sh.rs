@@ -49,6 +49,35 @@ pub fn face(d: Vec3) -> [f32; 4] {
     lobe(solid * C0, axis * C1, d)
 }
 
+/// The clamped-cosine lobe of unit integral about unit `d`: [`clamped_cosine`]`(d) / π`. The
+/// propagation stores the flux Φ crossing a face towards `d` (per face area s², in the units of
+/// the radiance integral ∫ L dω) as Φ times this lobe.
+pub fn cosine_unit(d: Vec3) -> [f32; 4] {
+    clamped_cosine(d).map(|c| c / std::f32::consts::PI)
+}
+
+/// What turns the reconstruction's SH dot product into irradiance. A unit-integral
+/// clamped-cosine lobe arriving head-on at a surface (travelling along −n) stands for a flux
+/// density of 1 through the surface, which is its irradiance; its dot product with the clamped
+/// cosine about −n is not 1 but π(Y₀⁰)² + (2π/3)²(√3/(2√π))²/π = 1/4 + 1/3 = 7/12 (the
+/// band-limited lobe 1/4 + cos θ/2 spreads part of its flux sideways, and the cosine weighting
+/// of that spread loses it). The reconstruction multiplies by the reciprocal, 12/7, so that the
+/// flux that the propagation delivers into an occupied cell through the face its surface faces
+/// becomes exactly that surface's irradiance. (A lobe arriving sideways, through a face
+/// perpendicular to the surface, is weighted 12/7 · 1/4 = 3/7; occupied cells receive flux only
+/// from the void in front of them, so that arises only at edges and corners.)
+pub fn flux_to_irradiance() -> f32 {
+    // A lobe travelling along z onto the surface with normal −z: the cosine about −n = z.
+    1.0 / dot(&cosine_unit(Vec3::Z), &clamped_cosine(Vec3::Z))
+}
+
+/// The irradiance of a surface with unit normal `n` from accumulated incident radiance `c`
+/// (travel-direction convention): [`flux_to_irradiance`] · `c` · [`clamped_cosine`]`(−n)`,
+/// floored at 0.
+pub fn irradiance(c: &[f32; 4], n: Vec3) -> f32 {
+    (flux_to_irradiance() * dot(c, &clamped_cosine(-n))).max(0.0)
+}
+
 /// Dot product of two coefficient vectors (the integral of the product of the functions).
 pub fn dot(a: &[f32; 4], b: &[f32; 4]) -> f32 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
@@ -60,9 +89,10 @@ pub fn eval(c: &[f32; 4], d: Vec3) -> f32 {
 }
 
 /// The convention as WGSL constants (`SH_C0`, `SH_C1`, the face pyramid's
-/// `SH_FACE0`/`SH_FACE1`, the clamped cosine's `SH_COS0`/`SH_COS1`) and functions:
-/// `sh_lobe(a, b, d)`, `sh_face(d)`, `sh_cosine(d)` (the clamped cosine about `d`) and
-/// `sh_cosine_unit(d)` (the same divided by π: a lobe of unit integral).
+/// `SH_FACE0`/`SH_FACE1`, the clamped cosine's `SH_COS0`/`SH_COS1`, [`flux_to_irradiance`] as
+/// `SH_FLUX_TO_IRRADIANCE`) and functions: `sh_lobe(a, b, d)`, `sh_face(d)`, `sh_cosine(d)`
+/// (the clamped cosine about `d`), `sh_cosine_unit(d)` (the same divided by π: a lobe of unit
+/// integral) and `sh_irradiance(c, n)` ([`irradiance`]).
 pub fn wgsl() -> String {
     let c = face(Vec3::Z);
     let k = clamped_cosine(Vec3::Z);
@@ -73,8 +103,16 @@ pub fn wgsl() -> String {
          fn sh_lobe(a: f32, b: f32, d: vec3<f32>) -> vec4<f32> {{ return vec4<f32>(a, b * d.y, b * d.z, b * d.x); }}\n\
          fn sh_face(d: vec3<f32>) -> vec4<f32> {{ return sh_lobe(SH_FACE0, SH_FACE1, d); }}\n\
          fn sh_cosine(d: vec3<f32>) -> vec4<f32> {{ return sh_lobe(SH_COS0, SH_COS1, d); }}\n\
-         fn sh_cosine_unit(d: vec3<f32>) -> vec4<f32> {{ return sh_lobe(SH_COS0 / 3.14159265, SH_COS1 / 3.14159265, d); }}\n",
-        C0, C1, c[0], c[2], k[0], k[2]
+         fn sh_cosine_unit(d: vec3<f32>) -> vec4<f32> {{ return sh_lobe(SH_COS0 / 3.14159265, SH_COS1 / 3.14159265, d); }}\n\
+         const SH_FLUX_TO_IRRADIANCE: f32 = {:.9e};\n\
+         fn sh_irradiance(c: vec4<f32>, n: vec3<f32>) -> f32 {{ return max(SH_FLUX_TO_IRRADIANCE * dot(c, sh_cosine(-n)), 0.0); }}\n",
+        C0,
+        C1,
+        c[0],
+        c[2],
+        k[0],
+        k[2],
+        flux_to_irradiance()
     )
 }
 
@@ -139,6 +177,26 @@ mod tests {
             // A uniform radiance of 1 has coefficients (√(4π), 0, 0, 0).
             let uniform = [(4.0 * std::f32::consts::PI).sqrt(), 0.0, 0.0, 0.0];
             assert!((dot(&uniform, &c) - std::f32::consts::PI).abs() < 1e-5);
+        }
+    }
+
+    /// The flux-to-irradiance constant is the closed form 12/7, and with it a unit-integral
+    /// clamped-cosine lobe gives a surface it meets head-on irradiance 1 and one it passes
+    /// sideways 3/7; numerically, the lobe's band-limited radiance integrated against the
+    /// clamped cosine is the 7/12 it corrects.
+    #[test]
+    fn flux_to_irradiance_is_twelve_sevenths() {
+        assert!((flux_to_irradiance() - 12.0 / 7.0).abs() < 1e-5);
+        for d in dirs() {
+            let lobe = cosine_unit(d);
+            assert!((irradiance(&lobe, -d) - 1.0).abs() < 1e-5, "head-on {d}");
+            let side = d.any_orthonormal_vector();
+            assert!(
+                (irradiance(&lobe, side) - 3.0 / 7.0).abs() < 1e-5,
+                "side {d}"
+            );
+            let v = integrate(|w| eval(&lobe, w) * d.dot(w).max(0.0));
+            assert!((v - 7.0 / 12.0).abs() < 1e-3, "{d}: {v}");
         }
     }
 
