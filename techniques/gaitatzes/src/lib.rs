@@ -39,7 +39,7 @@ use gibench_harness::technique::{
 };
 use gibench_harness::{wgpu, Error, Result};
 
-use volume::{Grid, Mode, Propagation, Reconstruction, Volumes, Voxelizer};
+use volume::{Grid, Mode, Propagation, Reconstruction, Transport, Volumes, Voxelizer};
 
 /// Stage: voxelization, combine and injection.
 pub const STAGE_VOXELIZATION: &str = "voxelization";
@@ -66,6 +66,12 @@ const PARAMS: &[ParamSpec] = &[
         kind: ParamKind::Choice(&["occluded", "lpv"]),
         default: "occluded",
         doc: "occluded: the paper's propagation through void cells with reflections at occupied ones (multiple bounces); lpv: plain light propagation volumes (no occlusion, one bounce)",
+    },
+    ParamSpec {
+        name: "transport",
+        kind: ParamKind::Choice(&Transport::NAMES),
+        default: "cosine",
+        doc: "what a void cell passes on through a face: cosine (the paper's reading, as in light propagation volumes: a clamped-cosine lobe along the face's axis; diffuses, most light between two walls returns to its source) or carry (the flux with the sender's own angular distribution: light keeps its direction and reaches the facing wall)",
     },
     ParamSpec {
         name: "albedo",
@@ -104,6 +110,7 @@ pub struct GaitatzesParams {
     pub iterations: u32,
     pub mode: Mode,
     pub stored_albedo: bool,
+    pub transport: Transport,
 }
 
 impl GaitatzesParams {
@@ -117,6 +124,7 @@ impl GaitatzesParams {
                 other => return Err(Error::param("mode", format!("unknown mode '{other}'"))),
             },
             stored_albedo: params.choice("albedo") == "stored",
+            transport: Transport::parse(params.choice("transport"))?,
         })
     }
 }
@@ -136,7 +144,13 @@ pub struct Gaitatzes {
 fn create(params: &Params, ctx: &PrepareContext, _: &Prepared) -> Result<Box<dyn Technique>> {
     let p = GaitatzesParams::from_params(params)?;
     let gpu = ctx.gpu;
-    let grid = Grid::around(&ctx.scene.extent, p.grid, p.mode, p.stored_albedo);
+    let grid = Grid::around(
+        &ctx.scene.extent,
+        p.grid,
+        p.mode,
+        p.stored_albedo,
+        p.transport,
+    );
     let volumes = Volumes::new(gpu, &grid)?;
     let voxelizer = Voxelizer::new(
         gpu,
