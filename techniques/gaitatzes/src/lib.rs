@@ -30,6 +30,7 @@
 //! Needs: compute shaders and storage buffers (Vulkan, GL ES 3.1); no optional features.
 
 pub mod sh;
+pub mod slab;
 pub mod volume;
 
 use gibench_harness::quality::IndirectComponent;
