@@ -14,7 +14,23 @@
 //!    paper's constant — or the voxel's albedo): secondary bounces.
 //! 3. **Reconstruction** (§4.3, Eq. 11–12; [`volume::Reconstruction`]): per pixel, the
 //!    accumulated radiance interpolated from the occupied ones of the eight nearest cells, and
-//!    the irradiance as its SH dot product with the clamped cosine about the normal.
+//!    the irradiance as its SH dot product with the clamped cosine about the normal, times the
+//!    flux-to-irradiance constant 12/7 ([`sh::flux_to_irradiance`]: without it a surface
+//!    receives 7/12 of the flux that arrives at it head-on).
+//!
+//! **What the propagation loses** ([`slab`]): a clamped-cosine lobe sends 40 % of its flux on
+//! and 15 % through each side face, and the side lobes send 15 % back, so light diffuses rather
+//! than travels. Between two infinite walls the share of the emitted flux that reaches the
+//! facing wall, converged, is 70 / 45 / 28 / 16 / 9 % at 2 / 4 / 8 / 16 / 30 cells apart; the
+//! rest returns to the emitter as spurious self-irradiance. More iterations or a finer grid do
+//! not recover it. This is the method class's (second-order SH propagation through cell faces,
+//! as in light propagation volumes), not a missing constant. Two variants, not the paper's:
+//! `transport=carry` keeps each lobe's direction through void cells: all the flux reaches the
+//! facing wall (in about 2.5 iterations per cell), at the price of beams that widen too little
+//! with distance; `transport=pyramid` passes on, through each face, the re-projection of the
+//! light within that face's pyramid (its integral and first moment), so light that left through
+//! a side face still leans forward: 84 / 68 / 53 / 37 / 25 % reach the facing wall at the
+//! distances above, and light still spreads.
 //!
 //! `mode=lpv` is plain light propagation volumes (Kaplanyan 2009) for the paper's Figure 6(d):
 //! the same injection, propagation through every cell without occlusion or reflection, the
@@ -22,10 +38,12 @@
 //!
 //! Second-order SH per colour channel, in the convention of [`sh`]. Deviations (README): what a
 //! cell sends through a face is normalised so that it passes on exactly its radiance integral
-//! (negative, ringing integrals dropped) and arrives as a clamped-cosine lobe of unit integral;
-//! occupied cells pass light only into void neighbours on their normal's side; the volumes are
-//! storage buffers and the slices 2D atlases, not 3D textures; each occupied voxel is taken to
-//! hold one cell face of surface (injected radiance B/π per unit cosine).
+//! (negative, ringing integrals dropped) and arrives as a clamped-cosine lobe of unit integral,
+//! which the reconstruction turns back into irradiance with the constant 12/7 (the paper gives
+//! neither); occupied cells pass light only into void neighbours on their normal's side; the
+//! volumes are storage buffers and the slices 2D atlases, not 3D textures; each occupied voxel
+//! is taken to hold one cell face of surface (injected radiance B/π per unit cosine);
+//! `transport=carry` and `transport=pyramid` are ours.
 //!
 //! Needs: compute shaders and storage buffers (Vulkan, GL ES 3.1); no optional features.
 
@@ -60,7 +78,7 @@ const PARAMS: &[ParamSpec] = &[
         name: "iterations",
         kind: ParamKind::Int { min: 0, max: 1024 },
         default: "12",
-        doc: "propagation iterations per frame (the paper: 11-12 outdoors, 64 for two bounces in the room); light travels one cell per iteration",
+        doc: "propagation iterations per frame (the paper: 11-12 outdoors, 64 for two bounces in the room); light advances at most one cell per iteration",
     },
     ParamSpec {
         name: "mode",
@@ -72,7 +90,7 @@ const PARAMS: &[ParamSpec] = &[
         name: "transport",
         kind: ParamKind::Choice(&Transport::NAMES),
         default: "cosine",
-        doc: "what a void cell passes on through a face: cosine (the paper's reading, as in light propagation volumes: a clamped-cosine lobe along the face's axis; diffuses, most light between two walls returns to its source) or carry (the flux with the sender's own angular distribution: light keeps its direction and reaches the facing wall)",
+        doc: "what a void cell passes on through a face: cosine (the paper's reading, as in light propagation volumes: a clamped-cosine lobe along the face's axis; diffuses, most light between two walls returns to its source), carry (ours: the flux with the sender's own angular distribution; light keeps its direction and all of it reaches the facing wall, in beams too narrow) or pyramid (ours: the flux with the distribution of the sender's light within the face's pyramid; less returns than with cosine and it still spreads)",
     },
     ParamSpec {
         name: "albedo",

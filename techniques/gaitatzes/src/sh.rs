@@ -78,6 +78,21 @@ pub fn irradiance(c: &[f32; 4], n: Vec3) -> f32 {
     (flux_to_irradiance() * dot(c, &clamped_cosine(-n))).max(0.0)
 }
 
+/// ∫ (ω·d)² dω over the face pyramid about `d` (its second moment along its axis); across the
+/// axis each of the two other directions gets (4π/6 − this) / 2. By quadrature of
+/// ∫∫ (1 + u² + v²)^(−5/2) du dv over [−1, 1]² (the face at distance 1).
+pub const FACE_MOMENT_AXIAL: f32 = 1.467_932_1;
+
+/// The first moment ∫ L(ω) ω dω of band-limited radiance `c` over the face pyramid about unit
+/// axis `d`: (Y₀⁰ c₀) X d + (√3/(2√π)) M (c_x, c_y, c_z), with X = ∫ ω·d dω over the pyramid and
+/// M its second-moment matrix (axial [`FACE_MOMENT_AXIAL`], the rest across).
+pub fn face_moment(c: &[f32; 4], d: Vec3) -> Vec3 {
+    let x = 2.0 * std::f32::consts::SQRT_2 * (1.0 / std::f32::consts::SQRT_2).atan();
+    let across = (4.0 * std::f32::consts::PI / 6.0 - FACE_MOMENT_AXIAL) / 2.0;
+    let v = Vec3::new(c[3], c[1], c[2]);
+    C0 * c[0] * x * d + C1 * (across * v + (FACE_MOMENT_AXIAL - across) * v.dot(d) * d)
+}
+
 /// Dot product of two coefficient vectors (the integral of the product of the functions).
 pub fn dot(a: &[f32; 4], b: &[f32; 4]) -> f32 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
@@ -105,6 +120,8 @@ pub fn wgsl() -> String {
          fn sh_cosine(d: vec3<f32>) -> vec4<f32> {{ return sh_lobe(SH_COS0, SH_COS1, d); }}\n\
          fn sh_cosine_unit(d: vec3<f32>) -> vec4<f32> {{ return sh_lobe(SH_COS0 / 3.14159265, SH_COS1 / 3.14159265, d); }}\n\
          const SH_FLUX_TO_IRRADIANCE: f32 = {:.9e};\n\
+         const SH_MOMENT_AXIAL: f32 = {:.9e};\n\
+         fn sh_face_moment(c: vec4<f32>, d: vec3<f32>) -> vec3<f32> {{ let across = (4.0 * 3.14159265 / 6.0 - SH_MOMENT_AXIAL) / 2.0; let v = vec3<f32>(c.w, c.y, c.z); return SH_C0 * c.x * (SH_FACE1 / SH_C1) * d + SH_C1 * (across * v + (SH_MOMENT_AXIAL - across) * dot(v, d) * d); }}\n\
          fn sh_irradiance(c: vec4<f32>, n: vec3<f32>) -> f32 {{ return max(SH_FLUX_TO_IRRADIANCE * dot(c, sh_cosine(-n)), 0.0); }}\n",
         C0,
         C1,
@@ -112,7 +129,8 @@ pub fn wgsl() -> String {
         c[2],
         k[0],
         k[2],
-        flux_to_irradiance()
+        flux_to_irradiance(),
+        FACE_MOMENT_AXIAL
     )
 }
 
@@ -197,6 +215,33 @@ mod tests {
             );
             let v = integrate(|w| eval(&lobe, w) * d.dot(w).max(0.0));
             assert!((v - 7.0 / 12.0).abs() < 1e-3, "{d}: {v}");
+        }
+    }
+
+    /// The pyramid's first moment of a band-limited function is its numerical integral (which
+    /// checks the axial second moment too).
+    #[test]
+    fn face_moment_matches_its_integral() {
+        let in_face = |n: Vec3, d: Vec3| {
+            let m = d.abs().max_element();
+            n.dot(d) > 0.0 && n.dot(d) >= m - 1e-7
+        };
+        let f = [0.7, -0.2, 0.3, 0.5];
+        for n in [Vec3::X, Vec3::NEG_Y, Vec3::Z] {
+            let m = face_moment(&f, n);
+            for k in 0..3 {
+                let v = integrate(|d| {
+                    if in_face(n, d) {
+                        eval(&f, d) * d[k]
+                    } else {
+                        0.0
+                    }
+                });
+                assert!(
+                    (v - m[k] as f64).abs() < 2e-3,
+                    "{n}: component {k}: {v} vs {m}"
+                );
+            }
         }
     }
 

@@ -17,7 +17,8 @@
 //! the flux through the four side faces arrives in the four side neighbours, which by the
 //! symmetry is the same as staying in the layer (as four cosine lobes along ±x and ±y, whose
 //! l = 1 terms cancel, for [`Transport::Cosine`]; as the cell's own lobe for
-//! [`Transport::Carry`]). Occupied cells accumulate the flux arriving head-on and send their
+//! [`Transport::Carry`]; as four lobes of the side pyramids' first moments, whose x and y parts
+//! cancel, for [`Transport::Pyramid`]). Occupied cells accumulate the flux arriving head-on and send their
 //! albedo times its mirror image on. With the exact flux-to-irradiance constant a wall's
 //! irradiance is the flux per unit area that has arrived at it. The model owes nothing to the
 //! shaders beyond those rules; at one void cell between black walls ([`Transport::Cosine`]) it
@@ -65,8 +66,12 @@ pub fn model(s: &Slabs, iterations: u32) -> Irradiance {
     let c0 = sh::C0 as f64;
     let c1 = sh::C1 as f64;
     // The face pyramid's coefficients and the unit-integral cosine lobe's.
+    let x = 2.0 * 2f64.sqrt() * (1.0 / 2f64.sqrt()).atan();
     let face0 = 4.0 * pi / 6.0 * c0;
-    let face1 = 2.0 * 2f64.sqrt() * (1.0 / 2f64.sqrt()).atan() * c1;
+    let face1 = x * c1;
+    // The pyramid's second moments along and across its axis.
+    let axial = sh::FACE_MOMENT_AXIAL as f64;
+    let across = (4.0 * pi / 6.0 - axial) / 2.0;
     let (cos0, cos1) = (c0, 2.0 / 3.0 * c1);
     let whole = |st: [f64; 2]| st[0] * 4.0 * pi * c0;
     let top = s.apart as usize;
@@ -116,12 +121,25 @@ pub fn model(s: &Slabs, iterations: u32) -> Irradiance {
                 }
                 let t = t as usize;
                 let wall = t == 0 || t == top;
-                if wall || s.transport == Transport::Cosine {
-                    next[t][0] += f * cos0;
-                    next[t][1] += f * cos1 * dz as f64;
-                } else {
-                    next[t][0] += f * st[0] / w;
-                    next[t][1] += f * st[1] / w;
+                match s.transport {
+                    _ if wall => {
+                        next[t][0] += f * cos0;
+                        next[t][1] += f * cos1 * dz as f64;
+                    }
+                    Transport::Cosine => {
+                        next[t][0] += f * cos0;
+                        next[t][1] += f * cos1 * dz as f64;
+                    }
+                    Transport::Carry => {
+                        next[t][0] += f * st[0] / w;
+                        next[t][1] += f * st[1] / w;
+                    }
+                    Transport::Pyramid => {
+                        // The first moment's z part over the ±z pyramid.
+                        let m = dz as f64 * c0 * st[0] * x + c1 * axial * st[1];
+                        next[t][0] += f * c0;
+                        next[t][1] += f * c1 * m / integral[k];
+                    }
                 }
                 if t == 0 {
                     at_emitter += f;
@@ -136,6 +154,12 @@ pub fn model(s: &Slabs, iterations: u32) -> Irradiance {
                     Transport::Carry => {
                         next[z][0] += side * st[0] / w;
                         next[z][1] += side * st[1] / w;
+                    }
+                    Transport::Pyramid => {
+                        // The side pyramids' first moments: their x and y parts cancel among
+                        // the four, their z parts are c1 · across · c_z each.
+                        next[z][0] += side * c0;
+                        next[z][1] += side * c1 * (c1 * across * st[1]) / integral[2];
                     }
                 }
             }
@@ -381,7 +405,7 @@ mod tests {
     /// propagation has converged (every iteration passes on exactly the flux it holds).
     #[test]
     fn the_model_conserves_the_emitted_flux() {
-        for transport in [Transport::Cosine, Transport::Carry] {
+        for transport in [Transport::Cosine, Transport::Carry, Transport::Pyramid] {
             for apart in [2, 3, 5, 9] {
                 let r = model(&slabs(apart, transport), 4000);
                 assert!(

@@ -49,17 +49,24 @@ pub enum Transport {
     /// away from a wall never turns back. Occupied cells still receive (and reflect) the flux as
     /// a cosine lobe along the face's axis.
     Carry,
+    /// The flux arrives with the angular distribution of the light that crossed the face: the
+    /// sender's radiance restricted to the face's pyramid, re-projected (its integral and first
+    /// moment). Light through the front face stays forward, light through a side face leans
+    /// forward too, so less of it turns back than with `Cosine`, and it still spreads. Occupied
+    /// cells receive and reflect cosine lobes, as with `Carry`.
+    Pyramid,
 }
 
 impl Transport {
     /// The parameter's values, in the order of the variants.
-    pub const NAMES: [&'static str; 2] = ["cosine", "carry"];
+    pub const NAMES: [&'static str; 3] = ["cosine", "carry", "pyramid"];
 
     /// Parses a value of the `transport` parameter.
     pub fn parse(name: &str) -> Result<Transport> {
         match name {
             "cosine" => Ok(Transport::Cosine),
             "carry" => Ok(Transport::Carry),
+            "pyramid" => Ok(Transport::Pyramid),
             other => Err(Error::param(
                 "transport",
                 format!(
@@ -136,7 +143,7 @@ impl Grid {
         format!(
             "const N: u32 = {}u;\nconst COLS: u32 = {}u;\nconst ORIGIN: vec3<f32> = vec3<f32>({:.9e}, {:.9e}, {:.9e});\n\
              const CELL: f32 = {:.9e};\nconst MODE: u32 = {}u;\nconst STORED_ALBEDO: u32 = {}u;\n\
-             const CARRY: u32 = {}u;\n{}\n{}",
+             const TRANSPORT: u32 = {}u;\n{}\n{}",
             self.n,
             self.cols(),
             self.origin.x,
@@ -145,7 +152,7 @@ impl Grid {
             self.cell,
             (self.mode == Mode::Lpv) as u32,
             self.stored_albedo as u32,
-            (self.transport == Transport::Carry) as u32,
+            self.transport as u32,
             sh::wgsl(),
             include_str!("shaders/grid.wgsl")
         )

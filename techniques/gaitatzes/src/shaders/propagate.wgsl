@@ -2,8 +2,9 @@
 // neighbours the radiance each sends through the shared face — the neighbour's SH integrated
 // over the face's 90-degree pyramid (SH dot product with the pyramid's coefficients; see
 // face_share) — and takes it as a clamped-cosine lobe of that flux along the direction of
-// travel (CARRY: into void cells, with the neighbour's own angular distribution instead, so a
-// lobe keeps its direction). Void cells pass the gathered radiance on. Occupied cells
+// travel (TRANSPORT 1: into void cells, with the neighbour's own angular distribution instead,
+// so a lobe keeps its direction; 2: with the distribution of the neighbour's light within the
+// face's pyramid). Void cells pass the gathered radiance on. Occupied cells
 // (MODE 0) add it to the accumulation as incident radiance and reflect it for the next bounce:
 // mirrored along the dominant axis of their normal (the paper's simplification of the rotation
 // to the normal), times the albedo (0.5, the paper's constant, or the voxel's), and send it on
@@ -84,6 +85,17 @@ fn unit_integral(c: vec4<f32>) -> vec4<f32> {
     return c / whole;
 }
 
+// The SH of `c` restricted to the pyramid of the face towards `d` (its integral and first
+// moment), rescaled to an integral of 1 (0 when the face's integral is not positive).
+fn through_face(c: vec4<f32>, d: vec3<f32>) -> vec4<f32> {
+    let flux = dot(c, sh_face(d));
+    if (flux <= 0.0) {
+        return vec4<f32>(0.0);
+    }
+    let m = sh_face_moment(c, d);
+    return vec4<f32>(SH_C0 * flux, SH_C1 * m.y, SH_C1 * m.z, SH_C1 * m.x) / flux;
+}
+
 fn dominant_axis(n: vec3<f32>) -> u32 {
     let a = abs(n);
     if (a.x >= a.y && a.x >= a.z) {
@@ -118,14 +130,23 @@ fn propagate(@builtin(global_invocation_id) id: vec3<u32>) {
         g.r += share.r * lobe;
         g.g += share.g * lobe;
         g.b += share.b * lobe;
-        // CARRY: the flux with the sender's angular distribution (its SH over its integral).
-        carried.r += share.r * unit_integral(s.r);
-        carried.g += share.g * unit_integral(s.g);
-        carried.b += share.b * unit_integral(s.b);
+        if (TRANSPORT == 1u) {
+            // The flux with the sender's angular distribution (its SH over its integral).
+            carried.r += share.r * unit_integral(s.r);
+            carried.g += share.g * unit_integral(s.g);
+            carried.b += share.b * unit_integral(s.b);
+        } else if (TRANSPORT == 2u) {
+            // The flux with the distribution of what crossed the face (the sender's SH over
+            // the face's pyramid, re-projected).
+            let df = vec3<f32>(d);
+            carried.r += share.r * through_face(s.r, df);
+            carried.g += share.g * through_face(s.g, df);
+            carried.b += share.b * through_face(s.b, df);
+        }
     }
     let i = cell_index(c);
     let v = here;
-    if (CARRY == 1u && !(MODE == 0u && v.normal.w > 0.0)) {
+    if (TRANSPORT != 0u && !(MODE == 0u && v.normal.w > 0.0)) {
         g = carried;
     }
     if (MODE == 0u && v.normal.w > 0.0) {
