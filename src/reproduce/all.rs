@@ -286,6 +286,15 @@ pub const TARGETS: &[Target] = &[
             paper: "sweep --scene gaitatzes-room --technique gaitatzes --sweep iterations=4,8,16,32,64,96 --quality --quality-reference multi-bounce --resolution 512x512 --frames 100 --warmup 10 --timing stages",
         },
     },
+    Target {
+        name: "gaitatzes-transport",
+        dir: "gaitatzes/transport",
+        what: "gaitatzes' three transports (cosine: the paper's; carry, pyramid: ours) on the room (32³, 64 iterations)",
+        kind: Kind::Command {
+            quick: "sweep --scene gaitatzes-room --technique gaitatzes --sweep transport=cosine,carry,pyramid --param iterations=64 --quality --quality-reference multi-bounce --frames 4 --warmup 3 --timing stages",
+            paper: "sweep --scene gaitatzes-room --technique gaitatzes --sweep transport=cosine,carry,pyramid --param iterations=64 --quality --quality-reference multi-bounce --resolution 512x512 --frames 100 --warmup 10 --timing stages",
+        },
+    },
 ];
 
 impl Target {

@@ -49,6 +49,50 @@ pub fn face(d: Vec3) -> [f32; 4] {
     lobe(solid * C0, axis * C1, d)
 }
 
+/// The clamped-cosine lobe of unit integral about unit `d`: [`clamped_cosine`]`(d) / π`. The
+/// propagation stores the flux Φ crossing a face towards `d` (per face area s², in the units of
+/// the radiance integral ∫ L dω) as Φ times this lobe.
+pub fn cosine_unit(d: Vec3) -> [f32; 4] {
+    clamped_cosine(d).map(|c| c / std::f32::consts::PI)
+}
+
+/// What turns the reconstruction's SH dot product into irradiance. A unit-integral
+/// clamped-cosine lobe arriving head-on at a surface (travelling along −n) stands for a flux
+/// density of 1 through the surface, which is its irradiance; its dot product with the clamped
+/// cosine about −n is not 1 but π(Y₀⁰)² + (2π/3)²(√3/(2√π))²/π = 1/4 + 1/3 = 7/12 (the
+/// band-limited lobe 1/4 + cos θ/2 spreads part of its flux sideways, and the cosine weighting
+/// of that spread loses it). The reconstruction multiplies by the reciprocal, 12/7, so that the
+/// flux that the propagation delivers into an occupied cell through the face its surface faces
+/// becomes exactly that surface's irradiance. (A lobe arriving sideways, through a face
+/// perpendicular to the surface, is weighted 12/7 · 1/4 = 3/7; occupied cells receive flux only
+/// from the void in front of them, so that arises only at edges and corners.)
+pub fn flux_to_irradiance() -> f32 {
+    // A lobe travelling along z onto the surface with normal −z: the cosine about −n = z.
+    1.0 / dot(&cosine_unit(Vec3::Z), &clamped_cosine(Vec3::Z))
+}
+
+/// The irradiance of a surface with unit normal `n` from accumulated incident radiance `c`
+/// (travel-direction convention): [`flux_to_irradiance`] · `c` · [`clamped_cosine`]`(−n)`,
+/// floored at 0.
+pub fn irradiance(c: &[f32; 4], n: Vec3) -> f32 {
+    (flux_to_irradiance() * dot(c, &clamped_cosine(-n))).max(0.0)
+}
+
+/// ∫ (ω·d)² dω over the face pyramid about `d` (its second moment along its axis); across the
+/// axis each of the two other directions gets (4π/6 − this) / 2. By quadrature of
+/// ∫∫ (1 + u² + v²)^(−5/2) du dv over [−1, 1]² (the face at distance 1).
+pub const FACE_MOMENT_AXIAL: f32 = 1.467_932_1;
+
+/// The first moment ∫ L(ω) ω dω of band-limited radiance `c` over the face pyramid about unit
+/// axis `d`: (Y₀⁰ c₀) X d + (√3/(2√π)) M (c_x, c_y, c_z), with X = ∫ ω·d dω over the pyramid and
+/// M its second-moment matrix (axial [`FACE_MOMENT_AXIAL`], the rest across).
+pub fn face_moment(c: &[f32; 4], d: Vec3) -> Vec3 {
+    let x = 2.0 * std::f32::consts::SQRT_2 * (1.0 / std::f32::consts::SQRT_2).atan();
+    let across = (4.0 * std::f32::consts::PI / 6.0 - FACE_MOMENT_AXIAL) / 2.0;
+    let v = Vec3::new(c[3], c[1], c[2]);
+    C0 * c[0] * x * d + C1 * (across * v + (FACE_MOMENT_AXIAL - across) * v.dot(d) * d)
+}
+
 /// Dot product of two coefficient vectors (the integral of the product of the functions).
 pub fn dot(a: &[f32; 4], b: &[f32; 4]) -> f32 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
@@ -60,9 +104,10 @@ pub fn eval(c: &[f32; 4], d: Vec3) -> f32 {
 }
 
 /// The convention as WGSL constants (`SH_C0`, `SH_C1`, the face pyramid's
-/// `SH_FACE0`/`SH_FACE1`, the clamped cosine's `SH_COS0`/`SH_COS1`) and functions:
-/// `sh_lobe(a, b, d)`, `sh_face(d)`, `sh_cosine(d)` (the clamped cosine about `d`) and
-/// `sh_cosine_unit(d)` (the same divided by π: a lobe of unit integral).
+/// `SH_FACE0`/`SH_FACE1`, the clamped cosine's `SH_COS0`/`SH_COS1`, [`flux_to_irradiance`] as
+/// `SH_FLUX_TO_IRRADIANCE`) and functions: `sh_lobe(a, b, d)`, `sh_face(d)`, `sh_cosine(d)`
+/// (the clamped cosine about `d`), `sh_cosine_unit(d)` (the same divided by π: a lobe of unit
+/// integral) and `sh_irradiance(c, n)` ([`irradiance`]).
 pub fn wgsl() -> String {
     let c = face(Vec3::Z);
     let k = clamped_cosine(Vec3::Z);
@@ -73,8 +118,19 @@ pub fn wgsl() -> String {
          fn sh_lobe(a: f32, b: f32, d: vec3<f32>) -> vec4<f32> {{ return vec4<f32>(a, b * d.y, b * d.z, b * d.x); }}\n\
          fn sh_face(d: vec3<f32>) -> vec4<f32> {{ return sh_lobe(SH_FACE0, SH_FACE1, d); }}\n\
          fn sh_cosine(d: vec3<f32>) -> vec4<f32> {{ return sh_lobe(SH_COS0, SH_COS1, d); }}\n\
-         fn sh_cosine_unit(d: vec3<f32>) -> vec4<f32> {{ return sh_lobe(SH_COS0 / 3.14159265, SH_COS1 / 3.14159265, d); }}\n",
-        C0, C1, c[0], c[2], k[0], k[2]
+         fn sh_cosine_unit(d: vec3<f32>) -> vec4<f32> {{ return sh_lobe(SH_COS0 / 3.14159265, SH_COS1 / 3.14159265, d); }}\n\
+         const SH_FLUX_TO_IRRADIANCE: f32 = {:.9e};\n\
+         const SH_MOMENT_AXIAL: f32 = {:.9e};\n\
+         fn sh_face_moment(c: vec4<f32>, d: vec3<f32>) -> vec3<f32> {{ let across = (4.0 * 3.14159265 / 6.0 - SH_MOMENT_AXIAL) / 2.0; let v = vec3<f32>(c.w, c.y, c.z); return SH_C0 * c.x * (SH_FACE1 / SH_C1) * d + SH_C1 * (across * v + (SH_MOMENT_AXIAL - across) * dot(v, d) * d); }}\n\
+         fn sh_irradiance(c: vec4<f32>, n: vec3<f32>) -> f32 {{ return max(SH_FLUX_TO_IRRADIANCE * dot(c, sh_cosine(-n)), 0.0); }}\n",
+        C0,
+        C1,
+        c[0],
+        c[2],
+        k[0],
+        k[2],
+        flux_to_irradiance(),
+        FACE_MOMENT_AXIAL
     )
 }
 
@@ -139,6 +195,53 @@ mod tests {
             // A uniform radiance of 1 has coefficients (√(4π), 0, 0, 0).
             let uniform = [(4.0 * std::f32::consts::PI).sqrt(), 0.0, 0.0, 0.0];
             assert!((dot(&uniform, &c) - std::f32::consts::PI).abs() < 1e-5);
+        }
+    }
+
+    /// The flux-to-irradiance constant is the closed form 12/7, and with it a unit-integral
+    /// clamped-cosine lobe gives a surface it meets head-on irradiance 1 and one it passes
+    /// sideways 3/7; numerically, the lobe's band-limited radiance integrated against the
+    /// clamped cosine is the 7/12 it corrects.
+    #[test]
+    fn flux_to_irradiance_is_twelve_sevenths() {
+        assert!((flux_to_irradiance() - 12.0 / 7.0).abs() < 1e-5);
+        for d in dirs() {
+            let lobe = cosine_unit(d);
+            assert!((irradiance(&lobe, -d) - 1.0).abs() < 1e-5, "head-on {d}");
+            let side = d.any_orthonormal_vector();
+            assert!(
+                (irradiance(&lobe, side) - 3.0 / 7.0).abs() < 1e-5,
+                "side {d}"
+            );
+            let v = integrate(|w| eval(&lobe, w) * d.dot(w).max(0.0));
+            assert!((v - 7.0 / 12.0).abs() < 1e-3, "{d}: {v}");
+        }
+    }
+
+    /// The pyramid's first moment of a band-limited function is its numerical integral (which
+    /// checks the axial second moment too).
+    #[test]
+    fn face_moment_matches_its_integral() {
+        let in_face = |n: Vec3, d: Vec3| {
+            let m = d.abs().max_element();
+            n.dot(d) > 0.0 && n.dot(d) >= m - 1e-7
+        };
+        let f = [0.7, -0.2, 0.3, 0.5];
+        for n in [Vec3::X, Vec3::NEG_Y, Vec3::Z] {
+            let m = face_moment(&f, n);
+            for k in 0..3 {
+                let v = integrate(|d| {
+                    if in_face(n, d) {
+                        eval(&f, d) * d[k]
+                    } else {
+                        0.0
+                    }
+                });
+                assert!(
+                    (v - m[k] as f64).abs() < 2e-3,
+                    "{n}: component {k}: {v} vs {m}"
+                );
+            }
         }
     }
 

@@ -35,6 +35,53 @@ pub enum Mode {
     Lpv,
 }
 
+/// What a void cell passes on of the flux it sends through a face (the flux itself, the share
+/// of the cell's radiance integral over that face's pyramid, is the same in both).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Transport {
+    /// The paper's scheme as this crate reads it (and light propagation volumes'): the flux
+    /// arrives as a clamped-cosine lobe along the face's axis. A lobe sends 40 % of its flux on,
+    /// 15 % through each side face, and side lobes send 15 % back: light diffuses, and between
+    /// two walls most of it returns to where it came from.
+    Cosine,
+    /// The flux arrives with the sending cell's own angular distribution (its SH, rescaled to
+    /// the flux): a lobe keeps its direction however it is split among faces, so light moving
+    /// away from a wall never turns back. Occupied cells still receive (and reflect) the flux as
+    /// a cosine lobe along the face's axis.
+    Carry,
+    /// The flux arrives with the angular distribution of the light that crossed the face: the
+    /// sender's radiance restricted to the face's pyramid, re-projected (its integral and first
+    /// moment). Light through the front face stays forward, light through a side face leans
+    /// forward too, so less of it turns back than with `Cosine`, and it still spreads. Occupied
+    /// cells receive and reflect cosine lobes, as with `Carry`.
+    Pyramid,
+}
+
+impl Transport {
+    /// The parameter's values, in the order of the variants.
+    pub const NAMES: [&'static str; 3] = ["cosine", "carry", "pyramid"];
+
+    /// Parses a value of the `transport` parameter.
+    pub fn parse(name: &str) -> Result<Transport> {
+        match name {
+            "cosine" => Ok(Transport::Cosine),
+            "carry" => Ok(Transport::Carry),
+            "pyramid" => Ok(Transport::Pyramid),
+            other => Err(Error::param(
+                "transport",
+                format!(
+                    "unknown transport '{other}' (expected one of {})",
+                    Transport::NAMES.join(", ")
+                ),
+            )),
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        Transport::NAMES[self as usize]
+    }
+}
+
 /// The grid (see the module docs).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Grid {
@@ -47,6 +94,8 @@ pub struct Grid {
     pub mode: Mode,
     /// Secondary bounces with the voxel's albedo instead of the paper's constant 0.5.
     pub stored_albedo: bool,
+    /// What void cells pass on.
+    pub transport: Transport,
 }
 
 /// Bytes of one cell of the voxel buffer (`Voxel`) and of an SH buffer (`Sh3`).
@@ -55,7 +104,13 @@ pub const CELL_BYTES: u64 = 48;
 impl Grid {
     /// A cubic grid of `n`³ cells around `extent`: its largest side plus half a cell on each
     /// side, so that walls on the bounding box fall inside cells, not on their boundaries.
-    pub fn around(extent: &SceneExtent, n: u32, mode: Mode, stored_albedo: bool) -> Grid {
+    pub fn around(
+        extent: &SceneExtent,
+        n: u32,
+        mode: Mode,
+        stored_albedo: bool,
+        transport: Transport,
+    ) -> Grid {
         let side = (extent.max - extent.min).max_element().max(1e-6) * n as f32 / (n as f32 - 1.0);
         Grid {
             n,
@@ -63,6 +118,7 @@ impl Grid {
             cell: side / n as f32,
             mode,
             stored_albedo,
+            transport,
         }
     }
 
@@ -86,7 +142,8 @@ impl Grid {
     pub fn wgsl(&self) -> String {
         format!(
             "const N: u32 = {}u;\nconst COLS: u32 = {}u;\nconst ORIGIN: vec3<f32> = vec3<f32>({:.9e}, {:.9e}, {:.9e});\n\
-             const CELL: f32 = {:.9e};\nconst MODE: u32 = {}u;\nconst STORED_ALBEDO: u32 = {}u;\n{}\n{}",
+             const CELL: f32 = {:.9e};\nconst MODE: u32 = {}u;\nconst STORED_ALBEDO: u32 = {}u;\n\
+             const TRANSPORT: u32 = {}u;\n{}\n{}",
             self.n,
             self.cols(),
             self.origin.x,
@@ -95,6 +152,7 @@ impl Grid {
             self.cell,
             (self.mode == Mode::Lpv) as u32,
             self.stored_albedo as u32,
+            self.transport as u32,
             sh::wgsl(),
             include_str!("shaders/grid.wgsl")
         )
@@ -484,13 +542,19 @@ impl Propagation {
     /// Records `iterations` iterations starting from propagation buffer 0. The field after
     /// them is in buffer `iterations % 2`.
     pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, iterations: u32) {
+        self.encode_from(encoder, 0, iterations);
+    }
+
+    /// Records `iterations` iterations starting from propagation buffer `from` (0 or 1). The
+    /// field after them is in buffer `(from + iterations) % 2`.
+    pub fn encode_from(&self, encoder: &mut wgpu::CommandEncoder, from: u32, iterations: u32) {
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("propagation"),
             timestamp_writes: None,
         });
         pass.set_pipeline(&self.pipeline);
         let g = self.n.div_ceil(4);
-        for k in 0..iterations {
+        for k in from..from + iterations {
             pass.set_bind_group(0, &self.groups[k as usize % 2], &[]);
             pass.dispatch_workgroups(g, g, g);
         }

@@ -4,7 +4,9 @@
 //! tilted triangle leaves no hole along any axis and marks no voxel the triangle's plane misses.
 
 use gibench_gaitatzes::sh;
-use gibench_gaitatzes::volume::{Grid, Mode, Propagation, Volumes, Voxelizer, CELL_BYTES};
+use gibench_gaitatzes::volume::{
+    Grid, Mode, Propagation, Transport, Volumes, Voxelizer, CELL_BYTES,
+};
 use gibench_harness::glam::{Vec2, Vec3};
 use gibench_harness::gpu::{GpuContext, GpuOptions};
 use gibench_harness::runner::{Harness, RunConfig, TimingMode};
@@ -52,6 +54,7 @@ fn grid(mode: Mode) -> Grid {
         cell: 1.0,
         mode,
         stored_albedo: false,
+        transport: Transport::Cosine,
     }
 }
 
@@ -335,7 +338,7 @@ fn voxelize_triangle(a: Vec3, b: Vec3, c: Vec3) {
         };
         let harness = Harness::new(&gpu, &scene, &config).unwrap();
         harness.uniforms.write(&gpu.queue, &harness.clock.frame(0));
-        let g = Grid::around(&scene.extent, 32, Mode::Occluded, false);
+        let g = Grid::around(&scene.extent, 32, Mode::Occluded, false, Transport::Cosine);
         let volumes = Volumes::new(&gpu, &g).unwrap();
         let voxelizer = Voxelizer::new(
             &gpu,

@@ -2,7 +2,9 @@
 // N (cells per axis), COLS (slice tiles per atlas row), ORIGIN (vec3: the grid's min corner),
 // CELL (cell edge), MODE (0: occluded propagation with reflections, Gaitatzes et al. 2010;
 // 1: plain light propagation volume, Kaplanyan 2009), STORED_ALBEDO (0: the paper's constant
-// 0.5 for secondary bounces, 1: the voxel's albedo) prepended, then sh::wgsl().
+// 0.5 for secondary bounces, 1: the voxel's albedo), TRANSPORT (how flux arrives in a void cell:
+// 0 as a clamped-cosine lobe along the face's axis; 1 with the sending cell's own angular
+// distribution; 2 with that of the light through the face's pyramid) prepended, then sh::wgsl().
 
 struct Voxel {
     // xyz: average unit normal of its surfaces (the side it emits and reflects on); w: 1 if

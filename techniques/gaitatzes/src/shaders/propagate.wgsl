@@ -2,7 +2,9 @@
 // neighbours the radiance each sends through the shared face — the neighbour's SH integrated
 // over the face's 90-degree pyramid (SH dot product with the pyramid's coefficients; see
 // face_share) — and takes it as a clamped-cosine lobe of that flux along the direction of
-// travel. Void cells pass the gathered radiance on. Occupied cells
+// travel (TRANSPORT 1: into void cells, with the neighbour's own angular distribution instead,
+// so a lobe keeps its direction; 2: with the distribution of the neighbour's light within the
+// face's pyramid). Void cells pass the gathered radiance on. Occupied cells
 // (MODE 0) add it to the accumulation as incident radiance and reflect it for the next bounce:
 // mirrored along the dominant axis of their normal (the paper's simplification of the rotation
 // to the normal), times the albedo (0.5, the paper's constant, or the voxel's), and send it on
@@ -74,6 +76,26 @@ fn face_share(c: vec4<f32>, d: vec3<i32>, open: array<bool, 6>) -> f32 {
     return max(dot(c, sh_face(vec3<f32>(d))), 0.0) * whole / positive;
 }
 
+// `c` rescaled to a radiance integral of 1 (0 when its integral is not positive).
+fn unit_integral(c: vec4<f32>) -> vec4<f32> {
+    let whole = c.x * 4.0 * 3.14159265 * SH_C0;
+    if (whole <= 0.0) {
+        return vec4<f32>(0.0);
+    }
+    return c / whole;
+}
+
+// The SH of `c` restricted to the pyramid of the face towards `d` (its integral and first
+// moment), rescaled to an integral of 1 (0 when the face's integral is not positive).
+fn through_face(c: vec4<f32>, d: vec3<f32>) -> vec4<f32> {
+    let flux = dot(c, sh_face(d));
+    if (flux <= 0.0) {
+        return vec4<f32>(0.0);
+    }
+    let m = sh_face_moment(c, d);
+    return vec4<f32>(SH_C0 * flux, SH_C1 * m.y, SH_C1 * m.z, SH_C1 * m.x) / flux;
+}
+
 fn dominant_axis(n: vec3<f32>) -> u32 {
     let a = abs(n);
     if (a.x >= a.y && a.x >= a.z) {
@@ -90,6 +112,7 @@ fn propagate(@builtin(global_invocation_id) id: vec3<u32>) {
     let c = vec3<i32>(id);
     let here = voxels[cell_index(c)];
     var g = Sh3(vec4<f32>(0.0), vec4<f32>(0.0), vec4<f32>(0.0));
+    var carried = g;
     for (var k = 0u; k < 6u; k++) {
         // The direction the light travels from the neighbour into this cell.
         let d = face_axis(k);
@@ -102,13 +125,30 @@ fn propagate(@builtin(global_invocation_id) id: vec3<u32>) {
             open[f] = passes(j, face_axis(f));
         }
         let s = source[cell_index(j)];
+        let share = vec3<f32>(face_share(s.r, d, open), face_share(s.g, d, open), face_share(s.b, d, open));
         let lobe = sh_cosine_unit(vec3<f32>(d));
-        g.r += face_share(s.r, d, open) * lobe;
-        g.g += face_share(s.g, d, open) * lobe;
-        g.b += face_share(s.b, d, open) * lobe;
+        g.r += share.r * lobe;
+        g.g += share.g * lobe;
+        g.b += share.b * lobe;
+        if (TRANSPORT == 1u) {
+            // The flux with the sender's angular distribution (its SH over its integral).
+            carried.r += share.r * unit_integral(s.r);
+            carried.g += share.g * unit_integral(s.g);
+            carried.b += share.b * unit_integral(s.b);
+        } else if (TRANSPORT == 2u) {
+            // The flux with the distribution of what crossed the face (the sender's SH over
+            // the face's pyramid, re-projected).
+            let df = vec3<f32>(d);
+            carried.r += share.r * through_face(s.r, df);
+            carried.g += share.g * through_face(s.g, df);
+            carried.b += share.b * through_face(s.b, df);
+        }
     }
     let i = cell_index(c);
     let v = here;
+    if (TRANSPORT != 0u && !(MODE == 0u && v.normal.w > 0.0)) {
+        g = carried;
+    }
     if (MODE == 0u && v.normal.w > 0.0) {
         let a = accumulation[i];
         accumulation[i] = Sh3(a.r + g.r, a.g + g.g, a.b + g.b);

@@ -1,8 +1,10 @@
 // Final reconstruction (Gaitatzes et al. 2010 §4.3, Eq. 11-12): per pixel, the accumulated
 // incident radiance interpolated trilinearly from the eight nearest grid points, using only
 // occupied ones (plain LPV: all), and the irradiance as its SH dot product with the clamped
-// cosine about the surface normal: E = integral of L(w) max(0, -n.w) dw. Expects the G-buffer's
-// read group at 0.
+// cosine about the surface normal, E = integral of L(w) max(0, -n.w) dw, times the
+// flux-to-irradiance constant 12/7 (sh_irradiance; sh::flux_to_irradiance derives it): the
+// propagation delivers flux as unit-integral cosine lobes, whose band-limited dot product with
+// the cosine is 7/12 of the flux they carry head-on. Expects the G-buffer's read group at 0.
 
 @group(0) @binding(0) var<uniform> camera: View;
 @group(0) @binding(1) var gbuffer_depth: texture_2d<f32>;
@@ -50,8 +52,7 @@ fn reconstruct(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     var e = vec3<f32>(0.0);
     if (weight > 0.0) {
-        let cosine = sh_cosine(-n);
-        e = max(vec3<f32>(dot(sum.r, cosine), dot(sum.g, cosine), dot(sum.b, cosine)) / weight, vec3<f32>(0.0));
+        e = vec3<f32>(sh_irradiance(sum.r, n), sh_irradiance(sum.g, n), sh_irradiance(sum.b, n)) / weight;
     }
     textureStore(output, px, vec4<f32>(e, 1.0));
 }
