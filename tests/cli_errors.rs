@@ -1062,3 +1062,28 @@ fn parameters_past_the_image_or_the_device() {
         );
     }
 }
+
+/// An area light a billion units wide (within the corner limit) sends every one of barczak's
+/// random walks past the Cornell box: the error names the scene's light, not the `vpls`
+/// parameter the user never gave (as it did before: "parameter 'vpls': at least one VPL slot").
+#[test]
+fn a_light_whose_walks_miss_the_scene_is_named() {
+    let tmp = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(root().join("scenes/cornell-area.json")).unwrap();
+    let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    v["light"]["size"] = serde_json::json!([1e9, 1e9]);
+    let p = tmp.path().join("wide-light.json");
+    std::fs::write(&p, serde_json::to_string_pretty(&v).unwrap()).unwrap();
+    let scene = p.to_str().unwrap();
+    fails(
+        &[
+            "--scene",
+            scene,
+            "--technique",
+            "barczak",
+            "--resolution",
+            "64x48",
+        ],
+        "field 'light'",
+    );
+}

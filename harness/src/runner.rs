@@ -189,8 +189,28 @@ pub struct FrameImages {
     pub size: [u32; 2],
     /// sRGB RGBA8 of the composed image.
     pub display: Vec<u8>,
+    /// The technique's irradiance, negative values set to 0 (see [`non_negative`]).
     pub indirect: Vec<[f32; 3]>,
     pub direct: Vec<[f32; 3]>,
+    /// Pixels of the technique's output that were negative before [`non_negative`].
+    pub negative_indirect: usize,
+}
+
+/// Sets negative irradiance to 0 and returns how many pixels had some. A technique that adds and
+/// subtracts estimates (`barczak`'s interpolated light map minus its occluded lights' exact
+/// contributions) can undershoot where the two disagree; no irradiance is negative, the compose
+/// pass clamps the same way, and the run warns with the count. NaN is left for its own warning.
+pub fn non_negative(img: &mut [[f32; 3]]) -> usize {
+    let mut n = 0;
+    for p in img.iter_mut() {
+        if p.iter().any(|c| *c < 0.0) {
+            n += 1;
+            for c in p.iter_mut() {
+                *c = c.max(0.0);
+            }
+        }
+    }
+    n
 }
 
 /// Largest finite half float: the irradiance buffers (Rgba16Float) clamp above it.
@@ -203,6 +223,13 @@ impl FrameImages {
     /// either.
     pub fn saturation_warnings(&self) -> Vec<String> {
         let mut out = Vec::new();
+        if self.negative_indirect > 0 {
+            out.push(format!(
+                "indirect irradiance was negative in {} of {} pixels of the last frame (the technique's estimates undershoot there); set to 0 in the images and the error metrics",
+                self.negative_indirect,
+                self.indirect.len()
+            ));
+        }
         for (what, img) in [("indirect", &self.indirect), ("direct", &self.direct)] {
             let nan = img.iter().filter(|p| p.iter().any(|c| c.is_nan())).count();
             if nan > 0 {
@@ -441,11 +468,13 @@ impl<'a> Harness<'a> {
                     }
                 }
             }
+            let (indirect, negative_indirect) = self.read_technique_output(technique.as_ref())?;
             images = Some(FrameImages {
                 size: config.resolution,
                 display: crate::image_io::read_texture(self.gpu, &compose.display)?,
-                indirect: self.read_technique_output(technique.as_ref())?,
+                indirect,
                 direct: crate::image_io::read_rgb_f32(self.gpu, &self.direct.irradiance)?,
+                negative_indirect,
             });
         }
         let result = RunResult {
@@ -530,7 +559,7 @@ impl<'a> Harness<'a> {
                 captured.push(CapturedFrame {
                     frame: f,
                     pair_end,
-                    indirect: to_vec3(self.read_technique_output(technique.as_ref())?),
+                    indirect: to_vec3(self.read_technique_output(technique.as_ref())?.0),
                     radiance: to_vec3(crate::image_io::read_rgb_f32(self.gpu, &compose.radiance)?),
                 });
             }
@@ -557,9 +586,12 @@ impl<'a> Harness<'a> {
         )
     }
 
-    fn read_technique_output(&self, technique: &dyn Technique) -> Result<Vec<[f32; 3]>> {
+    /// The technique's irradiance, made [`non_negative`], and how many pixels were negative.
+    fn read_technique_output(&self, technique: &dyn Technique) -> Result<(Vec<[f32; 3]>, usize)> {
         let tex = technique.output().texture();
-        crate::image_io::read_rgb_f32(self.gpu, tex)
+        let mut img = crate::image_io::read_rgb_f32(self.gpu, tex)?;
+        let negative = non_negative(&mut img);
+        Ok((img, negative))
     }
 }
 

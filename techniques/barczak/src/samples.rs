@@ -116,6 +116,14 @@ pub fn generate(
     } else {
         let (used, mut v) =
             vpl::generate_at_least(scene, bvh, light, settings.indirect, settings.bounces, 1.0);
+        if v.is_empty() {
+            // Not the parameters' fault: the light's walks left the scene (a light far larger
+            // than the scene, or outside it facing away).
+            return Err(Error::Invalid(format!(
+                "scene '{}': none of {} random walks from its light ({:?}, at {:?}) hit the scene, so there are no indirect light samples; check the light's position, direction and size in the scene file (field 'light')",
+                scene.descriptor.name, used.paths, light.kind, light.position
+            )));
+        }
         v.truncate(settings.indirect as usize);
         (used.paths, v)
     };

@@ -28,7 +28,9 @@ struct ComposeOut {
 fn fs_main(@builtin(position) frag: vec4<f32>) -> ComposeOut {
     let pix = vec2<i32>(frag.xy);
     let albedo = textureLoad(gbuffer_albedo, pix, 0).rgb;
-    let e = textureLoad(direct_irradiance, pix, 0).rgb + textureLoad(indirect_irradiance, pix, 0).rgb;
+    // A technique's estimate can undershoot below 0 (the runner counts and warns); no irradiance is.
+    let e = textureLoad(direct_irradiance, pix, 0).rgb
+        + max(textureLoad(indirect_irradiance, pix, 0).rgb, vec3<f32>(0.0));
     let radiance = albedo * e / 3.14159265358979;
     var out: ComposeOut;
     out.radiance = vec4<f32>(radiance, 1.0);
