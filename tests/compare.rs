@@ -129,6 +129,9 @@ fn verdicts_on_synthetic_results_are_exact() {
     assert!(busy.iter().all(|(_, v)| v == "unchanged"), "{busy:?}");
 }
 
+/// A hostile edit of a results file: its name, the edit, what the error must say.
+type Edit = (&'static str, fn(&mut Value), &'static str);
+
 /// Results files that cannot be read are named; a side that would lose its run fails.
 #[test]
 fn unreadable_results_are_named_and_a_lost_run_fails() {
@@ -136,7 +139,7 @@ fn unreadable_results_are_named_and_a_lost_run_fails() {
     let dir = tmp.path();
     let cal = serde_json::json!(10.0);
     synthetic(&dir.join("base"), &[1.0, 1.03, 0.98], |_| 1.0, cal.clone());
-    let edits: [(&str, fn(&mut Value), &str); 7] = [
+    let edits: [Edit; 7] = [
         (
             "no-calibration",
             |v| v["calibration_ms"] = 0.0.into(),

@@ -176,7 +176,7 @@ fn check_flip_input(test: &[u8], reference: &[u8], size: [u32; 2]) -> Result<usi
     }
     let expected = pixels as usize * 3;
     let size_of = |len: usize| -> String {
-        if len % 3 == 0 {
+        if len.is_multiple_of(3) {
             format!("{len} bytes ({} RGB8 pixels)", len / 3)
         } else {
             format!("{len} bytes (not a whole number of RGB8 pixels)")

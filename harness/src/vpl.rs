@@ -83,7 +83,7 @@ fn nth_prime(dim: usize) -> u32 {
         let is_prime = (3..)
             .step_by(2)
             .take_while(|d| d * d <= candidate)
-            .all(|d| candidate % d != 0);
+            .all(|d| !candidate.is_multiple_of(d));
         if is_prime {
             count += 1;
             if count == dim {

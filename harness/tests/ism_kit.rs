@@ -113,7 +113,8 @@ const SIZE: u32 = 32;
 /// The synthetic level 0 of slot 0: a depth ramp with scattered holes (one texel in five) and
 /// a 4×4 hole; `None` marks a hole.
 fn ramp(x: u32, y: u32) -> Option<f32> {
-    let hole = (x * 7 + y * 3) % 5 == 0 || ((12..16).contains(&x) && (20..24).contains(&y));
+    let hole =
+        (x * 7 + y * 3).is_multiple_of(5) || ((12..16).contains(&x) && (20..24).contains(&y));
     (!hole).then_some(0.3 + 0.01 * x as f32 + 0.005 * y as f32)
 }
 

@@ -33,7 +33,7 @@ fn instance(rng: &mut Rng, objects: usize, lights: u32) -> Vec<LightSet> {
             let set = LightSet::from_indices(
                 (start..start + len)
                     .map(|l| l % lights)
-                    .filter(|l| l % 3 != 0 || len % 2 == 0)
+                    .filter(|l| l % 3 != 0 || len.is_multiple_of(2))
                     .chain(strays),
             );
             if rng.below(8) == 0 {
