@@ -263,6 +263,12 @@ pub const TARGETS: &[Target] = &[
         kind: Kind::Paper(&gaitatzes2010::MODULE),
     },
     Target {
+        name: "gaitatzes-cornell",
+        dir: "gaitatzes/cornell",
+        what: "",
+        kind: Kind::Paper(&gaitatzes2010::MODULE),
+    },
+    Target {
         name: "barczak2006",
         dir: "barczak2006",
         what: "",
