@@ -40,6 +40,15 @@ elif [ "$only" != baseline ]; then
   "$g" reproduce all --quick --html --only "$targets" --out results
 fi
 
+# Gaitatzes' two-wall transfer sweep (model and GPU): an example of its crate, not a gibench
+# command (README: "Voxel SH propagation").
+case "results/gaitatzes/transfer" in "results/$only"*) run_transfer=1 ;; *) [ -n "$only" ] && run_transfer=0 || run_transfer=1 ;; esac
+if [ "$run_transfer" = 1 ] && [ "$only" != baseline ]; then
+  echo "== cargo run --release -p gibench-gaitatzes --example transfer -- results/gaitatzes/transfer"
+  rm -rf results/gaitatzes/transfer
+  cargo run --release --quiet -p gibench-gaitatzes --example transfer -- results/gaitatzes/transfer
+fi
+
 # Instruction counts of the CPU kernels under callgrind: the baseline CI's gate fails against.
 run results/baseline/instructions.json instructions --write --baseline results/baseline/instructions.json
 
