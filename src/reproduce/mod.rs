@@ -3,8 +3,8 @@
 //! `results/papers/<paper>.json` and printed beside ours, each labelled with its source.
 //!
 //! * [`laine2007`]: Laine et al. 2007, Tables 1 and 2, VPL management, dispersion.
-//! * [`gaitatzes2010`]: Gaitatzes et al. 2010, Table 1 and the Figure 6 comparison with plain
-//!   light propagation volumes.
+//! * [`gaitatzes2010`]: Gaitatzes et al. 2010, Table 1, the Figure 6 comparison with plain
+//!   light propagation volumes, and the Cornell bias taken apart effect by effect.
 //! * [`ism2008`]: the imperfect-shadow-map breakdown of the Kautz course slides (Ritschel et
 //!   al. 2008), ISM against classic maps on the same VPLs.
 //! * [`barczak2006`]: Barczak 2006, Figures 5-2 to 5-6 (frame rate against lights and
@@ -33,7 +33,7 @@ use gibench_harness::{Error, Result};
 pub struct ReproduceArgs {
     /// What to regenerate: `all` (every target below), or one target: laine-table1,
     /// laine-table2, laine-tables (both from one set of runs), laine-management,
-    /// laine-dispersion, ism-breakdown, gaitatzes-table1, gaitatzes-quality, barczak2006, or a sweep or run target (`gibench reproduce all --list` lists them).
+    /// laine-dispersion, ism-breakdown, gaitatzes-table1, gaitatzes-quality, gaitatzes-cornell, barczak2006, or a sweep or run target (`gibench reproduce all --list` lists them).
     pub target: String,
     /// Small sizes for machines without a GPU (each target says which).
     #[arg(long)]
