@@ -530,6 +530,11 @@ pub(crate) fn plan(args: &RunArgs, extra_params: &[String]) -> Result<Plan> {
     let mut raw = args.params.clone();
     raw.extend_from_slice(extra_params);
     let params = assign_params(&techniques, &raw)?;
+    if let Some(given) = quality.as_ref().and_then(|q| q.component) {
+        for line in other_components(&techniques, &params, given) {
+            eprintln!("warning: {line}");
+        }
+    }
     let desc = SceneDescriptor::resolve(&args.scene)?;
     let scene = Scene::load(&desc, &AssetPaths::standard(args.assets.as_deref()))?;
     // Where files will go must be usable before any GPU work.
@@ -545,6 +550,30 @@ pub(crate) fn plan(args: &RunArgs, extra_params: &[String]) -> Result<Plan> {
         desc,
         scene,
     })
+}
+
+/// A line for each technique whose parameters compute another component than `given`
+/// (`--quality-reference`): its error column is then against light it does not compute.
+fn other_components(
+    techniques: &[&TechniqueInfo],
+    params: &[Params],
+    given: IndirectComponent,
+) -> Vec<String> {
+    techniques
+        .iter()
+        .zip(params)
+        .filter_map(|(t, p)| {
+            let computed = (t.reference)(p);
+            (computed != given).then(|| {
+                format!(
+                    "--quality-reference {}: {} computes the {} component with these parameters; its error is measured against light it does not compute",
+                    given.name(),
+                    t.name,
+                    computed.name()
+                )
+            })
+        })
+        .collect()
 }
 
 impl Plan {
@@ -578,27 +607,46 @@ pub(crate) fn execute_with_bar(
     gpu: &GpuContext,
     spec: &RunSpec,
 ) -> Result<Vec<RunResult>> {
-    let results = match bars {
+    execute_skipping_with_bar(bars, gpu, spec, false).map(|(results, _)| results)
+}
+
+/// [`execute_with_bar`] leaving out, with `skip_unfit`, the techniques that cannot take the
+/// scene or the device ([`session::execute_skipping`]); each is named with its reason.
+pub(crate) fn execute_skipping_with_bar(
+    bars: &Bars,
+    gpu: &GpuContext,
+    spec: &RunSpec,
+    skip_unfit: bool,
+) -> Result<(Vec<RunResult>, Vec<session::Skipped>)> {
+    let executed = match bars {
         Bars::Own(quiet) => {
             let bar = progress_bar(*quiet, spec.total_frames());
-            let results = session::execute(gpu, spec, &mut |p| match p {
+            let executed = session::execute_skipping(gpu, spec, skip_unfit, &mut |p| match p {
                 Progress::Technique(name) => bar.set_message(name.to_string()),
                 Progress::Frame => bar.inc(1),
             });
             bar.finish_and_clear();
-            results
+            executed
         }
-        Bars::Shared(all) => session::execute(gpu, spec, &mut |p| match p {
+        Bars::Shared(all) => session::execute_skipping(gpu, spec, skip_unfit, &mut |p| match p {
             Progress::Technique(name) => all.technique(name),
             Progress::Frame => all.frame(),
         }),
     };
-    for r in results.iter().flatten() {
-        for w in &r.warnings {
-            bars.note(&format!("warning: {} on {}: {w}", r.technique, r.scene));
+    if let Ok((results, skipped)) = &executed {
+        for s in skipped {
+            bars.note(&format!(
+                "skipped {} on {}: {}",
+                s.technique, spec.scene.descriptor.name, s.reason
+            ));
+        }
+        for r in results {
+            for w in &r.warnings {
+                bars.note(&format!("warning: {} on {}: {w}", r.technique, r.scene));
+            }
         }
     }
-    results
+    executed
 }
 
 /// Where a command reports its progress: a bar of its own (hidden when quiet), or its share of
@@ -750,9 +798,27 @@ pub(crate) fn run_planned(
 ) -> Result<String> {
     let spec = plan.spec(args);
     bars.note(&announcement(plan, gpu));
-    let results = execute_with_bar(bars, gpu, &spec)?;
+    // A run over every technique leaves out one that cannot take the scene or the device; one
+    // named with --technique is an error.
+    let (results, skipped) =
+        execute_skipping_with_bar(bars, gpu, &spec, args.technique.is_empty())?;
     let name = &plan.desc.name;
-    let table = report::stage_table(&results);
+    if results.is_empty() {
+        let reasons: Vec<String> = skipped
+            .iter()
+            .map(|s| format!("{}: {}", s.technique, s.reason))
+            .collect();
+        return Err(Error::Invalid(format!(
+            "no technique could run on scene '{name}': {}",
+            reasons.join("; ")
+        )));
+    }
+    let mut table = report::stage_table(&results);
+    for s in &skipped {
+        table
+            .notes
+            .push(format!("Skipped {}: {}", s.technique, s.reason));
+    }
     bars.table(&table);
     let stem = format!("{name}-summary");
     let mut written: Vec<String> = report::write_tables(&table, &args.out, &stem)?
@@ -1137,7 +1203,7 @@ fn list() -> Result<()> {
         println!("  {:<16} {}", t.name, t.description);
         println!(
             "      compared with the {} reference by default; conformance: relative L1 error <= {}, mean ratio {}-{}",
-            t.reference.name(),
+            t.default_reference().name(),
             t.conformance.max_relative_l1,
             t.conformance.mean_ratio.0,
             t.conformance.mean_ratio.1

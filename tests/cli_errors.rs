@@ -1087,3 +1087,59 @@ fn a_light_whose_walks_miss_the_scene_is_named() {
         "field 'light'",
     );
 }
+
+/// The component each run is compared with follows its parameters (`keller-full bounces=3`
+/// computes several bounces, `barczak set=direct` the area light's direct light), and
+/// `--quality-reference` naming another one warns, naming the technique (checked at planning:
+/// an unwritable `--out` then stops the run before any work). Caught by: the component
+/// declared once per technique (no warning for bounces=3 against one bounce, a false one for
+/// set=direct against direct).
+#[test]
+fn quality_reference_other_than_the_computed_component_warns() {
+    let tmp = tempfile::tempdir().unwrap();
+    std::fs::write(tmp.path().join("file"), b"").unwrap();
+    let planned = |args: &[&str]| {
+        let mut all = vec!["run", "--quality", "--out", "file/out"];
+        all.extend_from_slice(args);
+        command_fails(tmp.path(), &[], &all, &["parameter 'out'"])
+    };
+    let warned = |stderr: &str, technique: &str| {
+        stderr
+            .lines()
+            .any(|l| l.starts_with("warning: --quality-reference") && l.contains(technique))
+    };
+    let e = planned(&[
+        "--technique",
+        "keller-full",
+        "--param",
+        "bounces=3",
+        "--quality-reference",
+        "one-bounce",
+    ]);
+    assert!(warned(&e, "keller-full computes the multi-bounce"), "{e}");
+    let e = planned(&[
+        "--technique",
+        "keller-full",
+        "--quality-reference",
+        "one-bounce",
+    ]);
+    assert!(!warned(&e, "keller-full"), "{e}");
+    let e = planned(&[
+        "--technique",
+        "barczak",
+        "--param",
+        "set=direct",
+        "--quality-reference",
+        "direct",
+    ]);
+    assert!(!warned(&e, "barczak"), "{e}");
+    let e = planned(&[
+        "--technique",
+        "barczak",
+        "--param",
+        "set=direct",
+        "--quality-reference",
+        "multi-bounce",
+    ]);
+    assert!(warned(&e, "barczak computes the direct"), "{e}");
+}

@@ -76,7 +76,7 @@ fn conform_on(gpu: &GpuContext, scene_name: &str, failures: &mut Vec<String>) {
     let frame = h.clock.frame(FRAMES - 1);
     let mut references = Vec::new();
     for info in registry::all() {
-        let component = info.reference;
+        let component = info.default_reference();
         let reference = match references.iter().position(|(c, _)| *c == component) {
             Some(i) => &references[i].1,
             None => {

@@ -263,3 +263,62 @@ fn negative_irradiance_is_set_to_zero_and_counted() {
         exr.display()
     );
 }
+
+/// A run over every technique does not die for one that cannot take the scene: on the arena
+/// (10,592 triangles, no recorded patches) `barczak` is left out with its reason, on standard
+/// error and in the summary table's notes, and the others run; named with `--technique`, it
+/// is an error before any frame, and no results file is written. Caught by: the run failing
+/// as a whole (as before), or leaving the technique out silently.
+#[test]
+fn a_run_over_every_technique_skips_one_that_cannot_take_the_scene() {
+    let small = [
+        "--scene",
+        "gaitatzes-arena",
+        "--resolution",
+        "64x48",
+        "--frames",
+        "1",
+        "--warmup",
+        "0",
+        "--timing",
+        "stages",
+        "--no-images",
+    ];
+    let dir = tempfile::tempdir().unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_gibench"))
+        .arg("run")
+        .args(small)
+        .arg("--out")
+        .arg(dir.path())
+        .arg("--quiet")
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("skipped barczak on gaitatzes-arena: ") && stderr.contains("patches"),
+        "{stderr}"
+    );
+    assert!(!dir.path().join("gaitatzes-arena-barczak.json").exists());
+    for t in ["direct", "keller-full", "laine", "ism", "gaitatzes"] {
+        let f = dir.path().join(format!("gaitatzes-arena-{t}.json"));
+        assert!(f.is_file(), "{} missing; {stderr}", f.display());
+    }
+    let md = std::fs::read_to_string(dir.path().join("gaitatzes-arena-summary.md")).unwrap();
+    assert!(md.contains("Skipped barczak: "), "{md}");
+    let named = tempfile::tempdir().unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_gibench"))
+        .arg("run")
+        .args(small)
+        .args(["--technique", "barczak", "--out"])
+        .arg(named.path())
+        .arg("--quiet")
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && stderr.contains("patches"),
+        "{stderr}"
+    );
+    assert!(!named.path().join("gaitatzes-arena-barczak.json").exists());
+}

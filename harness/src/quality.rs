@@ -74,11 +74,15 @@ pub struct QualityConfig {
 }
 
 impl QualityConfig {
-    /// This configuration with the component resolved for `info` (its declared one unless
-    /// overridden).
-    pub fn for_technique(&self, info: &crate::technique::TechniqueInfo) -> QualityConfig {
+    /// This configuration with the component resolved for `info` with `params` (the one they
+    /// compute unless overridden).
+    pub fn for_technique(
+        &self,
+        info: &crate::technique::TechniqueInfo,
+        params: &crate::technique::Params,
+    ) -> QualityConfig {
         QualityConfig {
-            component: Some(self.component.unwrap_or(info.reference)),
+            component: Some(self.component.unwrap_or((info.reference)(params))),
             ..self.clone()
         }
     }

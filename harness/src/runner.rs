@@ -544,7 +544,7 @@ impl<'a> Harness<'a> {
         cache: &ReferenceCache,
         progress: &mut dyn FnMut(),
     ) -> Result<(QualitySummary, QualityImages)> {
-        let quality = &quality.for_technique(info);
+        let quality = &quality.for_technique(info, params);
         let (mut technique, compose) = self.build(info, params, config, prepared)?;
         let mut profiler = Profiler::new(self.gpu, ProfileMode::Frame);
         let targets = quality.capture_frames(config.first_frame + config.warmup, config.frames);

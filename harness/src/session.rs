@@ -117,27 +117,61 @@ fn file_name(p: &Path) -> String {
         .unwrap_or_default()
 }
 
+/// A technique left out of a run over every technique: it cannot take the scene or does not
+/// fit the device (what its preparation said).
+#[derive(Clone, Debug)]
+pub struct Skipped {
+    pub technique: String,
+    pub reason: String,
+}
+
 /// Runs every technique of `spec` on `gpu` and writes its files; returns the results in order.
+/// A technique that cannot be prepared fails the run before any frame.
 pub fn execute(
     gpu: &GpuContext,
     spec: &RunSpec,
     progress: &mut dyn FnMut(Progress),
 ) -> Result<Vec<RunResult>> {
+    execute_skipping(gpu, spec, false, progress).map(|(results, _)| results)
+}
+
+/// [`execute`], except that with `skip_unfit` a technique whose preparation fails is left out
+/// (with its reason) instead of failing the run: for a run over every technique, which should
+/// not die for one that cannot take the scene. Skipped or not, it is found out before any
+/// frame runs.
+pub fn execute_skipping(
+    gpu: &GpuContext,
+    spec: &RunSpec,
+    skip_unfit: bool,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<(Vec<RunResult>, Vec<Skipped>)> {
     spec.validate()?;
     let harness = Harness::new(gpu, spec.scene, &spec.config)?;
     // Every technique is prepared and built once before any frame runs, so that what does not
     // fit the device (a VPL atlas, a buffer) is reported before the first technique's work.
     let mut prepared = Vec::with_capacity(spec.runs.len());
+    let mut skipped = Vec::new();
     for run in &spec.runs {
-        let p = harness.prepare(run.info, &run.params, &spec.config)?;
-        drop(harness.build(run.info, &run.params, &spec.config, &p)?);
-        prepared.push(p);
+        let ready = harness
+            .prepare(run.info, &run.params, &spec.config)
+            .and_then(|p| {
+                drop(harness.build(run.info, &run.params, &spec.config, &p)?);
+                Ok(p)
+            });
+        match ready {
+            Ok(p) => prepared.push((run, p)),
+            Err(e) if skip_unfit => skipped.push(Skipped {
+                technique: run.info.name.to_string(),
+                reason: e.to_string(),
+            }),
+            Err(e) => return Err(e),
+        }
     }
-    let mut results = Vec::with_capacity(spec.runs.len());
-    for (run, p) in spec.runs.iter().zip(&prepared) {
+    let mut results = Vec::with_capacity(prepared.len());
+    for (run, p) in &prepared {
         results.push(execute_one(&harness, spec, run, p, progress)?);
     }
-    Ok(results)
+    Ok((results, skipped))
 }
 
 fn execute_one(

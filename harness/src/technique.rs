@@ -234,6 +234,16 @@ pub trait Technique {
 /// as its own figure (`prepare_ms` in the results).
 pub type Prepared = Box<dyn std::any::Any + Send + Sync>;
 
+/// A technique whose output approximates one bounce of indirect light whatever its parameters.
+pub fn one_bounce(_: &Params) -> IndirectComponent {
+    IndirectComponent::OneBounce
+}
+
+/// A technique whose output approximates every bounce of indirect light whatever its parameters.
+pub fn multi_bounce(_: &Params) -> IndirectComponent {
+    IndirectComponent::MultiBounce
+}
+
 /// The `prepare` of a technique that prepares nothing.
 pub fn prepare_nothing(_: &Params, _: &PrepareContext) -> Result<Prepared> {
     Ok(Box::new(()))
@@ -263,9 +273,10 @@ pub struct TechniqueInfo {
     pub required_features: wgpu::Features,
     /// Limits the technique needs (checked before it is built).
     pub required_limits: fn() -> wgpu::Limits,
-    /// The reference component its indirect irradiance approximates (`--quality` compares
-    /// with it unless `--quality-reference` overrides).
-    pub reference: IndirectComponent,
+    /// The reference component its indirect irradiance approximates with these parameters
+    /// (`keller-full bounces=3` computes several bounces, `barczak set=direct` the direct
+    /// light): `--quality` compares with it unless `--quality-reference` overrides.
+    pub reference: fn(&Params) -> IndirectComponent,
     /// Its conformance bounds.
     pub conformance: Conformance,
     /// Per-scene preparation, once per scene and parameter set ([`prepare_nothing`] if none).
@@ -295,6 +306,14 @@ impl TechniqueInfo {
     pub fn parse_params(&self, given: &[(String, String)]) -> Result<Params> {
         let specs: Vec<ParamSpec> = self.param_specs().copied().collect();
         Params::parse(self.name, &specs, given)
+    }
+
+    /// The reference component with its default parameters (what `gibench list` shows).
+    pub fn default_reference(&self) -> IndirectComponent {
+        let defaults = self
+            .parse_params(&[])
+            .expect("a technique's defaults parse (tested for every registered technique)");
+        (self.reference)(&defaults)
     }
 
     /// Whether it declares a parameter `name`.

@@ -71,9 +71,16 @@ const GRID: u32 = 32;
 const LPV_FEW: u32 = 8;
 const LPV_MANY: u32 = 256;
 
+/// A `gaitatzes-cornell` step: the effect's name, the parameters it changes, what it undoes.
+pub type CornellStep = (
+    &'static str,
+    &'static [(&'static str, &'static str)],
+    &'static str,
+);
+
 /// The `gaitatzes-cornell` steps, cumulative: a name for the effect, the parameters changed
 /// from the previous step (the first: the defaults), and what the change undoes.
-pub const CORNELL_STEPS: [(&str, &[(&str, &str)], &str); 5] = [
+pub const CORNELL_STEPS: [CornellStep; 5] = [
     ("defaults", &[], "the default run: 32³, 12 iterations, bounce albedo 0.5, cosine transport"),
     (
         "reach",

@@ -4,7 +4,6 @@
 //!
 //! Needs: no optional GPU features, WebGL2-level limits.
 
-use gibench_harness::quality::IndirectComponent;
 use gibench_harness::technique::{
     prepare_nothing, Conformance, FrameContext, Params, PrepareContext, Prepared, Technique,
     TechniqueInfo,
@@ -19,7 +18,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     params: &[],
     required_features: wgpu::Features::empty(),
     required_limits: wgpu::Limits::downlevel_webgl2_defaults,
-    reference: IndirectComponent::OneBounce,
+    reference: gibench_harness::technique::one_bounce,
     // No indirect light at all: the mean ratio must be exactly zero.
     conformance: Conformance {
         max_relative_l1: 1.0,

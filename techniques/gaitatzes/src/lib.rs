@@ -51,7 +51,6 @@ pub mod sh;
 pub mod slab;
 pub mod volume;
 
-use gibench_harness::quality::IndirectComponent;
 use gibench_harness::technique::{
     prepare_nothing, Conformance, FrameContext, ParamKind, ParamSpec, Params, PrepareContext,
     Prepared, Technique, TechniqueInfo,
@@ -107,7 +106,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     params: &[PARAMS],
     required_features: wgpu::Features::empty(),
     required_limits: wgpu::Limits::downlevel_defaults,
-    reference: IndirectComponent::MultiBounce,
+    reference: gibench_harness::technique::multi_bounce,
     // On the Cornell boxes against the multi-bounce reference at the defaults (32³, 12
     // iterations, `transport=cosine`), measured (tests/conformance.rs, 96x72): mean ratio 0.315
     // (spot), 0.322 (area), 0.321 (omni), 0.570 (sun); relative L1 0.72, 0.72, 0.94, 0.77. The

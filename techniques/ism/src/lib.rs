@@ -41,7 +41,6 @@ use gibench_harness::ir::rsm::ReflectiveShadowMap;
 use gibench_harness::ir::splat::PointSplat;
 use gibench_harness::ir::vpl_sample::{RsmTexels, VplSampler};
 use gibench_harness::passes::DrawSet;
-use gibench_harness::quality::IndirectComponent;
 use gibench_harness::technique::{
     Conformance, FrameContext, ParamKind, ParamSpec, Params, PrepareContext, Prepared, Technique,
     TechniqueInfo,
@@ -105,7 +104,7 @@ pub const INFO_CLASSIC: TechniqueInfo = TechniqueInfo {
     params: &[CLASSIC_PARAMS, GATHER],
     required_features: wgpu::Features::empty(),
     required_limits: wgpu::Limits::downlevel_defaults,
-    reference: IndirectComponent::OneBounce,
+    reference: gibench_harness::technique::one_bounce,
     // The same bound as `ism`: the VPLs are the same; only the maps differ.
     conformance: Conformance {
         max_relative_l1: 0.8,
@@ -123,7 +122,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     params: &[OWN_PARAMS, GATHER],
     required_features: wgpu::Features::empty(),
     required_limits: wgpu::Limits::downlevel_defaults,
-    reference: IndirectComponent::OneBounce,
+    reference: gibench_harness::technique::one_bounce,
     // On the Cornell boxes against the one-bounce reference (64 VPLs, 1024 points each, 4x4
     // tiles, 3 pull-push levels): measured relative L1 0.34–0.69 and mean ratio 0.93–0.94 on
     // the spot, area and omni boxes, 1.14 on the sun box, where light leaks through holes the

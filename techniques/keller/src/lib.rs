@@ -85,6 +85,16 @@ const CONFORMANCE: Conformance = Conformance {
     mean_ratio: (0.88, 1.1),
 };
 
+/// What Keller's VPLs light with `params`: one bounce from single-vertex paths, several with
+/// `bounces` > 1 (Keller's fractional absorption).
+fn computed_component(params: &Params) -> IndirectComponent {
+    if params.has("bounces") && params.int("bounces") > 1 {
+        IndirectComponent::MultiBounce
+    } else {
+        IndirectComponent::OneBounce
+    }
+}
+
 /// `keller-full` registry entry.
 pub const FULL: TechniqueInfo = TechniqueInfo {
     name: "keller-full",
@@ -92,7 +102,7 @@ pub const FULL: TechniqueInfo = TechniqueInfo {
     params: &[FULL_OWN, GATHER_PARAMS],
     required_features: wgpu::Features::empty(),
     required_limits: wgpu::Limits::downlevel_defaults,
-    reference: IndirectComponent::OneBounce,
+    reference: computed_component,
     conformance: CONFORMANCE,
     prepare,
     create: create_full,
@@ -105,7 +115,7 @@ pub const INCREMENTAL: TechniqueInfo = TechniqueInfo {
     params: &[INCREMENTAL_OWN, GATHER_PARAMS],
     required_features: wgpu::Features::empty(),
     required_limits: wgpu::Limits::downlevel_defaults,
-    reference: IndirectComponent::OneBounce,
+    reference: computed_component,
     conformance: CONFORMANCE,
     prepare,
     create: create_incremental,

@@ -44,7 +44,6 @@ use gibench_harness::ir::gather::{GatherParams, VplGather, GATHER_PARAMS};
 use gibench_harness::ir::raster::AtlasClear;
 use gibench_harness::light::SampleDomain;
 use gibench_harness::passes::DrawSet;
-use gibench_harness::quality::IndirectComponent;
 use gibench_harness::scene::Scene;
 use gibench_harness::technique::{
     prepare_nothing, Conformance, FrameContext, ParamKind, ParamSpec, Params, PrepareContext,
@@ -85,7 +84,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     params: &[OWN_PARAMS, GATHER_PARAMS],
     required_features: wgpu::Features::empty(),
     required_limits: wgpu::Limits::downlevel_defaults,
-    reference: IndirectComponent::OneBounce,
+    reference: gibench_harness::technique::one_bounce,
     // On the Cornell boxes against the one-bounce reference (64 VPLs, 4x4 tiles): measured
     // relative L1 0.33–0.71 and mean ratio 0.94–1.04 (the same VPL count as keller-*).
     conformance: Conformance {
