@@ -322,11 +322,23 @@ fn a_killed_unreaped_run_does_not_hold_the_folder() {
         .args(["-KILL", &pid.to_string()])
         .status()
         .unwrap();
-    while std::fs::read_to_string(format!("/proc/{pid}/stat"))
-        .is_ok_and(|s| !s.split(") ").nth(1).unwrap_or("").starts_with('Z'))
-    {
+    // The first thread to show `Z` may be the leader while the process's other threads (the
+    // driver's workers) are still exiting, and they hold the open files (and so the lock) until
+    // the last of them is gone: wait until the leader is a zombie and is the only thread left.
+    let zombie_alone = || {
+        let z = std::fs::read_to_string(format!("/proc/{pid}/stat"))
+            .is_ok_and(|s| s.split(") ").nth(1).unwrap_or("").starts_with('Z'));
+        let threads = std::fs::read_dir(format!("/proc/{pid}/task")).map_or(0, |d| d.count());
+        z && threads <= 1
+    };
+    let start = Instant::now();
+    while !zombie_alone() && start.elapsed() < Duration::from_secs(60) {
         std::thread::sleep(Duration::from_millis(10));
     }
+    assert!(
+        zombie_alone(),
+        "process {pid} did not become a lone zombie in 60 s"
+    );
     let o = small_direct(&out);
     let _ = first.wait();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
