@@ -23,7 +23,8 @@
 //! * [`atlas::ShadowAtlas`] — one visibility map per slot (paraboloid, cube or octahedral; 16/32-bit depth
 //!   or a 32-bit float texture), its parameters and its WGSL lookup.
 //! * [`raster::AtlasRasteriser`] — renders chosen slots of a depth atlas from a
-//!   [`DrawSet`](crate::passes::DrawSet), uploading its own views.
+//!   [`DrawSet`](crate::passes::DrawSet), uploading its own views; octahedral maps only into
+//!   the faces [`face_cull::Occluders`] finds occluders in, where the technique asks.
 //! * [`interleave::Interleave`] — split, combine and the geometry-aware filter (Laine et al.
 //!   2007 §5).
 //! * [`accumulate::Accumulation`] — a store and an atlas through the interleaving.
@@ -44,6 +45,7 @@
 pub mod accumulate;
 pub mod atlas;
 pub mod edges;
+pub mod face_cull;
 pub mod gather;
 pub mod interleave;
 pub mod points;

@@ -15,7 +15,9 @@
 //! maps (Barczak 2006 §4.2) with one pass per octahedron face into the same square, the face's
 //! projection in the vertex shader, fragments outside its triangle (widened by a sliver, so
 //! neighbouring faces leave no crack) discarded (Barczak clips with user clip planes, which
-//! wgpu's GL backend lacks) and the exact distance written as depth.
+//! wgpu's GL backend lacks) and the exact distance written as depth. A caller may name the
+//! faces to draw per map ([`AtlasRasteriser::render_faces`]; Barczak §4.2.2 skips the
+//! octahedral faces holding no occluder, [`super::face_cull`]); the others stay cleared.
 //!
 //! VPLs a GPU pass wrote into a [`VplStore`] (imperfect shadow maps' RSM-sampled VPLs) are
 //! rendered with [`StoreViews`]: a compute pass writes each slot's paraboloid view from the store
@@ -242,14 +244,38 @@ impl AtlasRasteriser {
         vpls: &[(u32, Vpl)],
         clear: AtlasClear,
     ) -> u32 {
-        let kept = || vpls.iter().filter(|(s, _)| *s < self.capacity);
+        self.render_faces(gpu, encoder, atlas, scene, uniforms, vpls, &[], clear)
+            .0
+    }
+
+    /// [`render`](Self::render) drawing map `k` only into the faces whose bits are set in
+    /// `faces[k]` (bit f: face f; [`face_cull::Occluders`](super::face_cull::Occluders) finds
+    /// them for octahedral maps); a face not drawn is left cleared. `faces` shorter than `vpls`
+    /// draws every face of the maps past its end. Returns the maps and the faces rendered.
+    #[allow(clippy::too_many_arguments)]
+    pub fn render_faces(
+        &self,
+        gpu: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        atlas: &ShadowAtlas,
+        scene: &GpuScene,
+        uniforms: &FrameUniforms,
+        vpls: &[(u32, Vpl)],
+        faces: &[u8],
+        clear: AtlasClear,
+    ) -> (u32, u32) {
+        let kept = || {
+            (vpls.iter().enumerate())
+                .filter(|(_, (s, _))| *s < self.capacity)
+                .map(|(k, (s, v))| (k, *s, v))
+        };
         // One upload covering every slot rendered (per-slot writes cost about 1 ms each on
         // lavapipe: 8x the maps themselves at 256 VPLs).
         let mut mirror = self.mirror.borrow_mut();
         let (mut lo, mut hi) = (u32::MAX, 0);
-        for (slot, vpl) in kept() {
-            self.write_view(&mut mirror, atlas, *slot, vpl);
-            (lo, hi) = (lo.min(*slot), hi.max(*slot));
+        for (_, slot, vpl) in kept() {
+            self.write_view(&mut mirror, atlas, slot, vpl);
+            (lo, hi) = (lo.min(slot), hi.max(slot));
         }
         if lo <= hi {
             let slot_bytes = self.kind.faces() as usize * VIEW_STRIDE as usize;
@@ -262,7 +288,7 @@ impl AtlasRasteriser {
             atlas,
             scene,
             uniforms,
-            kept().map(|(s, _)| *s),
+            kept().map(|(k, s, _)| (s, faces.get(k).copied().unwrap_or(u8::MAX))),
             clear,
         )
     }
@@ -289,20 +315,22 @@ impl AtlasRasteriser {
             pass.set_bind_group(0, &views.group, &[]);
             pass.dispatch_workgroups(count.div_ceil(64), 1, 1);
         }
-        self.draw(encoder, atlas, scene, uniforms, 0..count, AtlasClear::Whole)
+        let slots = (0..count).map(|s| (s, u8::MAX));
+        self.draw(encoder, atlas, scene, uniforms, slots, AtlasClear::Whole)
+            .0
     }
 
-    /// Records the maps of `slots`, whose views are in place, after the clear `clear` asks for.
-    /// Returns the number of maps recorded.
+    /// Records the maps of `slots` (slot, faces to draw), whose views are in place, after the
+    /// clear `clear` asks for. Returns the maps and the faces recorded.
     fn draw(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         atlas: &ShadowAtlas,
         scene: &GpuScene,
         uniforms: &FrameUniforms,
-        slots: impl Iterator<Item = u32>,
+        slots: impl Iterator<Item = (u32, u8)>,
         clear: AtlasClear,
-    ) -> u32 {
+    ) -> (u32, u32) {
         let load = match clear {
             AtlasClear::Whole => wgpu::LoadOp::Clear(0.0),
             AtlasClear::RenderedSlots => wgpu::LoadOp::Load,
@@ -324,8 +352,8 @@ impl AtlasRasteriser {
         });
         let s = atlas.settings.size;
         let faces = self.kind.faces();
-        let mut count = 0;
-        for slot in slots {
+        let (mut count, mut drawn) = (0, 0);
+        for (slot, mask) in slots {
             count += 1;
             if clear == AtlasClear::RenderedSlots {
                 let ([x, y], [w, h]) = atlas.block(slot);
@@ -335,7 +363,8 @@ impl AtlasRasteriser {
                 pass.draw(0..3, 0..1);
             }
             pass.set_pipeline(&self.map_pipeline);
-            for f in 0..faces {
+            for f in (0..faces).filter(|f| mask & (1 << f) != 0) {
+                drawn += 1;
                 let [x, y] = atlas.face_origin(slot, f);
                 pass.set_viewport(x as f32, y as f32, s as f32, s as f32, 0.0, 1.0);
                 pass.set_scissor_rect(x, y, s, s);
@@ -344,7 +373,7 @@ impl AtlasRasteriser {
                 scene.draw(&mut pass, uniforms, 1, self.draw_set);
             }
         }
-        count
+        (count, drawn)
     }
 
     /// The compute pass that writes the views of the VPLs in `store` for

@@ -10,6 +10,7 @@
 //!   light (the descriptor's; the thesis has two).
 //! * [`table_room`] — the room with a 1.6 × 1.0 m table, 0.9 m high, for the bunny to walk on.
 //! * [`pillar_room`] — the room with four 0.4 m square pillars from floor to ceiling.
+//! * [`casters`] — a room's shadow casters alone (its shadow mesh: the shell left out).
 //! * [`torus`] — the thesis' 820-vertex torus mover (41 × 20 vertices), 0.3 m ring, 0.1 m tube.
 //!
 //! Units are metres, +Y up. Walls: red at x = 0, blue at x = 6 (the thesis' colour bleeding),
@@ -193,12 +194,15 @@ fn shell(tessellate: Option<f32>) -> Builder {
     b
 }
 
-fn finish(b: Builder) -> (Mesh, Vec<Material>, Vec<Patch>) {
+/// A generated room: its mesh, materials and patches.
+pub type Room = (Mesh, Vec<Material>, Vec<Patch>);
+
+fn finish(b: Builder) -> Room {
     (b.mesh, materials(), b.patches)
 }
 
 /// The room with large area lights: two blocks on the floor (objects 6, 7).
-pub fn area_room(tessellate: Option<f32>) -> (Mesh, Vec<Material>, Vec<Patch>) {
+pub fn area_room(tessellate: Option<f32>) -> Room {
     let mut b = shell(tessellate);
     let v = Vec3::new;
     b.cuboid(v(1.2, 0., 1.8), v(2.2, 0.8, 2.8), 5, 6, 1, true, false);
@@ -207,7 +211,7 @@ pub fn area_room(tessellate: Option<f32>) -> (Mesh, Vec<Material>, Vec<Patch>) {
 }
 
 /// The room with a table (object 6: a 1.6 × 1.0 × 0.06 m top at 0.9 m on four 6 cm legs).
-pub fn table_room(tessellate: Option<f32>) -> (Mesh, Vec<Material>, Vec<Patch>) {
+pub fn table_room(tessellate: Option<f32>) -> Room {
     let mut b = shell(tessellate);
     let v = Vec3::new;
     let (x0, z0, x1, z1) = (2.2, 2.5, 3.8, 3.5);
@@ -232,7 +236,7 @@ pub fn table_room(tessellate: Option<f32>) -> (Mesh, Vec<Material>, Vec<Patch>) 
 }
 
 /// The room with four pillars (objects 6–9), floor to ceiling.
-pub fn pillar_room(tessellate: Option<f32>) -> (Mesh, Vec<Material>, Vec<Patch>) {
+pub fn pillar_room(tessellate: Option<f32>) -> Room {
     let mut b = shell(tessellate);
     let v = Vec3::new;
     for (i, (x, z)) in [(1.6, 1.6), (4.4, 1.6), (1.6, 4.4), (4.4, 4.4)]
@@ -250,6 +254,21 @@ pub fn pillar_room(tessellate: Option<f32>) -> (Mesh, Vec<Material>, Vec<Patch>)
         );
     }
     finish(b)
+}
+
+/// The shadow casters of a room built by `room`: only its patches that cast shadows (split
+/// into cells of about `tessellate`), as the thesis leaves the outer walls, which cannot block
+/// other surfaces, out of its occluders (§4.2.2). The shell of a room is convex, so leaving it
+/// out of a shadow map changes no lookup inside the room; it lets a map's octahedral faces
+/// without a caster go undrawn.
+pub fn casters(room: fn(Option<f32>) -> Room, tessellate: Option<f32>) -> Room {
+    let (_, materials, patches) = room(None);
+    let kept: Vec<Patch> = patches.into_iter().filter(|p| p.casts_shadows).collect();
+    let mut mesh = Mesh::default();
+    for p in &kept {
+        quad(&mut mesh, p.corners, p.normal, p.material, tessellate);
+    }
+    (mesh, materials, kept)
 }
 
 /// Vertices around the ring and around the tube of [`torus`].

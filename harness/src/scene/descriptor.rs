@@ -24,6 +24,9 @@ pub const GENERATED_MESHES: &[&str] = &[
     "barczak-area-room",
     "barczak-table-room",
     "barczak-pillar-room",
+    "barczak-area-casters",
+    "barczak-table-casters",
+    "barczak-pillar-casters",
     "torus-820",
 ];
 

@@ -406,6 +406,9 @@ fn generate(name: &str, tessellate: Option<f32>) -> Result<(Mesh, Vec<Material>,
         "barczak-area-room" => barczak::area_room(tessellate),
         "barczak-table-room" => barczak::table_room(tessellate),
         "barczak-pillar-room" => barczak::pillar_room(tessellate),
+        "barczak-area-casters" => barczak::casters(barczak::area_room, tessellate),
+        "barczak-table-casters" => barczak::casters(barczak::table_room, tessellate),
+        "barczak-pillar-casters" => barczak::casters(barczak::pillar_room, tessellate),
         "torus-820" => none(barczak::torus()),
         _ => {
             return Err(crate::Error::Invalid(format!(

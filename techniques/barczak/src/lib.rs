@@ -50,7 +50,8 @@
 //! The samples are made once, from the light's pose at the first frame (the thesis' static
 //! lights). Stages: `visibility` (CPU: movers in the database, light-map updates, schedule,
 //! pass planning), `shadow-maps`, `light-maps`, `edges`, `low-res`, `lights`, `prt-lighting`
-//! (CPU), `prt`; counters `vpls`, `maps-rendered`, `light-draws`, `elements`,
+//! (CPU), `prt`; counters `vpls`, `maps-rendered`, `map-faces` (octahedral faces drawn into:
+//! `face-cull=on` skips those without occluders), `light-draws`, `elements`,
 //! `light-map-changes`.
 
 pub mod database;
@@ -163,6 +164,12 @@ const PARAMS: &[ParamSpec] = &[
         doc: "shadow maps a moving object made out of date re-rendered per frame, brightest and oldest first (the thesis: 100-150 of 300)",
     },
     ParamSpec {
+        name: "face-cull",
+        kind: ParamKind::Choice(&["on", "off"]),
+        default: "on",
+        doc: "on: a shadow map is drawn only into the octahedral faces that hold an occluder (the thesis' §4.2.2 culling test); off: into all four",
+    },
+    ParamSpec {
         name: "light-map-res",
         kind: ParamKind::Int { min: 1, max: 64 },
         default: "8",
@@ -261,6 +268,7 @@ impl BarczakParams {
                 map_size: params.int("vpl-map-size") as u32,
                 updates: params.int("updates") as u32,
                 prt_directions: params.int("prt-directions") as usize,
+                face_cull: params.choice("face-cull") == "on",
             },
         })
     }
@@ -311,9 +319,10 @@ impl Technique for Barczak {
         let mut counts = ctx
             .profiler
             .cpu_stage(STAGE_VISIBILITY, || r.update(gpu, frame))?;
-        counts.maps_rendered = ctx.profiler.gpu_stage(gpu, STAGE_SHADOW_MAPS, |enc| {
-            r.encode_shadow_maps(gpu, enc, scene, uniforms)
-        })?;
+        (counts.maps_rendered, counts.map_faces) =
+            ctx.profiler.gpu_stage(gpu, STAGE_SHADOW_MAPS, |enc| {
+                r.encode_shadow_maps(gpu, enc, scene, uniforms)
+            })?;
         ctx.profiler.gpu_stage(gpu, STAGE_LIGHT_MAPS, |enc| {
             r.encode_light_maps(enc, uniforms)
         })?;
@@ -337,6 +346,7 @@ impl Technique for Barczak {
         ctx.profiler.count("vpls", vpls as f64);
         ctx.profiler
             .count("maps-rendered", counts.maps_rendered as f64);
+        ctx.profiler.count("map-faces", counts.map_faces as f64);
         ctx.profiler.count("light-draws", counts.light_draws as f64);
         ctx.profiler.count("elements", counts.elements as f64);
         ctx.profiler

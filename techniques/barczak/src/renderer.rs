@@ -9,7 +9,8 @@
 //!
 //! Per frame: every mover that moved is moved in the visibility database (Table 4-1), the light
 //! maps gain or lose single lights, and the shadow maps the motion touched go out of date; the
-//! schedule re-renders `updates` of them by priority (all on the first frame); the light draws
+//! schedule re-renders `updates` of them by priority (all on the first frame), each only into
+//! the octahedral faces that hold an occluder (§4.2.2, unless `face_cull` is off); the light draws
 //! are planned (optimised at Full) and drawn — with the low-resolution pass at Full and VD+LP
 //! (edges found, the lights drawn at low resolution, interpolated off the edges and drawn
 //! again at full resolution on them); each mover's lighting environment is gathered
@@ -22,6 +23,7 @@ use gibench_harness::bvh::SceneBvh;
 use gibench_harness::gpu::GpuContext;
 use gibench_harness::ir::atlas::{AtlasFormat, AtlasSettings, MapKind, ShadowAtlas};
 use gibench_harness::ir::edges::EdgeSettings;
+use gibench_harness::ir::face_cull::Occluders;
 use gibench_harness::ir::raster::{AtlasClear, AtlasRasteriser};
 use gibench_harness::ir::store::VplStore;
 use gibench_harness::passes::{
@@ -62,6 +64,8 @@ pub struct RendererSettings {
     pub updates: u32,
     /// Directions of the PRT transfer integral.
     pub prt_directions: usize,
+    /// Draw a shadow map only into the octahedral faces holding an occluder (§4.2.2).
+    pub face_cull: bool,
 }
 
 /// What the renderer prepares on the CPU once per scene (§4.1, §4.3, §4.4): the scene's light
@@ -165,6 +169,8 @@ impl Optimisation {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct FrameCounts {
     pub maps_rendered: u32,
+    /// Octahedral faces drawn into (four per map without face culling).
+    pub map_faces: u32,
     /// Draws of lights over leaves (the thesis' passes; the low-resolution pass draws twice).
     pub light_draws: u32,
     pub elements: u32,
@@ -179,6 +185,11 @@ pub struct Renderer {
     samples: Vec<Vpl>,
     /// This frame's maps to render (kept between frames: no allocation per frame).
     render: Vec<(u32, Vpl)>,
+    /// The faces of each map of `render` to draw into (§4.2.2).
+    faces: Vec<u8>,
+    /// The occluders in world space: the static casters' triangles (once) and the movers'
+    /// bounding spheres (posed every frame).
+    occluders: Occluders,
     atlas: ShadowAtlas,
     raster: AtlasRasteriser,
     light_map: LightMapPass,
@@ -267,7 +278,15 @@ impl Renderer {
         let schedule = ShadowMapSchedule::new(bz.flux.iter().copied());
         let output = render_target(&gpu.device, "barczak irradiance", gbuffer.size, HDR_FORMAT);
         let output_view = output.create_view(&Default::default());
+        let casters = scene.shadow_caster_mesh();
+        let occluders = Occluders::new(
+            (0..casters.triangle_count())
+                .map(|t| casters.triangle(t))
+                .collect(),
+        );
         Ok(Renderer {
+            faces: Vec::with_capacity(lights.len()),
+            occluders,
             poses: frame.movers.clone(),
             samples: lights.iter().map(|(_, v)| *v).collect(),
             render: Vec::with_capacity(lights.len()),
@@ -321,7 +340,8 @@ impl Renderer {
         frame: &FrameState,
     ) -> Result<FrameCounts> {
         let mut counts = self.update(gpu, frame)?;
-        counts.maps_rendered = self.encode_shadow_maps(gpu, encoder, scene, uniforms);
+        (counts.maps_rendered, counts.map_faces) =
+            self.encode_shadow_maps(gpu, encoder, scene, uniforms);
         self.encode_light_maps(encoder, uniforms);
         self.encode_edges(encoder);
         counts.light_draws =
@@ -371,6 +391,14 @@ impl Renderer {
             self.render
                 .extend(due.into_iter().map(|l| self.lights[l as usize]));
         }
+        // §4.2.2: the faces of each due map that hold an occluder (the movers at their poses).
+        self.faces.clear();
+        if self.settings.face_cull {
+            let (bounds, poses) = (&self.bz.movers, &self.poses);
+            (self.occluders).set_spheres(bounds.iter().zip(poses).map(|(b, m)| b.posed(*m)));
+            let (occ, atlas) = (&self.occluders, &self.atlas);
+            (self.faces).extend(self.render.iter().map(|(_, v)| occ.faces(atlas, v)));
+        }
         if replan {
             let level = self.settings.level;
             self.draws
@@ -380,24 +408,26 @@ impl Renderer {
         Ok(counts)
     }
 
-    /// The shadow maps due this frame (with the movers in them). Returns how many.
+    /// The shadow maps due this frame (with the movers in them), each only into the faces
+    /// [`update`](Self::update) found occluders in. Returns the maps and the faces drawn.
     pub fn encode_shadow_maps(
         &mut self,
         gpu: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
         scene: &GpuScene,
         uniforms: &FrameUniforms,
-    ) -> u32 {
+    ) -> (u32, u32) {
         if self.render.is_empty() {
-            return 0;
+            return (0, 0);
         }
-        self.raster.render(
+        self.raster.render_faces(
             gpu,
             encoder,
             &self.atlas,
             scene,
             uniforms,
             &self.render,
+            &self.faces,
             AtlasClear::RenderedSlots,
         )
     }

@@ -37,6 +37,7 @@ fn settings(level: Optimisation) -> RendererSettings {
         map_size: 64,
         updates: 1000,
         prt_directions: 64,
+        face_cull: true,
     }
 }
 
