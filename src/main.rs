@@ -781,11 +781,21 @@ fn run(args: &RunArgs) -> Result<()> {
     let plan = plan(args, &[])?;
     plan.spec(args).validate()?;
     let set = OutputSet::begin("out", &args.out)?;
+    if args.technique.is_empty() {
+        // A run over every technique says which it skipped; one that skipped none leaves no
+        // earlier run's list behind.
+        set.replace_files(&skipped_file(&plan.desc.name))?;
+    }
     let gpu = open_gpu(args)?;
     let done = run_planned(args, &plan, &gpu, &Bars::Own(args.quiet))?;
     set.publish()?;
     eprintln!("{done}");
     Ok(())
+}
+
+/// The file in which a run over every technique on `scene` lists those it skipped and why.
+fn skipped_file(scene: &str) -> String {
+    format!("{scene}-skipped.json")
 }
 
 /// The work of `gibench run` once planned and its output set is open: runs, tables, plots.
@@ -825,6 +835,21 @@ pub(crate) fn run_planned(
         .iter()
         .map(|p| file_name(p))
         .collect();
+    if !skipped.is_empty() {
+        let list: Vec<serde_json::Value> = (skipped.iter())
+            .map(|s| serde_json::json!({ "technique": s.technique, "reason": s.reason }))
+            .collect();
+        let record = serde_json::json!({
+            "scene": name,
+            "note": "techniques a run over every technique left out, each with its reason (not a results file)",
+            "skipped": list,
+        });
+        let path = args.out.join(skipped_file(name));
+        let bytes =
+            serde_json::to_vec_pretty(&record).map_err(|e| Error::Invalid(e.to_string()))?;
+        gibench_harness::error::write_atomic(&path, &bytes)?;
+        written.push(file_name(&path));
+    }
     report::stacked_bar_svg(
         &results,
         &args.out.join(format!("{stem}.svg")),
@@ -1225,7 +1250,8 @@ fn read_results(inputs: &[PathBuf]) -> Result<Vec<RunResult>> {
         .collect())
 }
 
-/// The results files given (or found in the given folders), each with its folder.
+/// The results files given (or found in the given folders: JSON files that are not results are
+/// passed over there), each with its folder.
 fn read_results_with_folders(inputs: &[PathBuf]) -> Result<Vec<(PathBuf, RunResult)>> {
     let mut files = Vec::new();
     for input in inputs {
@@ -1234,6 +1260,9 @@ fn read_results_with_folders(inputs: &[PathBuf]) -> Result<Vec<(PathBuf, RunResu
                 .map_err(|e| Error::io(input, e))?
                 .filter_map(|e| e.ok().map(|e| e.path()))
                 .filter(|p| p.extension().is_some_and(|x| x == "json"))
+                // Other JSON files in a results folder (a run's list of skipped techniques, a
+                // comparison) are passed over; a damaged results file is still read, and named.
+                .filter(|p| results_like(p).is_some())
                 .collect();
             found.sort();
             files.extend(found);

@@ -306,6 +306,24 @@ fn a_run_over_every_technique_skips_one_that_cannot_take_the_scene() {
     }
     let md = std::fs::read_to_string(dir.path().join("gaitatzes-arena-summary.md")).unwrap();
     assert!(md.contains("Skipped barczak: "), "{md}");
+    let text = std::fs::read_to_string(dir.path().join("gaitatzes-arena-skipped.json")).unwrap();
+    let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let list = v["skipped"].as_array().unwrap();
+    assert_eq!(list.len(), 1, "{text}");
+    assert_eq!(list[0]["technique"], "barczak", "{text}");
+    assert!(
+        list[0]["reason"].as_str().unwrap().contains("patches"),
+        "{text}"
+    );
+    // The folder's results are still read as results (the list is not one).
+    let o = Command::new(env!("CARGO_BIN_EXE_gibench"))
+        .arg("report")
+        .arg(dir.path())
+        .arg("--out")
+        .arg(dir.path().join("report"))
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let named = tempfile::tempdir().unwrap();
     let o = Command::new(env!("CARGO_BIN_EXE_gibench"))
         .arg("run")
@@ -321,4 +339,28 @@ fn a_run_over_every_technique_skips_one_that_cannot_take_the_scene() {
         "{stderr}"
     );
     assert!(!named.path().join("gaitatzes-arena-barczak.json").exists());
+    assert!(!named.path().join("gaitatzes-arena-skipped.json").exists());
+}
+
+/// A run over every technique that skips none removes an earlier run's list of skipped
+/// techniques from its folder (a stale list would name a technique whose results are there).
+#[test]
+fn a_run_that_skips_nothing_leaves_no_list_of_skipped_techniques() {
+    let dir = tempfile::tempdir().unwrap();
+    let stale = dir.path().join("cornell-skipped.json");
+    std::fs::write(&stale, r#"{"scene": "cornell", "skipped": []}"#).unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_gibench"))
+        .arg("run")
+        .args(["--resolution", "64x48", "--frames", "1", "--warmup", "0"])
+        .args(["--timing", "stages", "--no-images", "--quiet", "--out"])
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{stderr}");
+    assert!(
+        dir.path().join("cornell-barczak.json").is_file(),
+        "{stderr}"
+    );
+    assert!(!stale.exists(), "{stderr}");
 }
