@@ -932,6 +932,15 @@ pub(crate) fn with_folder(dir: &Path, results: Vec<RunResult>) -> Vec<(PathBuf, 
 }
 
 /// Writes an HTML page ([`gibench_harness::html`]) with this process's command line.
+/// This command as a user would type it: `gibench` and its arguments (not the executable's
+/// path on this machine, which names a user's folders and means nothing elsewhere).
+pub(crate) fn command_line() -> String {
+    std::iter::once("gibench".to_string())
+        .chain(std::env::args().skip(1))
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
 pub(crate) fn write_page(
     path: &Path,
     title: String,
@@ -941,7 +950,7 @@ pub(crate) fn write_page(
 ) -> Result<()> {
     gibench_harness::html::Page {
         title,
-        command: std::env::args().collect::<Vec<_>>().join(" "),
+        command: command_line(),
         tables,
         figures,
         runs,

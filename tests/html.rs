@@ -163,6 +163,10 @@ fn run_page_loads_clean_and_fails_on_a_broken_image_or_console_error() {
     }
     assert!(html.contains("reference (multi-bounce)") || html.contains("reference (one-bounce)"));
     assert!(html.contains("src=\"cornell-time-vs-error.svg\""));
+    // The command as typed, not this machine's path to the executable; a driver only if named.
+    assert!(html.contains("<code>gibench run --technique direct,keller-full,laine"));
+    assert!(!html.contains(env!("CARGO_BIN_EXE_gibench")));
+    assert!(!html.contains("driver )") && !html.contains("driver ;"));
     assert_clean(&browser, &page);
     let shot = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("html-report/screenshot.png");
     screenshot(&browser, &page, &shot);

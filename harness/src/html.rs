@@ -168,10 +168,18 @@ impl Page {
             .runs
             .iter()
             .map(|(_, r)| {
-                format!(
-                    "{} ({}, driver {})",
-                    r.device.adapter, r.device.backend, r.device.driver
-                )
+                // GL reports no driver name; its version string is the driver's description.
+                let d = &r.device;
+                let driver = [d.driver.as_str(), d.driver_info.as_str()]
+                    .into_iter()
+                    .filter(|s| !s.is_empty())
+                    .collect::<Vec<_>>()
+                    .join(" ");
+                if driver.is_empty() {
+                    format!("{} ({})", d.adapter, d.backend)
+                } else {
+                    format!("{} ({}, driver {driver})", d.adapter, d.backend)
+                }
             })
             .collect();
         devices.sort();

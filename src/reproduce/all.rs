@@ -1084,7 +1084,7 @@ impl Manifest {
                 "gibench reproduce all ({} sizes) on {}",
                 self.mode, self.adapter
             ),
-            &std::env::args().collect::<Vec<_>>().join(" "),
+            &crate::command_line(),
             &entries,
         )
     }
