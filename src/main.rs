@@ -931,7 +931,6 @@ pub(crate) fn with_folder(dir: &Path, results: Vec<RunResult>) -> Vec<(PathBuf, 
         .collect()
 }
 
-/// Writes an HTML page ([`gibench_harness::html`]) with this process's command line.
 /// This command as a user would type it: `gibench` and its arguments (not the executable's
 /// path on this machine, which names a user's folders and means nothing elsewhere).
 pub(crate) fn command_line() -> String {
@@ -941,6 +940,7 @@ pub(crate) fn command_line() -> String {
         .join(" ")
 }
 
+/// Writes an HTML page ([`gibench_harness::html`]) with this process's command line.
 pub(crate) fn write_page(
     path: &Path,
     title: String,
