@@ -562,6 +562,20 @@ fn barczak2006_writes_five_figures_and_their_tables() {
             );
         }
     }
+    // Each update case is run once more without face culling, named in Figure 5-5's notes and
+    // kept out of the rows (20 and 16 above).
+    let md = std::fs::read_to_string(tmp.path().join("barczak-fig5-5.md")).unwrap();
+    for case in [
+        "bunny-table",
+        "torus-table",
+        "bunny-pillars",
+        "torus-pillars",
+    ] {
+        assert!(
+            md.contains(&format!("{case} ")) && md.contains("with face culling against"),
+            "{case}: {md}"
+        );
+    }
     let levels: Vec<String> = rows("barczak-fig5-3")
         .iter()
         .map(|r| r[1].clone())
