@@ -753,6 +753,48 @@ mod tests {
         }
     }
 
+    /// Threads taking and releasing the lock over and over: a release removes the lock file,
+    /// so a taker that opened the file just before may lock the removed file while another
+    /// creates and locks a new one. Exactly one may hold it at any time (the check that the
+    /// locked file is still the one at the path; without it two held it at once here).
+    #[test]
+    fn a_released_lock_file_is_never_held_twice() {
+        use std::sync::atomic::{AtomicUsize, Ordering::SeqCst};
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path();
+        let (held, most, taken) = (
+            AtomicUsize::new(0),
+            AtomicUsize::new(0),
+            AtomicUsize::new(0),
+        );
+        let errors = Mutex::new(Vec::new());
+        let deadline = std::time::Instant::now() + std::time::Duration::from_millis(1500);
+        std::thread::scope(|s| {
+            for _ in 0..6 {
+                s.spawn(|| {
+                    while std::time::Instant::now() < deadline {
+                        match FolderLock::take(dir) {
+                            Ok(lock) => {
+                                let now = held.fetch_add(1, SeqCst) + 1;
+                                most.fetch_max(now, SeqCst);
+                                taken.fetch_add(1, SeqCst);
+                                std::thread::yield_now();
+                                held.fetch_sub(1, SeqCst);
+                                lock.release();
+                            }
+                            Err(LockError::InUse(_)) => std::thread::yield_now(),
+                            Err(e) => errors.lock().unwrap().push(format!("{e:?}")),
+                        }
+                    }
+                });
+            }
+        });
+        let errors = errors.into_inner().unwrap();
+        assert!(errors.is_empty(), "{:?}", &errors[..errors.len().min(3)]);
+        assert!(taken.load(SeqCst) > 0);
+        assert_eq!(most.load(SeqCst), 1, "two held the lock at once");
+    }
+
     /// A replaced subfolder that is a symbolic link to a folder outside: publication removes
     /// nothing there (before, every file in the link's target was deleted).
     #[cfg(unix)]
