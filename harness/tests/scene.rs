@@ -523,3 +523,34 @@ fn torus_mover_is_closed_with_820_vertices() {
     }
     assert!(edges.values().all(|n| *n == 2), "the torus has open edges");
 }
+
+#[test]
+#[ignore = "prints chart counts and times of the glTF scenes; used to size Barczak on any mesh"]
+fn chart_counts() {
+    use gibench_harness::scene::charts::{charts, ChartSettings};
+    for name in ["sibenik", "sponza", "maze", "conference", "cornell-gltf"] {
+        let Ok(scene) = Scene::load_named(name, &AssetPaths::standard(None)) else {
+            println!("{name}: not found");
+            continue;
+        };
+        let t = std::time::Instant::now();
+        let c = charts(&scene.mesh, ChartSettings::for_mesh(&scene.mesh));
+        let convex = c.iter().filter(|c| c.convex).count();
+        let single = c.iter().filter(|c| c.triangles.len() == 1).count();
+        let rect: f32 = c
+            .iter()
+            .map(|c| {
+                (c.rectangle[1] - c.rectangle[0]).length()
+                    * (c.rectangle[3] - c.rectangle[0]).length()
+            })
+            .sum();
+        let area: f32 = c.iter().map(|c| c.area).sum();
+        println!(
+            "{name}: {} triangles, {} charts ({convex} convex, {single} of one triangle), rectangles/area {:.2}, {:.2} s",
+            scene.mesh.triangle_count(),
+            c.len(),
+            rect / area,
+            t.elapsed().as_secs_f64()
+        );
+    }
+}

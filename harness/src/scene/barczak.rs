@@ -50,6 +50,7 @@ impl Builder {
             material,
             levels,
             casts_shadows: casts,
+            chart: None,
         });
     }
 

@@ -10,6 +10,7 @@
 //! any of its vertices.
 
 pub mod barczak;
+pub mod charts;
 pub mod cornell;
 pub mod descriptor;
 pub mod gaitatzes;
@@ -360,6 +361,21 @@ pub struct Patch {
     /// Whether it can shadow another surface (a convex room's own walls cannot; the thesis leaves
     /// them out of the occluders).
     pub casts_shadows: bool,
+    /// Where the patch is a chart of a mesh that records no patches ([`charts`]): the triangles
+    /// it stands for, which may cover only part of the rectangle. `None`: the rectangle is the
+    /// surface.
+    pub chart: Option<ChartSurface>,
+}
+
+/// The surface of a chart patch (see [`Patch::chart`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ChartSurface {
+    /// Its triangles, world space, wound counter-clockwise seen from the front.
+    pub triangles: Vec<[Vec3; 3]>,
+    /// The convex hull of the triangles, counter-clockwise seen from the front: the blocker.
+    pub hull: Vec<Vec3>,
+    /// Whether the triangles fill the hull, so that it may block fully.
+    pub convex: bool,
 }
 
 /// The whole scene.
@@ -675,40 +691,51 @@ impl Scene {
         self.shadow_mesh.as_ref().unwrap_or(&self.mesh)
     }
     /// The patches a light-mapped technique lights and tests against: the recorded
-    /// [`Scene::patches`], or, where the scene records none, one patch per static triangle
-    /// (corners a, b, c and the midpoint of c–a, so the patch is exactly the triangle, planar;
-    /// each its own object, casting shadows, split `levels` times; degenerate triangles
-    /// skipped). Triangles are exact where a source's quads are not planar (the measured
-    /// Cornell box's are not, by up to 3 mm). Errors name the scene when it has more than
-    /// `max_triangles` triangles to make patches of (before any work per patch).
-    pub fn receiver_patches(&self, levels: u32, max_triangles: usize) -> Result<Vec<Patch>> {
+    /// [`Scene::patches`], or, where the scene records none, the static mesh's [`charts`]: each
+    /// chart's smallest rectangle with its triangles and hull ([`Patch::chart`]), its own
+    /// object, casting shadows, split up to `levels` times (fewer for small charts: until a
+    /// leaf's longer side is at most 1/16 of the scene's diagonal). Errors name the scene and
+    /// the count when it makes more than `max_charts` charts.
+    pub fn receiver_patches(&self, levels: u32, max_charts: usize) -> Result<Vec<Patch>> {
         if !self.patches.is_empty() {
             return Ok(self.patches.clone());
         }
-        let n = self.mesh.triangle_count();
-        if n > max_triangles {
+        let charts = charts::charts(&self.mesh, charts::ChartSettings::for_mesh(&self.mesh));
+        if charts.len() > max_charts {
             return Err(crate::Error::Invalid(format!(
-                "scene '{}' records no patches, and one patch per triangle would make {n}, more than the {max_triangles} allowed; use a scene that records patches (barczak-area, barczak-table, barczak-pillars) or a smaller mesh",
-                self.descriptor.name
+                "scene '{}' records no patches, and its {} triangles make {} planar charts, more than the {max_charts} allowed; use a scene that records patches (barczak-area, barczak-table, barczak-pillars) or a smaller mesh",
+                self.descriptor.name,
+                self.mesh.triangle_count(),
+                charts.len()
             )));
         }
-        let mut out = Vec::with_capacity(n);
-        for t in 0..n {
-            let [a, b, c] = self.mesh.triangle(t);
-            let cross = (b - a).cross(c - a);
-            if cross.length_squared() <= f32::MIN_POSITIVE {
-                continue;
-            }
-            out.push(Patch {
-                corners: [a, b, c, 0.5 * (a + c)],
-                normal: cross.normalize(),
-                object: t as u32,
-                material: self.mesh.triangle_material(t),
-                levels,
-                casts_shadows: true,
-            });
-        }
-        Ok(out)
+        let leaf = self.extent.diagonal / 16.0;
+        Ok(charts
+            .into_iter()
+            .enumerate()
+            .map(|(k, c)| {
+                let r = c.rectangle;
+                let side = (r[1] - r[0]).length().max((r[3] - r[0]).length());
+                let needed = (side / leaf).max(1.0).log2().ceil() as u32;
+                Patch {
+                    corners: r,
+                    normal: c.normal,
+                    object: k as u32,
+                    material: c.material,
+                    levels: needed.min(levels),
+                    casts_shadows: true,
+                    chart: Some(ChartSurface {
+                        triangles: c
+                            .triangles
+                            .iter()
+                            .map(|t| self.mesh.triangle(*t as usize))
+                            .collect(),
+                        hull: c.hull,
+                        convex: c.convex,
+                    }),
+                }
+            })
+            .collect())
     }
 
     /// Area-weighted mean of the materials' average colours over the static mesh (Keller's

@@ -23,7 +23,8 @@
 
 use glam::Vec3;
 
-use crate::visibility::{Blocker, LightState, Occlusion, PatchTree, PointLight, Reach, Shape};
+use crate::blocker_index::BlockerIndex;
+use crate::visibility::{Blocker, LightState, Occlusion, PatchTree, PointLight, Reach};
 
 /// A receiver's geometry.
 #[derive(Clone, Debug)]
@@ -71,6 +72,9 @@ impl Receiver {
                 for n in &mut t.nodes {
                     n.corners = n.corners.map(to);
                 }
+                for tri in &mut t.surface {
+                    *tri = tri.map(to);
+                }
             }
             ReceiverShape::Object { center, .. } => *center = to(*center),
         }
@@ -113,6 +117,8 @@ pub struct VisibilityDatabase {
     pub blockers: Vec<Blocker>,
     /// `[receiver][node][light]`.
     entries: Vec<Vec<Vec<NodeEntry>>>,
+    /// The blockers' boxes, to test a root pyramid only against those that may reach in.
+    index: BlockerIndex,
 }
 
 /// Whether a light lights a node in this state (it belongs in the light map).
@@ -132,6 +138,7 @@ impl VisibilityDatabase {
                 .iter()
                 .map(|r| vec![vec![NodeEntry::default(); lights.len()]; r.node_count()])
                 .collect(),
+            index: BlockerIndex::new(&blockers),
             lights,
             receivers,
             blockers,
@@ -160,11 +167,19 @@ impl VisibilityDatabase {
         &self.entries
     }
 
-    /// Recomputes every node of receiver `r` for every light against every blocker.
+    /// Recomputes every node of receiver `r` for every light against every blocker (those
+    /// the index rules out for the root's reach are left out: the exact test would reject
+    /// them).
     fn recompute_receiver(&mut self, r: usize) -> usize {
-        let candidates: Vec<u32> = (0..self.blockers.len() as u32).collect();
+        let mut candidates = Vec::new();
         let mut tests = 0;
         for l in 0..self.lights.len() {
+            let reach = self.receivers[r].reach(0, &self.lights[l]);
+            self.index
+                .query(|lo, hi| reach.rules_out(lo, hi), &mut candidates);
+            for node in &mut self.entries[r] {
+                node[l] = NodeEntry::default();
+            }
             tests += self.visit(r, l, 0, None, &candidates, true);
         }
         tests
@@ -272,11 +287,10 @@ impl VisibilityDatabase {
             .filter(|&b| self.blockers[b as usize].object == object)
             .collect();
         for &b in &moved {
-            let shape = &mut self.blockers[b as usize].shape;
-            match shape {
-                Shape::Polygon(v) => v.iter_mut().for_each(|p| *p = to(*p)),
-                Shape::Sphere { center, .. } => *center = to(*center),
+            for p in self.blockers[b as usize].shape.points_mut() {
+                *p = to(*p);
             }
+            self.index.moved(b, &self.blockers);
         }
         let mut tests = 0;
         for r in 0..self.receivers.len() {

@@ -129,7 +129,7 @@ impl LightDraws {
         // The most any level plans without merging: every leaf, every light, split in two groups
         // (VD: one more partial draw per leaf at most).
         let max_draws = (tiles * (lights.div_ceil(k) as u64 + 1)).max(1);
-        let max_indices = (6 * tiles * lights as u64).max(1);
+        let max_indices = (leaves.vertex_count() as u64 * lights as u64).max(1);
         let indices = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("barczak element indices"),
             size: max_indices * 4,
@@ -361,7 +361,7 @@ impl LightDraws {
             for e in &elements {
                 let start = indices.len() as u32;
                 for &tile in &e.objects {
-                    indices.extend(6 * tile..6 * tile + 6);
+                    indices.extend(self.leaves.ranges[tile as usize].clone());
                 }
                 let range = start..indices.len() as u32;
                 let flag = if lookup { LOOKUP } else { 0 };

@@ -15,6 +15,7 @@ use gibench_harness::passes::{
     params_entry, shader_module, FrameUniforms, GBuffer, CAMERA_SLOT, HDR_FORMAT,
 };
 use gibench_harness::{wgpu, Result};
+use glam::Vec3;
 
 use crate::database::{ReceiverShape, VisibilityDatabase};
 use crate::lightmap::LightMaps;
@@ -29,18 +30,87 @@ struct LeafVertex {
 }
 
 /// The patch leaves as GPU geometry, shared by the light-map and subtraction passes: leaf `t`
-/// (its tile) is vertices `6t .. 6t + 6`, two triangles, each vertex with its position, tile,
-/// the patch normal and its (s, t) in the leaf.
+/// (its tile) is the vertices [`Leaves::ranges`]`[t]`, a triangle list, each vertex with its
+/// position, tile, the patch normal and its (s, t) in the leaf. A patch whose rectangle is its
+/// surface gives each leaf two triangles; a chart gives each leaf its triangles clipped to the
+/// leaf (nothing where they leave the leaf empty).
 pub struct Leaves {
     /// (receiver, node) of each leaf, in tile order.
     pub tiles: Vec<(usize, usize)>,
+    /// Each tile's vertices.
+    pub ranges: Vec<std::ops::Range<u32>>,
     vertices: wgpu::Buffer,
+}
+
+/// The polygon `poly` (points in a leaf's (s, t)) clipped to the unit square.
+fn clip_to_unit_square(mut poly: Vec<[f32; 2]>) -> Vec<[f32; 2]> {
+    for (axis, keep_above) in [(0, true), (0, false), (1, true), (1, false)] {
+        let inside = |p: &[f32; 2]| {
+            if keep_above {
+                p[axis] >= 0.0
+            } else {
+                p[axis] <= 1.0
+            }
+        };
+        let bound = if keep_above { 0.0 } else { 1.0 };
+        let mut next = Vec::with_capacity(poly.len() + 2);
+        for i in 0..poly.len() {
+            let (p, q) = (poly[i], poly[(i + 1) % poly.len()]);
+            if inside(&p) {
+                next.push(p);
+            }
+            if inside(&p) != inside(&q) {
+                let f = (bound - p[axis]) / (q[axis] - p[axis]);
+                next.push([p[0] + f * (q[0] - p[0]), p[1] + f * (q[1] - p[1])]);
+            }
+        }
+        poly = next;
+        if poly.len() < 3 {
+            return Vec::new();
+        }
+    }
+    poly
+}
+
+/// The triangles of a leaf with `corners` (a rectangle, in order) that `surface` covers, as
+/// (s, t) in the leaf, three points each: the leaf's two triangles when `surface` is empty.
+pub fn leaf_triangles(corners: [Vec3; 4], surface: &[[Vec3; 3]]) -> Vec<[f32; 2]> {
+    let st = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+    if surface.is_empty() {
+        return [0, 1, 2, 0, 2, 3].iter().map(|&k| st[k]).collect();
+    }
+    let [a, b, _, d] = corners;
+    let (u, v) = (b - a, d - a);
+    let (uu, vv) = (u.length_squared(), v.length_squared());
+    let mut out = Vec::new();
+    for tri in surface {
+        let flat = tri
+            .iter()
+            .map(|p| [(*p - a).dot(u) / uu, (*p - a).dot(v) / vv])
+            .collect();
+        let poly = clip_to_unit_square(flat);
+        // Pieces with no area (a triangle touching the leaf along an edge) are left out.
+        let twice_area: f32 = (0..poly.len())
+            .map(|i| {
+                let (p, q) = (poly[i], poly[(i + 1) % poly.len()]);
+                p[0] * q[1] - p[1] * q[0]
+            })
+            .sum();
+        if twice_area.abs() <= 1e-9 {
+            continue;
+        }
+        for i in 1..poly.len().saturating_sub(1) {
+            out.extend([poly[0], poly[i], poly[i + 1]]);
+        }
+    }
+    out
 }
 
 impl Leaves {
     /// The leaves of every patch receiver of `db`.
     pub fn new(gpu: &GpuContext, db: &VisibilityDatabase) -> Leaves {
         let mut tiles = Vec::new();
+        let mut ranges = Vec::new();
         let mut vertices = Vec::new();
         for (r, receiver) in db.receivers.iter().enumerate() {
             let ReceiverShape::Patch(tree) = &receiver.shape else {
@@ -49,16 +119,18 @@ impl Leaves {
             for n in tree.leaves() {
                 let tile = tiles.len() as u32;
                 tiles.push((r, n));
-                let c = tree.nodes[n].corners;
-                let st = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
-                for k in [0, 1, 2, 0, 2, 3] {
+                let [a, b, c, d] = tree.nodes[n].corners;
+                let start = vertices.len() as u32;
+                for st in leaf_triangles([a, b, c, d], &tree.surface) {
+                    let position = a.lerp(b, st[0]).lerp(d.lerp(c, st[0]), st[1]);
                     vertices.push(LeafVertex {
-                        position: c[k].to_array(),
+                        position: position.to_array(),
                         leaf: tile,
                         normal: tree.normal.to_array(),
-                        st: st[k],
+                        st,
                     });
                 }
+                ranges.push(start..vertices.len() as u32);
             }
         }
         let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
@@ -71,8 +143,14 @@ impl Leaves {
             .write_buffer(&buffer, 0, bytemuck::cast_slice(&vertices));
         Leaves {
             tiles,
+            ranges,
             vertices: buffer,
         }
+    }
+
+    /// How many vertices all tiles have.
+    pub fn vertex_count(&self) -> u32 {
+        self.ranges.last().map_or(0, |r| r.end)
     }
 
     /// The vertex buffer.
@@ -279,7 +357,63 @@ impl LightMapPass {
         pass.set_bind_group(1, &self.gbuffer_group, &[]);
         pass.set_bind_group(2, &self.group, &[]);
         pass.set_vertex_buffer(0, self.leaves.buffer().slice(..));
-        pass.draw(0..6 * self.leaves.tiles.len() as u32, 0..1);
+        pass.draw(0..self.leaves.vertex_count(), 0..1);
         1
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::visibility::PatchTree;
+
+    fn area(st: &[[f32; 2]]) -> f32 {
+        st.chunks(3)
+            .map(|t| {
+                let (a, b, c) = (t[0], t[1], t[2]);
+                0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]))
+            })
+            .sum()
+    }
+
+    /// A chart's triangles clipped to the leaves of its 2 × 2 split: every piece inside its
+    /// leaf and wound the same way, the pieces' areas adding up to the triangles', and the
+    /// L-shaped chart's empty quarter given nothing; a rectangle patch's leaf is two triangles
+    /// covering it.
+    #[test]
+    fn chart_triangles_are_cut_to_each_leaf() {
+        let v = |x: f32, y: f32| Vec3::new(x, y, 0.0);
+        let corners = [v(0.0, 0.0), v(2.0, 0.0), v(2.0, 2.0), v(0.0, 2.0)];
+        // [0,2] × [0,1] and [0,1] × [1,2], the long triangles crossing the leaves' edges.
+        let surface = vec![
+            [v(0.0, 0.0), v(2.0, 0.0), v(2.0, 1.0)],
+            [v(0.0, 0.0), v(2.0, 1.0), v(0.0, 1.0)],
+            [v(0.0, 1.0), v(1.0, 1.0), v(1.0, 2.0)],
+            [v(0.0, 1.0), v(1.0, 2.0), v(0.0, 2.0)],
+        ];
+        let tree = PatchTree::new(0, corners, Vec3::Z, 1).with_surface(surface);
+        let mut total = 0.0;
+        for n in tree.leaves() {
+            let c = tree.nodes[n].corners;
+            let st = leaf_triangles(c, &tree.surface);
+            assert_eq!(st.len() % 3, 0);
+            let inside = |x: f32| (-1e-6..=1.0 + 1e-6).contains(&x);
+            assert!(st.iter().all(|p| inside(p[0]) && inside(p[1])));
+            for t in st.chunks(3) {
+                assert!(area(t) >= -1e-6, "a piece turned over");
+            }
+            // Each leaf is 1 × 1 scene units, so (s, t) area is scene area.
+            let a = area(&st);
+            if c[0] == v(1.0, 1.0) {
+                assert_eq!(st.len(), 0, "the empty quarter got {a}");
+            } else {
+                assert!((a - 1.0).abs() < 1e-5, "leaf at {}: {a}", c[0]);
+            }
+            total += a;
+        }
+        assert!((total - 3.0).abs() < 1e-4, "{total}");
+        let whole = leaf_triangles(corners, &[]);
+        assert_eq!(whole.len(), 6);
+        assert!((area(&whole) - 1.0).abs() < 1e-6);
     }
 }

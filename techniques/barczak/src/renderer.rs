@@ -41,7 +41,7 @@ use crate::prt::{self, COEFFS};
 use crate::prt_pass::PrtPass;
 use crate::samples::SampleSettings;
 use crate::schedule::ShadowMapSchedule;
-use crate::setup::{prepare, BarczakScene};
+use crate::setup::{prepare_with, BarczakScene};
 
 /// The renderer's settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -66,6 +66,8 @@ pub struct RendererSettings {
     pub prt_directions: usize,
     /// Draw a shadow map only into the octahedral faces holding an occluder (§4.2.2).
     pub face_cull: bool,
+    /// Charts a scene without recorded patches may make (`Scene::receiver_patches`).
+    pub max_charts: usize,
 }
 
 /// What the renderer prepares on the CPU once per scene (§4.1, §4.3, §4.4): the scene's light
@@ -85,13 +87,14 @@ impl Prepared {
         frame: &FrameState,
         settings: &RendererSettings,
     ) -> Result<Prepared> {
-        let bz = prepare(
+        let bz = prepare_with(
             scene,
             bvh,
             frame,
             &frame.light,
             settings.samples,
             settings.light_map_res,
+            settings.max_charts,
         )?;
         let lift = 1e-4 * scene.extent.diagonal;
         let transfers = scene

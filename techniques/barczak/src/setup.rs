@@ -6,10 +6,13 @@
 //! and their poses at the first frame, the light's pose, the static BVH.
 //! Writes: [`BarczakScene`].
 //!
-//! * The patches are the scene's recorded ones, or one per triangle where it records none
-//!   (`Scene::receiver_patches`: the Cornell boxes, small glTF scenes).
+//! * The patches are the scene's recorded ones, or, where it records none, its planar charts
+//!   (`Scene::receiver_patches`: the Cornell boxes, Sibenik, Sponza, …): each chart's smallest
+//!   rectangle, standing for the chart's triangles ([`PatchTree::surface`]).
 //! * Every patch is a receiver, split `levels` times; a patch that casts shadows is also a
-//!   polygon blocker. Patches of one object never shadow each other.
+//!   blocker: its rectangle, or a chart's convex hull — a polygon blocker when the triangles
+//!   fill the hull, otherwise a [`Shape::Chart`], which blocks only partially. Patches of one
+//!   object never shadow each other.
 //! * Every mover is a complex object: its bounding sphere (about its origin, posed) is both a
 //!   receiver (lit by PRT) and a sphere blocker; mover k is object `first_mover_object + k`.
 //! * The light samples are oriented point lights at the sample positions.
@@ -53,13 +56,13 @@ pub struct BarczakScene {
     pub first_mover_object: u32,
 }
 
-/// Subdivision levels of the patches made from triangles for a scene that records none.
-pub const TRIANGLE_PATCH_LEVELS: u32 = 2;
-/// Triangles a scene without recorded patches may have (a patch each).
-pub const MAX_TRIANGLE_PATCHES: usize = 4096;
+/// Subdivision levels at most of the chart patches of a scene that records none.
+pub const CHART_LEVELS: u32 = 2;
+/// Charts a scene without recorded patches may make.
+pub const MAX_CHARTS: usize = 200_000;
 
-/// Prepares `scene` at `frame` (the movers' poses) with light `light` (see the module docs).
-/// Errors name the scene when it records no patches and has too many triangles to make them.
+/// Prepares `scene` at `frame` (the movers' poses) with light `light` (see the module docs),
+/// allowing [`MAX_CHARTS`] charts.
 pub fn prepare(
     scene: &Scene,
     bvh: &SceneBvh,
@@ -68,7 +71,29 @@ pub fn prepare(
     settings: SampleSettings,
     light_map_res: u32,
 ) -> Result<BarczakScene> {
-    let patches = scene.receiver_patches(TRIANGLE_PATCH_LEVELS, MAX_TRIANGLE_PATCHES)?;
+    prepare_with(
+        scene,
+        bvh,
+        frame,
+        light,
+        settings,
+        light_map_res,
+        MAX_CHARTS,
+    )
+}
+
+/// [`prepare`] allowing `max_charts` charts. Errors name the scene when it records no patches
+/// and makes more charts, before any work per chart.
+pub fn prepare_with(
+    scene: &Scene,
+    bvh: &SceneBvh,
+    frame: &FrameState,
+    light: &LightPose,
+    settings: SampleSettings,
+    light_map_res: u32,
+    max_charts: usize,
+) -> Result<BarczakScene> {
+    let patches = scene.receiver_patches(CHART_LEVELS, max_charts)?;
     let samples = samples::generate(scene, bvh, light, settings)?;
     let lights: Vec<PointLight> = samples
         .all()
@@ -81,14 +106,26 @@ pub fn prepare(
     let mut receivers = Vec::new();
     let mut blockers = Vec::new();
     for p in &patches {
+        let tree = PatchTree::new(p.object, p.corners, p.normal, p.levels);
         receivers.push(Receiver {
             object: p.object,
-            shape: ReceiverShape::Patch(PatchTree::new(p.object, p.corners, p.normal, p.levels)),
+            shape: ReceiverShape::Patch(match &p.chart {
+                Some(c) => tree.with_surface(c.triangles.clone()),
+                None => tree,
+            }),
         });
         if p.casts_shadows {
+            let shape = match &p.chart {
+                None => Shape::Polygon(p.corners.to_vec()),
+                Some(c) if c.convex => Shape::Polygon(c.hull.clone()),
+                Some(c) => Shape::Chart {
+                    hull: c.hull.clone(),
+                    triangles: c.triangles.clone(),
+                },
+            };
             blockers.push(Blocker {
                 object: p.object,
-                shape: Shape::Polygon(p.corners.to_vec()),
+                shape,
             });
         }
     }

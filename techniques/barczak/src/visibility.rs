@@ -20,6 +20,9 @@
 //!   through it before they reach the receiver: the pyramid's cross-section in the polygon's
 //!   plane is then the hull of those four crossings, inside the convex polygon, so every
 //!   segment from the light to the receiver crosses it.
+//! * A **chart** blocker (a mesh's planar chart whose triangles leave gaps in their convex
+//!   hull) reaches in as its hull does, and is then partial: the hull cannot prove that every
+//!   ray meets a triangle.
 //! * A **sphere** blocker (a complex object's bounds) reaches into the pyramid when its centre
 //!   is closer to the pyramid (a convex solid: the nearest point of its faces, or zero inside)
 //!   than its radius; it is then taken as partial (a bound cannot prove full occlusion).
@@ -72,6 +75,27 @@ pub enum Shape {
     Polygon(Vec<Vec3>),
     /// A complex object's bounding sphere.
     Sphere { center: Vec3, radius: f32 },
+    /// A planar chart of a mesh (`gibench_harness::scene::ChartSurface`) whose triangles do
+    /// not fill their convex `hull`: the hull decides what reaches into a pyramid, as a
+    /// polygon's outline does, but it blocks only partially (the triangles may leave gaps);
+    /// a ray meets the `triangles`.
+    Chart {
+        hull: Vec<Vec3>,
+        triangles: Vec<[Vec3; 3]>,
+    },
+}
+
+impl Shape {
+    /// Every point of the shape's definition, to move it rigidly.
+    pub fn points_mut(&mut self) -> Box<dyn Iterator<Item = &mut Vec3> + '_> {
+        match self {
+            Shape::Polygon(v) => Box::new(v.iter_mut()),
+            Shape::Sphere { center, .. } => Box::new(std::iter::once(center)),
+            Shape::Chart { hull, triangles } => {
+                Box::new(hull.iter_mut().chain(triangles.iter_mut().flatten()))
+            }
+        }
+    }
 }
 
 /// A shadow caster: its shape and the object it belongs to (an object never blocks itself).
@@ -221,6 +245,9 @@ impl Pyramid {
                 } else {
                     Occlusion::Partial
                 })
+            }
+            Shape::Chart { hull, .. } => {
+                self.clips_to_something(hull).then_some(Occlusion::Partial)
             }
         }
     }
@@ -379,6 +406,10 @@ pub fn segment_hits(a: Vec3, b: Vec3, shape: &Shape, eps: f32) -> bool {
             let n = polygon_normal(vertices);
             n != Vec3::ZERO && segment_crosses_polygon(a, b, vertices, n, eps)
         }
+        Shape::Chart { triangles, .. } => triangles.iter().any(|t| {
+            let n = polygon_normal(t);
+            n != Vec3::ZERO && segment_crosses_polygon(a, b, t, n, eps)
+        }),
     }
 }
 
@@ -397,6 +428,9 @@ pub struct PatchTree {
     pub object: u32,
     pub normal: Vec3,
     pub nodes: Vec<PatchNode>,
+    /// The triangles the patch stands for where they cover only part of its rectangle (a
+    /// chart); empty: the rectangle is the surface.
+    pub surface: Vec<[Vec3; 3]>,
 }
 
 /// One node of a [`PatchTree`].
@@ -421,6 +455,7 @@ impl PatchTree {
                 level: 0,
                 children: None,
             }],
+            surface: Vec::new(),
         };
         let mut i = 0;
         while i < tree.nodes.len() {
@@ -446,6 +481,12 @@ impl PatchTree {
             i += 1;
         }
         tree
+    }
+
+    /// The tree standing for `triangles` (see [`PatchTree::surface`]).
+    pub fn with_surface(mut self, triangles: Vec<[Vec3; 3]>) -> PatchTree {
+        self.surface = triangles;
+        self
     }
 
     /// The tolerance every node's pyramid to `light` uses: the whole patch's.
@@ -509,6 +550,21 @@ impl Reach {
         match Pyramid::to_sphere(light.position, center, radius) {
             Some(p) => Reach::Pyramid(p),
             None => Reach::Everything,
+        }
+    }
+
+    /// Whether nothing inside the axis-aligned box `lo`..`hi` can reach in: the box lies
+    /// outside one of the pyramid's planes (or the light is behind).
+    pub fn rules_out(&self, lo: Vec3, hi: Vec3) -> bool {
+        match self {
+            Reach::Behind => true,
+            Reach::Everything => false,
+            Reach::Pyramid(p) => {
+                let (c, e) = ((lo + hi) * 0.5, (hi - lo) * 0.5);
+                p.planes
+                    .iter()
+                    .any(|pl| pl.distance(c) + pl.n.abs().dot(e) < 0.0)
+            }
         }
     }
 

@@ -90,3 +90,66 @@ fn mover_updates_equal_a_full_recomputation() {
         "updates made {incremental} tests, rebuilds {rebuilt}"
     );
 }
+
+/// The same states as testing every node against every blocker without the blocker index
+/// (`visibility::determine`, `classify_object`): on the room after its movers moved (the
+/// index refitted), and on the charts of a scene that records no patches.
+#[test]
+fn the_blocker_index_leaves_every_state_unchanged() {
+    use gibench_barczak::visibility::{classify_object, determine};
+    let check = |db: &VisibilityDatabase, what: &str| {
+        let mut partial = 0;
+        for (r, rec) in db.receivers.iter().enumerate() {
+            for (l, light) in db.lights.iter().enumerate() {
+                let want: Vec<LightState> = match &rec.shape {
+                    ReceiverShape::Patch(tree) => determine(tree, light, &db.blockers)
+                        .into_iter()
+                        .map(|v| v.state)
+                        .collect(),
+                    ReceiverShape::Object { center, radius } => {
+                        vec![
+                            classify_object(*center, *radius, rec.object, light, &db.blockers)
+                                .state,
+                        ]
+                    }
+                };
+                for (n, w) in want.iter().enumerate() {
+                    partial += (*w == LightState::Partial) as usize;
+                    // Below a fully blocked node, `determine` keeps "blocked" where the
+                    // database says "behind": both leave the light out.
+                    let unlit =
+                        |s: LightState| matches!(s, LightState::Blocked | LightState::Behind);
+                    let got = db.state(r, n, l);
+                    assert!(
+                        got == *w || (unlit(got) && unlit(*w)),
+                        "{what}: receiver {r} node {n} light {l}: {got:?}, without the index {w:?}"
+                    );
+                }
+            }
+        }
+        assert!(partial > 0, "{what}: no partial light to check");
+    };
+    let (receivers, blockers) = room();
+    let (mut db, _) = VisibilityDatabase::build(lights(), receivers, blockers);
+    check(&db, "room");
+    for step in 0..6 {
+        db.move_object(7, |p| p + Vec3::new(0.35, 0.0, 0.25));
+        db.move_object(8, |p| p + Vec3::new(-0.2, 0.05, 0.3));
+        check(&db, &format!("room after move {step}"));
+    }
+    let scene = gibench_harness::scene::Scene::load_named(
+        "cornell-gltf",
+        &gibench_harness::assets::AssetPaths::standard(None),
+    )
+    .unwrap();
+    let bvh = gibench_harness::bvh::SceneBvh::new(&scene.mesh);
+    let frame = gibench_harness::anim::FrameClock::new(&scene.descriptor).frame(0);
+    let settings = gibench_barczak::samples::SampleSettings {
+        direct: 0,
+        indirect: 32,
+        bounces: 2,
+    };
+    let prepared =
+        gibench_barczak::setup::prepare(&scene, &bvh, &frame, &frame.light, settings, 2).unwrap();
+    check(&prepared.db, "cornell-gltf charts");
+}

@@ -38,6 +38,7 @@ fn settings(level: Optimisation) -> RendererSettings {
         updates: 1000,
         prt_directions: 64,
         face_cull: true,
+        max_charts: gibench_barczak::setup::MAX_CHARTS,
     }
 }
 

@@ -122,3 +122,38 @@ fn merges_that_save_nothing_are_not_made() {
         assert_eq!(out, start);
     }
 }
+
+/// Above `MAX_GREEDY` elements (a chart-patched scene): every (object, light) pair still drawn
+/// exactly once, never more passes, deterministic, and objects with equal lights share an
+/// element; in seconds, not the quadratic pass over all pairs.
+#[test]
+fn many_elements_keep_every_pair_once() {
+    use gibench_barczak::passes::MAX_GREEDY;
+    let mut rng = Rng(11);
+    let objects = 3 * MAX_GREEDY + 17;
+    let mut lights = instance(&mut rng, objects, 64);
+    // Many objects with the same few light sets, as neighbouring charts have.
+    for (i, l) in lights.iter_mut().enumerate().filter(|(i, _)| i % 3 == 0) {
+        *l = LightSet::from_indices((i % 5) as u32..(i % 5) as u32 + 9);
+    }
+    let start = one_per_object(&lights);
+    let k = 16;
+    let out = optimise(start.clone(), k);
+    assert!(total_passes(&out, k) <= total_passes(&start, k));
+    let got = pairs(&out);
+    assert!(got.values().all(|n| *n == 1), "a pair is drawn twice");
+    assert_eq!(
+        pairs(&start).keys().collect::<Vec<_>>(),
+        got.keys().collect::<Vec<_>>()
+    );
+    for shift in 0..5u32 {
+        let set = LightSet::from_indices(shift..shift + 9);
+        let holders = out.iter().filter(|e| e.lights == set).count();
+        assert!(
+            holders <= 1,
+            "lights {shift}..{}: {holders} elements",
+            shift + 9
+        );
+    }
+    assert_eq!(out, optimise(start, k), "not deterministic");
+}

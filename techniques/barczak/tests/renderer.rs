@@ -25,6 +25,7 @@ const SETTINGS: RendererSettings = RendererSettings {
     updates: 1000,
     prt_directions: 256,
     face_cull: true,
+    max_charts: gibench_barczak::setup::MAX_CHARTS,
 };
 
 #[test]

@@ -88,24 +88,23 @@ fn light_maps_agree_with_ray_casts(name: &str, direct: u32) {
     );
 }
 
-/// A scene that records no patches and has too many triangles to make them of is refused with a
-/// message naming it, before the light samples are made.
+/// A scene that records no patches gets its planar charts as patches (cornell-gltf: 34
+/// triangles, its walls' quads and the boxes' faces, 18 charts, each holding its triangles);
+/// more charts than allowed is an error naming the scene and the counts.
 #[test]
-fn scenes_with_too_many_triangles_are_refused() {
-    let scene = Scene::load_named("maze", &AssetPaths::standard(None)).unwrap();
+fn scenes_without_patches_get_charts_up_to_a_limit() {
+    let scene = Scene::load_named("cornell-gltf", &AssetPaths::standard(None)).unwrap();
     assert!(scene.patches.is_empty());
-    let bvh = SceneBvh::new(&scene.mesh);
-    let frame = FrameClock::new(&scene.descriptor).frame(0);
-    let settings = SampleSettings {
-        direct: 0,
-        indirect: 8,
-        bounces: 1,
-    };
-    let err = prepare(&scene, &bvh, &frame, &frame.light, settings, 2)
-        .unwrap_err()
-        .to_string();
+    let patches = scene.receiver_patches(2, 1000).unwrap();
+    assert_eq!(patches.len(), 18);
+    let held: usize = patches
+        .iter()
+        .map(|p| p.chart.as_ref().unwrap().triangles.len())
+        .sum();
+    assert_eq!(held, scene.mesh.triangle_count());
+    let err = scene.receiver_patches(2, 17).unwrap_err().to_string();
     assert!(
-        err.contains("'maze'") && err.contains("patches") && err.contains("4096"),
+        err.contains("'cornell-gltf'") && err.contains("18 planar charts") && err.contains("17"),
         "{err}"
     );
 }
