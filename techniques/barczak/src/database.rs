@@ -22,6 +22,7 @@
 //! database on the moved scene (tested).
 
 use glam::Vec3;
+use rayon::prelude::*;
 
 use crate::blocker_index::BlockerIndex;
 use crate::visibility::{Blocker, LightState, Occlusion, PatchTree, PointLight, Reach};
@@ -126,78 +127,46 @@ fn lit(state: Option<LightState>) -> bool {
     matches!(state, Some(LightState::Unblocked | LightState::Partial))
 }
 
-impl VisibilityDatabase {
-    /// The database of the scene, computed in full. Returns it and the tests made.
-    pub fn build(
-        lights: Vec<PointLight>,
-        receivers: Vec<Receiver>,
-        blockers: Vec<Blocker>,
-    ) -> (VisibilityDatabase, usize) {
-        let mut db = VisibilityDatabase {
-            entries: receivers
-                .iter()
-                .map(|r| vec![vec![NodeEntry::default(); lights.len()]; r.node_count()])
-                .collect(),
-            index: BlockerIndex::new(&blockers),
-            lights,
-            receivers,
-            blockers,
-        };
-        let mut tests = 0;
-        for r in 0..db.receivers.len() {
-            tests += db.recompute_receiver(r);
-        }
-        (db, tests)
-    }
+/// What every receiver's computation reads: the lights, the blockers and their index.
+struct Shared<'a> {
+    lights: &'a [PointLight],
+    blockers: &'a [Blocker],
+    index: &'a BlockerIndex,
+}
 
-    /// The entry of `node` of `receiver` for `light`.
-    pub fn entry(&self, receiver: usize, node: usize, light: usize) -> &NodeEntry {
-        &self.entries[receiver][node][light]
-    }
-
-    /// The light's state over the node.
-    pub fn state(&self, receiver: usize, node: usize, light: usize) -> LightState {
-        self.entries[receiver][node][light]
-            .state
-            .expect("every node is computed")
-    }
-
-    /// Every entry, `[receiver][node][light]` (to compare two databases).
-    pub fn entries(&self) -> &[Vec<Vec<NodeEntry>>] {
-        &self.entries
-    }
-
-    /// Recomputes every node of receiver `r` for every light against every blocker (those
-    /// the index rules out for the root's reach are left out: the exact test would reject
-    /// them).
-    fn recompute_receiver(&mut self, r: usize) -> usize {
+impl Shared<'_> {
+    /// Recomputes every node of `receiver` (its `entries`, `[node][light]`) for every light
+    /// against every blocker (those the index rules out for the root's reach are left out:
+    /// the exact test would reject them).
+    fn recompute(&self, receiver: &Receiver, entries: &mut [Vec<NodeEntry>]) -> usize {
         let mut candidates = Vec::new();
         let mut tests = 0;
         for l in 0..self.lights.len() {
-            let reach = self.receivers[r].reach(0, &self.lights[l]);
+            let reach = receiver.reach(0, &self.lights[l]);
             self.index
                 .query(|lo, hi| reach.rules_out(lo, hi), &mut candidates);
-            for node in &mut self.entries[r] {
+            for node in entries.iter_mut() {
                 node[l] = NodeEntry::default();
             }
-            tests += self.visit(r, l, 0, None, &candidates, true);
+            tests += self.visit(receiver, entries, l, 0, None, &candidates, true);
         }
         tests
     }
 
-    /// Brings node `n` of receiver `r` for light `l` up to date for the blockers `only`, given
-    /// its parent's entry (`None` at the root), and descends where Table 4-1 says so; `full`
-    /// recomputes the whole subtree. Returns the tests made.
+    /// Brings node `n` of `receiver` (its `entries`) for light `l` up to date for the
+    /// blockers `only`, given its parent's entry (`None` at the root), and descends where
+    /// Table 4-1 says so; `full` recomputes the whole subtree. Returns the tests made.
+    #[allow(clippy::too_many_arguments)]
     fn visit(
-        &mut self,
-        r: usize,
+        &self,
+        receiver: &Receiver,
+        entries: &mut [Vec<NodeEntry>],
         l: usize,
         n: usize,
         parent: Option<&NodeEntry>,
         only: &[u32],
         full: bool,
     ) -> usize {
-        let receiver = &self.receivers[r];
         let reach = receiver.reach(n, &self.lights[l]);
         let mut tests = 0;
         let mut fresh: Vec<(u32, Occlusion)> = Vec::new();
@@ -226,7 +195,7 @@ impl VisibilityDatabase {
                 }
             }
         }
-        let entry = &mut self.entries[r][n][l];
+        let entry = &mut entries[n][l];
         // The entries of the blockers not revisited stay; the revisited ones are replaced.
         let old: Vec<(u32, Occlusion)> = entry
             .blockers
@@ -244,14 +213,63 @@ impl VisibilityDatabase {
             entry.state = Some(reach.state(&entry.blockers));
         }
         if descend {
-            if let Some(children) = self.receivers[r].children(n) {
-                let parent = self.entries[r][n][l].clone();
+            if let Some(children) = receiver.children(n) {
+                let parent = entries[n][l].clone();
                 for c in children {
-                    tests += self.visit(r, l, c as usize, Some(&parent), only, full);
+                    tests +=
+                        self.visit(receiver, entries, l, c as usize, Some(&parent), only, full);
                 }
             }
         }
         tests
+    }
+}
+
+impl VisibilityDatabase {
+    /// The database of the scene, computed in full. Returns it and the tests made.
+    pub fn build(
+        lights: Vec<PointLight>,
+        receivers: Vec<Receiver>,
+        blockers: Vec<Blocker>,
+    ) -> (VisibilityDatabase, usize) {
+        let mut db = VisibilityDatabase {
+            entries: receivers
+                .iter()
+                .map(|r| vec![vec![NodeEntry::default(); lights.len()]; r.node_count()])
+                .collect(),
+            index: BlockerIndex::new(&blockers),
+            lights,
+            receivers,
+            blockers,
+        };
+        // Receivers are independent: computed in parallel, the same as one after another.
+        let scene = Shared {
+            lights: &db.lights,
+            blockers: &db.blockers,
+            index: &db.index,
+        };
+        let tests = (db.receivers.par_iter())
+            .zip(db.entries.par_iter_mut())
+            .map(|(receiver, entries)| scene.recompute(receiver, entries))
+            .sum();
+        (db, tests)
+    }
+
+    /// The entry of `node` of `receiver` for `light`.
+    pub fn entry(&self, receiver: usize, node: usize, light: usize) -> &NodeEntry {
+        &self.entries[receiver][node][light]
+    }
+
+    /// The light's state over the node.
+    pub fn state(&self, receiver: usize, node: usize, light: usize) -> LightState {
+        self.entries[receiver][node][light]
+            .state
+            .expect("every node is computed")
+    }
+
+    /// Every entry, `[receiver][node][light]` (to compare two databases).
+    pub fn entries(&self) -> &[Vec<Vec<NodeEntry>>] {
+        &self.entries
     }
 
     /// Moves `object` (its blockers and receivers) by the rigid map `to` and updates the
@@ -292,14 +310,24 @@ impl VisibilityDatabase {
             }
             self.index.moved(b, &self.blockers);
         }
+        for r in &mut self.receivers {
+            if r.object == object {
+                r.transform(&to);
+            }
+        }
+        let scene = Shared {
+            lights: &self.lights,
+            blockers: &self.blockers,
+            index: &self.index,
+        };
         let mut tests = 0;
-        for r in 0..self.receivers.len() {
-            if self.receivers[r].object == object {
-                self.receivers[r].transform(&to);
-                tests += self.recompute_receiver(r);
+        for (receiver, entries) in self.receivers.iter().zip(&mut self.entries) {
+            if receiver.object == object {
+                // Moved: every node against every blocker (its reach moved).
+                tests += scene.recompute(receiver, entries);
             } else {
                 for l in 0..self.lights.len() {
-                    tests += self.visit(r, l, 0, None, &moved, false);
+                    tests += scene.visit(receiver, entries, l, 0, None, &moved, false);
                 }
             }
         }

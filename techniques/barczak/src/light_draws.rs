@@ -130,6 +130,17 @@ impl LightDraws {
         // (VD: one more partial draw per leaf at most).
         let max_draws = (tiles * (lights.div_ceil(k) as u64 + 1)).max(1);
         let max_indices = (leaves.vertex_count() as u64 * lights as u64).max(1);
+        let limit = gpu.device.limits().max_buffer_size;
+        let need = (max_indices * 4).max(max_draws * RECORD_STRIDE);
+        if need > limit {
+            return Err(Error::Invalid(format!(
+                "barczak's light draws would need a {} MB buffer ({} leaves, {} of their vertices, {lights} light samples), more than this device's largest ({} MB); use fewer samples (vpls) or a scene with fewer patches (max-charts)",
+                need >> 20,
+                tiles,
+                leaves.vertex_count(),
+                limit >> 20
+            )));
+        }
         let indices = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("barczak element indices"),
             size: max_indices * 4,

@@ -41,7 +41,7 @@ use crate::prt::{self, COEFFS};
 use crate::prt_pass::PrtPass;
 use crate::samples::SampleSettings;
 use crate::schedule::ShadowMapSchedule;
-use crate::setup::{prepare_with, BarczakScene};
+use crate::setup::{prepare, BarczakScene};
 
 /// The renderer's settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -87,7 +87,7 @@ impl Prepared {
         frame: &FrameState,
         settings: &RendererSettings,
     ) -> Result<Prepared> {
-        let bz = prepare_with(
+        let bz = prepare(
             scene,
             bvh,
             frame,

@@ -61,30 +61,10 @@ pub const CHART_LEVELS: u32 = 2;
 /// Charts a scene without recorded patches may make.
 pub const MAX_CHARTS: usize = 200_000;
 
-/// Prepares `scene` at `frame` (the movers' poses) with light `light` (see the module docs),
-/// allowing [`MAX_CHARTS`] charts.
+/// Prepares `scene` at `frame` (the movers' poses) with light `light` (see the module docs).
+/// Errors name the scene when it records no patches and makes more than `max_charts` charts,
+/// before any work per chart.
 pub fn prepare(
-    scene: &Scene,
-    bvh: &SceneBvh,
-    frame: &FrameState,
-    light: &LightPose,
-    settings: SampleSettings,
-    light_map_res: u32,
-) -> Result<BarczakScene> {
-    prepare_with(
-        scene,
-        bvh,
-        frame,
-        light,
-        settings,
-        light_map_res,
-        MAX_CHARTS,
-    )
-}
-
-/// [`prepare`] allowing `max_charts` charts. Errors name the scene when it records no patches
-/// and makes more charts, before any work per chart.
-pub fn prepare_with(
     scene: &Scene,
     bvh: &SceneBvh,
     frame: &FrameState,

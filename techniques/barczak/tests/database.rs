@@ -149,7 +149,6 @@ fn the_blocker_index_leaves_every_state_unchanged() {
         indirect: 32,
         bounces: 2,
     };
-    let prepared =
-        gibench_barczak::setup::prepare(&scene, &bvh, &frame, &frame.light, settings, 2).unwrap();
+    let prepared = support::prepared(&scene, &bvh, &frame, settings, 2);
     check(&prepared.db, "cornell-gltf charts");
 }

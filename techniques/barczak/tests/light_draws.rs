@@ -11,7 +11,6 @@ use gibench_barczak::light_draws::{Level, LightDraws};
 use gibench_barczak::lightmap::contribution;
 use gibench_barczak::lightmap_pass::{Leaves, LightMapPass};
 use gibench_barczak::samples::SampleSettings;
-use gibench_barczak::setup::prepare;
 use gibench_barczak::visibility::LightState;
 use gibench_harness::assets::AssetPaths;
 use gibench_harness::glam::Vec3;
@@ -39,7 +38,7 @@ fn light_maps_minus_occluded_partials_equal_the_brute_force_gather() {
             indirect: 40,
             bounces: 2,
         };
-        let bz = prepare(&scene, &harness.bvh, &frame, &frame.light, settings, 4).unwrap();
+        let bz = support::prepared(&scene, &harness.bvh, &frame, settings, 4);
         let lights = bz.samples.slotted();
         let n = lights.len() as u32;
         let store = VplStore::new(gpu, n).unwrap();

@@ -4,7 +4,6 @@
 
 use gibench_barczak::lightmap_pass::{Leaves, LightMapPass};
 use gibench_barczak::samples::SampleSettings;
-use gibench_barczak::setup::prepare;
 use gibench_harness::assets::AssetPaths;
 use gibench_harness::glam::Vec3;
 use gibench_harness::passes::{render_target, HDR_FORMAT};
@@ -27,7 +26,7 @@ fn light_map_pass_draws_the_cpu_light_maps() {
             indirect: 24,
             bounces: 2,
         };
-        let bz = prepare(&scene, &harness.bvh, &frame, &frame.light, settings, RES).unwrap();
+        let bz = support::prepared(&scene, &harness.bvh, &frame, settings, RES);
         let leaves = std::sync::Arc::new(Leaves::new(gpu, &bz.db));
         let pass = LightMapPass::new(
             gpu,

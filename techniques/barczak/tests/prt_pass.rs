@@ -5,7 +5,6 @@
 use gibench_barczak::prt::{self, COEFFS};
 use gibench_barczak::prt_pass::PrtPass;
 use gibench_barczak::samples::SampleSettings;
-use gibench_barczak::setup::prepare;
 use gibench_harness::assets::AssetPaths;
 use gibench_harness::bvh::SceneBvh;
 use gibench_harness::glam::{Mat3, Vec3};
@@ -45,7 +44,7 @@ fn prt_draw_interpolates_the_cpu_vertex_irradiance() {
             indirect: 48,
             bounces: 2,
         };
-        let bz = prepare(&scene, &harness.bvh, &frame, &frame.light, settings, 2).unwrap();
+        let bz = support::prepared(&scene, &harness.bvh, &frame, settings, 2);
         let model = frame.movers[0];
         let (centre, _) = bz.movers[0].posed(model);
         let rotation = Mat3::from_mat4(model);

@@ -5,7 +5,7 @@
 use gibench_barczak::database::ReceiverShape;
 use gibench_barczak::lightmap::{contribution, texel_position};
 use gibench_barczak::samples::SampleSettings;
-use gibench_barczak::setup::prepare;
+use gibench_barczak::setup::{prepare, MAX_CHARTS};
 use gibench_barczak::visibility::LightState;
 use gibench_harness::anim::FrameClock;
 use gibench_harness::assets::AssetPaths;
@@ -35,7 +35,16 @@ fn light_maps_agree_with_ray_casts(name: &str, direct: u32) {
         indirect: 48,
         bounces: 3,
     };
-    let bz = prepare(&scene, &bvh, &frame, &frame.light, settings, RES).unwrap();
+    let bz = prepare(
+        &scene,
+        &bvh,
+        &frame,
+        &frame.light,
+        settings,
+        RES,
+        MAX_CHARTS,
+    )
+    .unwrap();
     assert_eq!(bz.db.lights.len(), 64);
     // The real occluders: the static mesh and the torus where frame 0 puts it.
     let mut world = scene.mesh.clone();

@@ -263,3 +263,16 @@ pub fn render_frame(
         counts,
     )
 }
+
+/// `setup::prepare` of `scene` at `frame` (its light) with `settings`, light maps of `res`,
+/// the default chart limit.
+pub fn prepared(
+    scene: &Scene,
+    bvh: &gibench_harness::bvh::SceneBvh,
+    frame: &gibench_harness::anim::FrameState,
+    settings: gibench_barczak::samples::SampleSettings,
+    res: u32,
+) -> gibench_barczak::setup::BarczakScene {
+    use gibench_barczak::setup::{prepare, MAX_CHARTS};
+    prepare(scene, bvh, frame, &frame.light, settings, res, MAX_CHARTS).unwrap()
+}
