@@ -703,7 +703,7 @@ impl Scene {
         let charts = charts::charts(&self.mesh, charts::ChartSettings::for_mesh(&self.mesh));
         if charts.len() > max_charts {
             return Err(crate::Error::Invalid(format!(
-                "scene '{}' records no patches, and its {} triangles make {} planar charts, more than the {max_charts} allowed; use a scene that records patches (barczak-area, barczak-table, barczak-pillars) or a smaller mesh",
+                "scene '{}' records no patches, and its {} triangles make {} planar charts, more than the {max_charts} allowed (barczak's `max-charts`: raise it, with memory and preparation time to match, or use a scene that records patches: barczak-area, barczak-table, barczak-pillars)",
                 self.descriptor.name,
                 self.mesh.triangle_count(),
                 charts.len()

@@ -14,7 +14,7 @@ use gibench_harness::gpu::GpuContext;
 use gibench_harness::passes::{
     params_entry, shader_module, FrameUniforms, GBuffer, CAMERA_SLOT, HDR_FORMAT,
 };
-use gibench_harness::{wgpu, Result};
+use gibench_harness::{wgpu, Error, Result};
 use glam::Vec3;
 
 use crate::database::{ReceiverShape, VisibilityDatabase};
@@ -237,9 +237,25 @@ impl LightMapPass {
     ) -> Result<LightMapPass> {
         let device = &gpu.device;
         let res = maps.res;
+        let size = (leaves.tiles.len() as u64 * (res * res) as u64 * 16).max(16);
+        let limits = device.limits();
+        let limit = limits
+            .max_buffer_size
+            .min(limits.max_storage_buffer_binding_size as u64);
+        if size > limit {
+            return Err(Error::param(
+                "light-map-res",
+                format!(
+                    "{res}² texels on each of {} leaves need a {} MB light-map buffer, more than this device binds ({} MB); use a lower light-map-res",
+                    leaves.tiles.len(),
+                    size >> 20,
+                    limit >> 20
+                ),
+            ));
+        }
         let texels = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("barczak light maps"),
-            size: (leaves.tiles.len() as u64 * (res * res) as u64 * 16).max(16),
+            size,
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
