@@ -241,7 +241,7 @@ impl LightMapPass {
         let limits = device.limits();
         let limit = limits
             .max_buffer_size
-            .min(limits.max_storage_buffer_binding_size as u64);
+            .min(limits.max_storage_buffer_binding_size);
         if size > limit {
             return Err(Error::param(
                 "light-map-res",
