@@ -15,7 +15,11 @@ fn run_ok(args: &[&str], out: &std::path::Path) -> String {
         .unwrap();
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success(), "gibench run {args:?} failed:\n{stderr}");
-    String::from_utf8_lossy(&o.stdout).into_owned()
+    let stdout = String::from_utf8_lossy(&o.stdout).into_owned();
+    // The terminal table fits 120 columns (before: over 300 with every technique's stages).
+    let widest = stdout.lines().map(|l| l.chars().count()).max().unwrap_or(0);
+    assert!(widest <= 120, "a line of {widest} characters:\n{stdout}");
+    stdout
 }
 
 #[test]
