@@ -140,6 +140,16 @@ pub fn say_uncaptured(message: &str) {
 }
 
 impl GpuContext {
+    /// The largest buffer this device can create and bind whole as storage, bytes (the
+    /// smaller of the two limits): what every storage buffer sized by a parameter is checked
+    /// against before it is made.
+    pub fn max_storage_buffer(&self) -> u64 {
+        let limits = self.device.limits();
+        limits
+            .max_storage_buffer_binding_size
+            .min(limits.max_buffer_size)
+    }
+
     /// Picks an adapter and creates the device.
     pub fn new(opts: &GpuOptions) -> Result<GpuContext> {
         let wait_limit = opts.wait_limit()?;

@@ -195,12 +195,9 @@ impl Interleave {
         let tile_size = [full[0].div_ceil(tiles[0]), full[1].div_ceil(tiles[1])];
         let split_size = [tile_size[0] * tiles[0], tile_size[1] * tiles[1]];
 
-        let limits = device.limits();
         let split_bytes = split_size[0] as u64 * split_size[1] as u64 * 16;
         let full_bytes = full[0] as u64 * full[1] as u64 * 16;
-        let max = limits
-            .max_storage_buffer_binding_size
-            .min(limits.max_buffer_size);
+        let max = gpu.max_storage_buffer();
         if split_bytes.max(full_bytes) > max {
             return Err(Error::Gpu(format!(
                 "interleave buffers of {} bytes exceed the adapter's storage-buffer limit of {max}",

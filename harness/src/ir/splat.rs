@@ -52,10 +52,7 @@ pub(crate) fn texel_buffer_size(
     param: &str,
 ) -> Result<u64> {
     let bytes = texels * 4;
-    let limits = gpu.device.limits();
-    let max = limits
-        .max_storage_buffer_binding_size
-        .min(limits.max_buffer_size);
+    let max = gpu.max_storage_buffer();
     if bytes > max {
         let advice = if param == "vpl-map-size" {
             "use fewer VPLs or smaller maps"

@@ -68,10 +68,7 @@ impl VplStore {
             return Err(Error::param("vpls", "at least one VPL slot is needed"));
         }
         let size = HEADER + capacity as u64 * std::mem::size_of::<GpuVpl>() as u64;
-        let limits = gpu.device.limits();
-        let max = limits
-            .max_storage_buffer_binding_size
-            .min(limits.max_buffer_size);
+        let max = gpu.max_storage_buffer();
         if size > max {
             return Err(Error::param(
                 "vpls",

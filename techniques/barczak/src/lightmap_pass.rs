@@ -238,10 +238,7 @@ impl LightMapPass {
         let device = &gpu.device;
         let res = maps.res;
         let size = (leaves.tiles.len() as u64 * (res * res) as u64 * 16).max(16);
-        let limits = device.limits();
-        let limit = limits
-            .max_buffer_size
-            .min(limits.max_storage_buffer_binding_size);
+        let limit = gpu.max_storage_buffer();
         if size > limit {
             return Err(Error::param(
                 "light-map-res",

@@ -175,9 +175,7 @@ impl Grid {
     pub fn check_limits(&self, gpu: &GpuContext) -> Result<()> {
         let limits = gpu.device.limits();
         let bytes = self.cells() * CELL_BYTES;
-        let max = limits
-            .max_storage_buffer_binding_size
-            .min(limits.max_buffer_size);
+        let max = gpu.max_storage_buffer();
         if bytes > max {
             return Err(Error::param(
                 "grid",

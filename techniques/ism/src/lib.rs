@@ -176,10 +176,7 @@ impl IsmParams {
     /// buffer (16 bytes a point), the reflective shadow map's texel buffers (16 bytes a texel,
     /// six faces) and its 3 × 2 faces' texture.
     pub fn check_device(&self, gpu: &gibench_harness::gpu::GpuContext) -> Result<()> {
-        let limits = gpu.device.limits();
-        let max = limits
-            .max_storage_buffer_binding_size
-            .min(limits.max_buffer_size);
+        let max = gpu.max_storage_buffer();
         let pool_bytes = self.pool as u64 * 16;
         if pool_bytes > max {
             return Err(Error::param(
