@@ -102,8 +102,8 @@ pub fn convex_hull(points: &[Vec2]) -> Vec<Vec2> {
     hull
 }
 
-/// The area of a counter-clockwise polygon.
-fn polygon_area(p: &[Vec2]) -> f32 {
+/// The signed area of a polygon (positive when counter-clockwise).
+pub fn polygon_area(p: &[Vec2]) -> f32 {
     let n = p.len();
     (0..n).map(|i| p[i].perp_dot(p[(i + 1) % n])).sum::<f32>() * 0.5
 }

@@ -14,6 +14,7 @@ use gibench_harness::gpu::GpuContext;
 use gibench_harness::passes::{
     params_entry, shader_module, FrameUniforms, GBuffer, CAMERA_SLOT, HDR_FORMAT,
 };
+use gibench_harness::scene::charts::polygon_area;
 use gibench_harness::{wgpu, Error, Result};
 use glam::Vec3;
 
@@ -90,13 +91,8 @@ pub fn leaf_triangles(corners: [Vec3; 4], surface: &[[Vec3; 3]]) -> Vec<[f32; 2]
             .collect();
         let poly = clip_to_unit_square(flat);
         // Pieces with no area (a triangle touching the leaf along an edge) are left out.
-        let twice_area: f32 = (0..poly.len())
-            .map(|i| {
-                let (p, q) = (poly[i], poly[(i + 1) % poly.len()]);
-                p[0] * q[1] - p[1] * q[0]
-            })
-            .sum();
-        if twice_area.abs() <= 1e-9 {
+        let points: Vec<glam::Vec2> = poly.iter().map(|p| glam::Vec2::from(*p)).collect();
+        if polygon_area(&points).abs() <= 5e-10 {
             continue;
         }
         for i in 1..poly.len().saturating_sub(1) {
