@@ -15,8 +15,8 @@
 //! at least one pass, so it ends.
 //!
 //! Scoring every pair needs memory and time in the square of the elements: fine for the
-//! thesis' rooms (tens), not for a chart-patched scene (Sibenik: 27,000 elements, 7 GB and
-//! 15 minutes before it was bounded). Above [`MAX_GREEDY`] elements, elements with equal
+//! thesis' rooms (tens), not for a chart-patched scene (tens of thousands; on Sibenik one
+//! plan did not finish in minutes). Above [`MAX_GREEDY`] elements, elements with equal
 //! lights are joined first and the greedy runs on consecutive groups of [`MAX_GREEDY`]
 //! (a deviation, in the README's table).
 

@@ -59,8 +59,8 @@ pub struct BarczakScene {
 /// Subdivision levels at most of the chart patches of a scene that records none.
 pub const CHART_LEVELS: u32 = 2;
 /// Charts a scene without recorded patches may make by default (the `max-charts` parameter):
-/// Sibenik (25,010), Sponza (26,414) and Maze (53,219) fit; the conference room (115,302)
-/// would take more than 25 minutes and 14 GB to prepare on 2 cores.
+/// Sibenik (25,010), Sponza (26,414) and Maze (53,219) fit; the conference room's (115,302)
+/// visibility database is beyond a 2-core, 24 GB machine.
 pub const MAX_CHARTS: usize = 60_000;
 
 /// Prepares `scene` at `frame` (the movers' poses) with light `light` (see the module docs).
