@@ -5,9 +5,10 @@
 //!
 //! Reads: the blockers' shapes (their axis-aligned boxes).
 //! Writes: for a query (a test "is this box certainly outside?"), the blockers whose boxes it
-//! does not rule out, ascending. A box outside one of a pyramid's bounding planes is outside
-//! the pyramid, so the exact test would have rejected every blocker left out: the database is
-//! the same with the index as without (tested).
+//! does not rule out (each blocker's own box, not only its leaf's), ascending. A box outside
+//! one of a pyramid's bounding planes is outside the pyramid, so the exact test would have
+//! rejected every blocker left out: the database is the same with the index as without
+//! (tested).
 //!
 //! Built once (median splits on the longest axis, up to [`LEAF_SIZE`] blockers a leaf); when
 //! an object moves, its blockers' leaves are refitted and then their ancestors, in place
@@ -40,6 +41,8 @@ pub struct BlockerIndex {
     order: Vec<u32>,
     /// Each blocker's leaf.
     leaf_of: Vec<u32>,
+    /// Each blocker's box (a leaf's blockers are tested one by one).
+    boxes: Vec<(Vec3, Vec3)>,
 }
 
 /// The axis-aligned box of a shape.
@@ -67,10 +70,12 @@ impl BlockerIndex {
             nodes: Vec::new(),
             order: (0..blockers.len() as u32).collect(),
             leaf_of: vec![NONE; blockers.len()],
+            boxes: Vec::new(),
         };
         if !blockers.is_empty() {
             index.build(&boxes, 0, blockers.len(), NONE);
         }
+        index.boxes = boxes;
         index
     }
 
@@ -126,7 +131,10 @@ impl BlockerIndex {
             }
             if node.left == NONE {
                 let (f, c) = (node.first as usize, node.count as usize);
-                out.extend_from_slice(&self.order[f..f + c]);
+                out.extend(self.order[f..f + c].iter().filter(|&&b| {
+                    let (lo, hi) = self.boxes[b as usize];
+                    !outside(lo, hi)
+                }));
             } else {
                 stack[top] = node.left;
                 stack[top + 1] = node.right;
@@ -136,9 +144,15 @@ impl BlockerIndex {
         out.sort_unstable();
     }
 
+    /// Blocker `b`'s box.
+    pub fn bounds_of(&self, b: u32) -> (Vec3, Vec3) {
+        self.boxes[b as usize]
+    }
+
     /// Refits after blocker `b` of `blockers` moved: its leaf's box is recomputed from its
     /// blockers and every ancestor's from its children.
     pub fn moved(&mut self, b: u32, blockers: &[Blocker]) {
+        self.boxes[b as usize] = bounds(&blockers[b as usize].shape);
         let mut n = self.leaf_of[b as usize];
         let mut first = true;
         while n != NONE {
@@ -148,7 +162,7 @@ impl BlockerIndex {
                 self.order[f..f + c].iter().fold(
                     (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
                     |(lo, hi), &k| {
-                        let (a, b) = bounds(&blockers[k as usize].shape);
+                        let (a, b) = self.boxes[k as usize];
                         (lo.min(a), hi.max(b))
                     },
                 )

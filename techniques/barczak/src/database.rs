@@ -154,8 +154,9 @@ impl Shared<'_> {
     }
 
     /// Brings node `n` of `receiver` (its `entries`) for light `l` up to date for the
-    /// blockers `only`, given its parent's entry (`None` at the root), and descends where
-    /// Table 4-1 says so; `full` recomputes the whole subtree. Returns the tests made.
+    /// blockers `only` (ascending), given its parent's entry (`None` at the root), and descends
+    /// where Table 4-1 says so; `full` recomputes the whole subtree (its entries were reset).
+    /// Returns the tests made.
     #[allow(clippy::too_many_arguments)]
     fn visit(
         &self,
@@ -168,57 +169,61 @@ impl Shared<'_> {
         full: bool,
     ) -> usize {
         let reach = receiver.reach(n, &self.lights[l]);
+        let revisited = |b: &u32| only.binary_search(b).is_ok();
         let mut tests = 0;
-        let mut fresh: Vec<(u32, Occlusion)> = Vec::new();
-        if !matches!(reach, Reach::Behind) {
-            for &b in only {
-                let blocker = &self.blockers[b as usize];
-                if blocker.object == receiver.object {
-                    continue;
-                }
-                let o = match parent {
-                    None => {
-                        tests += 1;
-                        reach.test(&blocker.shape)
-                    }
-                    Some(p) => match p.blockers.iter().find(|(pb, _)| *pb == b).map(|x| x.1) {
-                        Some(Occlusion::Full) => Some(Occlusion::Full),
-                        Some(Occlusion::Partial) => {
-                            tests += 1;
-                            reach.test(&blocker.shape)
-                        }
-                        None => None,
-                    },
-                };
-                if let Some(o) = o {
-                    fresh.push((b, o));
-                }
-            }
-        }
+        let mut test = |b: u32| {
+            tests += 1;
+            reach.test(&self.blockers[b as usize].shape).map(|o| (b, o))
+        };
+        // Ascending by blocker, as `only` and the parent's list are.
+        let fresh: Vec<(u32, Occlusion)> = match (&reach, parent) {
+            (Reach::Behind, _) => Vec::new(),
+            // At a root, a blocker whose box lies outside the reach cannot reach in (the exact
+            // test would say so; the index already left such blockers out of a recomputation).
+            (_, None) => (only.iter().copied())
+                .filter(|&b| self.blockers[b as usize].object != receiver.object)
+                .filter(|&b| {
+                    let (lo, hi) = self.index.bounds_of(b);
+                    !reach.rules_out(lo, hi)
+                })
+                .filter_map(&mut test)
+                .collect(),
+            // Below the root only the parent's blockers can reach in: full stays full, partial
+            // is tested again, missing stays missing.
+            (_, Some(p)) => (p.blockers.iter())
+                .filter(|(b, _)| revisited(b))
+                .filter_map(|&(b, o)| match o {
+                    Occlusion::Full => Some((b, o)),
+                    Occlusion::Partial => test(b),
+                })
+                .collect(),
+        };
         let entry = &mut entries[n][l];
-        // The entries of the blockers not revisited stay; the revisited ones are replaced.
-        let old: Vec<(u32, Occlusion)> = entry
-            .blockers
-            .iter()
-            .filter(|(b, _)| only.contains(b))
-            .copied()
-            .collect();
-        // A full recomputation (a moved or new receiver) also renews the state: its reach moved.
-        let unchanged = old == fresh && entry.state.is_some() && !full;
+        // The entries of the blockers not revisited stay; the revisited ones are replaced. A
+        // full recomputation (a moved or new receiver) also renews the state: its reach moved.
+        let unchanged = !full
+            && entry.state.is_some()
+            && entry
+                .blockers
+                .iter()
+                .filter(|(b, _)| revisited(b))
+                .eq(fresh.iter());
         let descend = !unchanged || fresh.iter().any(|(_, o)| *o == Occlusion::Partial);
         if !unchanged {
-            entry.blockers.retain(|(b, _)| !only.contains(b));
+            entry.blockers.retain(|(b, _)| !revisited(b));
             entry.blockers.extend(fresh);
             entry.blockers.sort_unstable_by_key(|(b, _)| *b);
             entry.state = Some(reach.state(&entry.blockers));
         }
         if descend {
             if let Some(children) = receiver.children(n) {
-                let parent = entries[n][l].clone();
+                // Children never read their parent's entry: lend it to them without a copy.
+                let parent = std::mem::take(&mut entries[n][l]);
                 for c in children {
                     tests +=
                         self.visit(receiver, entries, l, c as usize, Some(&parent), only, full);
                 }
+                entries[n][l] = parent;
             }
         }
         tests

@@ -269,10 +269,18 @@ impl Pyramid {
     /// Whether what is left of the convex polygon after clipping by the pyramid (its far plane
     /// moved `eps` towards the light) covers a share of the pyramid's solid angle.
     fn clips_to_something(&self, vertices: &[Vec3]) -> bool {
+        let shift = |k: usize| if k == 4 { self.tolerance.eps } else { 0.0 };
+        // Wholly outside one plane: nothing is left (the common case, decided without clipping).
+        let outside = |(k, plane): (usize, &Plane)| {
+            vertices.iter().all(|v| plane.distance(*v) - shift(k) < 0.0)
+        };
+        if self.planes.iter().enumerate().any(outside) {
+            return false;
+        }
         let mut poly: Vec<Vec3> = vertices.to_vec();
         let mut next = Vec::with_capacity(poly.len() + 5);
         for (k, plane) in self.planes.iter().enumerate() {
-            let shift = if k == 4 { self.tolerance.eps } else { 0.0 };
+            let shift = shift(k);
             next.clear();
             for i in 0..poly.len() {
                 let (p, q) = (poly[i], poly[(i + 1) % poly.len()]);
