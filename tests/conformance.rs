@@ -56,12 +56,48 @@ fn every_registered_technique_conforms() {
     let gpu = GpuContext::new(&GpuOptions::default()).expect("a GPU adapter (Vulkan or GL)");
     let mut failures = Vec::new();
     for scene_name in ["cornell", "cornell-area", "cornell-omni", "cornell-sun"] {
-        conform_on(&gpu, scene_name, &mut failures);
+        conform_on(
+            &gpu,
+            scene_name,
+            registry::all().iter(),
+            true,
+            &mut failures,
+        );
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
-fn conform_on(gpu: &GpuContext, scene_name: &str, failures: &mut Vec<String>) {
+/// Barczak's receivers on scenes that record no patches are generated charts (issue 37): its
+/// entry also covers the papers' large scenes, with one build each (the Cornell entries check
+/// determinism; a build here takes most of a minute on two cores).
+#[test]
+fn barczak_conforms_on_the_papers_scenes() {
+    let gpu = GpuContext::new(&GpuOptions::default()).expect("a GPU adapter (Vulkan or GL)");
+    let barczak: Vec<&TechniqueInfo> = registry::all()
+        .iter()
+        .filter(|t| t.name == "barczak")
+        .collect();
+    assert_eq!(barczak.len(), 1, "barczak is registered");
+    let mut failures = Vec::new();
+    for scene_name in ["sibenik", "sponza", "maze"] {
+        conform_on(
+            &gpu,
+            scene_name,
+            barczak.iter().copied(),
+            false,
+            &mut failures,
+        );
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+fn conform_on<'a>(
+    gpu: &GpuContext,
+    scene_name: &str,
+    techniques: impl Iterator<Item = &'a TechniqueInfo>,
+    twice: bool,
+    failures: &mut Vec<String>,
+) {
     let scene = Scene::load_named(scene_name, &AssetPaths::standard(None)).unwrap();
     let config = RunConfig {
         resolution: SIZE,
@@ -75,7 +111,7 @@ fn conform_on(gpu: &GpuContext, scene_name: &str, failures: &mut Vec<String>) {
     let h = Harness::new(gpu, &scene, &config).unwrap();
     let frame = h.clock.frame(FRAMES - 1);
     let mut references = Vec::new();
-    for info in registry::all() {
+    for info in techniques {
         let component = info.default_reference();
         let reference = match references.iter().position(|(c, _)| *c == component) {
             Some(i) => &references[i].1,
@@ -99,7 +135,11 @@ fn conform_on(gpu: &GpuContext, scene_name: &str, failures: &mut Vec<String>) {
             }
         };
         let a = render(gpu, &h, info, &config);
-        let b = render(gpu, &h, info, &config);
+        let b = if twice {
+            render(gpu, &h, info, &config)
+        } else {
+            a.clone()
+        };
         let name = format!("{} on {scene_name}", info.name);
         // 1. Finite.
         if let Some(i) = a.iter().position(|e| !e.is_finite()) {
@@ -107,14 +147,17 @@ fn conform_on(gpu: &GpuContext, scene_name: &str, failures: &mut Vec<String>) {
         }
         // 2. Zero where the camera sees no geometry (the reference's hit mask, the same camera).
         let misses: Vec<usize> = (0..a.len()).filter(|&i| !reference.hit[i]).collect();
-        assert!(!misses.is_empty(), "the Cornell view shows background");
+        assert!(
+            !misses.is_empty() || !scene_name.starts_with("cornell"),
+            "the Cornell view shows background"
+        );
         if let Some(&i) = misses.iter().find(|&&i| a[i] != Vec3::ZERO) {
             failures.push(format!(
                 "{name}: {} where no geometry is hit (pixel {i})",
                 a[i]
             ));
         }
-        // 3. Deterministic across builds.
+        // 3. Deterministic across builds (where built twice).
         if a != b {
             let n = a.iter().zip(&b).filter(|(x, y)| x != y).count();
             failures.push(format!("{name}: two builds differ in {n} pixels"));
