@@ -16,7 +16,7 @@ mod registry;
 use gibench_harness::assets::AssetPaths;
 use gibench_harness::gpu::{GpuContext, GpuOptions};
 use gibench_harness::profiler::{ProfileMode, Profiler};
-use gibench_harness::runner::{Harness, RunConfig, TimingMode};
+use gibench_harness::runner::{process_memory_mb, Harness, RunConfig, TimingMode};
 use gibench_harness::scene::Scene;
 
 const MAX_GROWTH_MB: f64 = 12.0;
@@ -26,17 +26,7 @@ const MEASURED: u32 = 2 * WINDOW;
 
 /// The resident set size in MB (`VmRSS`).
 fn rss_mb() -> f64 {
-    let status = std::fs::read_to_string("/proc/self/status").expect("/proc/self/status");
-    let line = status
-        .lines()
-        .find(|l| l.starts_with("VmRSS:"))
-        .expect("a VmRSS line");
-    let kb: f64 = line
-        .split_whitespace()
-        .nth(1)
-        .and_then(|v| v.parse().ok())
-        .expect("VmRSS in kB");
-    kb / 1024.0
+    process_memory_mb("VmRSS").expect("VmRSS in /proc/self/status")
 }
 
 #[test]

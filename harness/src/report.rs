@@ -1422,6 +1422,7 @@ mod tests {
             images: vec!["frame.png".into()],
             warnings: Vec::new(),
             calibration_ms: None,
+            peak_memory_mb: None,
         }
     }
 

@@ -130,6 +130,11 @@ pub struct RunResult {
     /// a shared machine between sessions cancels.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub calibration_ms: Option<f64>,
+    /// The process's peak resident memory when the run ended (`VmHWM`, MB; Linux): the
+    /// technique's own peak when it was the only one run in the process (one `--technique`),
+    /// else the largest of those run so far.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub peak_memory_mb: Option<f64>,
 }
 
 impl RunResult {

@@ -192,25 +192,57 @@ pub struct FrameImages {
     /// The technique's irradiance, negative values set to 0 (see [`non_negative`]).
     pub indirect: Vec<[f32; 3]>,
     pub direct: Vec<[f32; 3]>,
-    /// Pixels of the technique's output that were negative before [`non_negative`].
-    pub negative_indirect: usize,
+    /// The technique's output's negative pixels before [`non_negative`].
+    pub negative_indirect: Negatives,
 }
 
-/// Sets negative irradiance to 0 and returns how many pixels had some. A technique that adds and
+/// What [`non_negative`] found below zero.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Negatives {
+    /// Pixels with a negative channel.
+    pub pixels: usize,
+    /// Of those, the pixels whose RGB sum lies below −1 % of the image's mean RGB sum. Half
+    /// floats keep 11 significant bits (rounding ≤ 2⁻¹¹ ≈ 0.05 % of a value), so estimates
+    /// that cancel to about zero leave less than that unless they are 20 times the mean: a
+    /// pixel beyond it is the technique's estimates disagreeing, not rounding.
+    pub beyond_rounding: usize,
+    /// The lowest RGB sum relative to the image's mean (−1.0: minus the mean).
+    pub lowest: f32,
+}
+
+/// Sets negative irradiance to 0 and says what was negative. A technique that adds and
 /// subtracts estimates (`barczak`'s interpolated light map minus its occluded lights' exact
-/// contributions) can undershoot where the two disagree; no irradiance is negative, the compose
-/// pass clamps the same way, and the run warns with the count. NaN is left for its own warning.
-pub fn non_negative(img: &mut [[f32; 3]]) -> usize {
-    let mut n = 0;
+/// contributions, in half floats) undershoots by rounding where they cancel to about zero and
+/// further where the two disagree; no irradiance is negative, the compose pass clamps the same
+/// way, and the run warns with the counts. NaN is left for its own warning.
+pub fn non_negative(img: &mut [[f32; 3]]) -> Negatives {
+    let sum = |p: &[f32; 3]| p.iter().sum::<f32>();
+    let mean = img.iter().map(|p| sum(p) as f64).sum::<f64>() / img.len().max(1) as f64;
+    let mut found = Negatives::default();
     for p in img.iter_mut() {
         if p.iter().any(|c| *c < 0.0) {
-            n += 1;
+            let relative = (sum(p) as f64 / mean) as f32;
+            found.pixels += 1;
+            found.beyond_rounding += usize::from(relative < -0.01);
+            found.lowest = found.lowest.min(relative);
             for c in p.iter_mut() {
                 *c = c.max(0.0);
             }
         }
     }
-    n
+    found
+}
+
+/// A memory figure of this process from `/proc/self/status` (`VmRSS`: resident now; `VmHWM`:
+/// the peak resident set so far), in MB; `None` where there is no such file (not Linux).
+pub fn process_memory_mb(field: &str) -> Option<f64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| {
+        l.strip_prefix(field)
+            .is_some_and(|rest| rest.starts_with(':'))
+    })?;
+    let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb / 1024.0)
 }
 
 /// Largest finite half float: the irradiance buffers (Rgba16Float) clamp above it.
@@ -223,11 +255,14 @@ impl FrameImages {
     /// either.
     pub fn saturation_warnings(&self) -> Vec<String> {
         let mut out = Vec::new();
-        if self.negative_indirect > 0 {
+        let neg = self.negative_indirect;
+        if neg.pixels > 0 {
             out.push(format!(
-                "indirect irradiance was negative in {} of {} pixels of the last frame (the technique's estimates undershoot there); set to 0 in the images and the error metrics",
-                self.negative_indirect,
-                self.indirect.len()
+                "indirect irradiance was negative in {} of {} pixels of the last frame, {} of them below -1 % of the image's mean (the lowest {:.1} % of it): the technique's estimates undershoot there (within 1 %: half-float rounding where estimates cancel to about zero); set to 0 in the images and the error metrics",
+                neg.pixels,
+                self.indirect.len(),
+                neg.beyond_rounding,
+                100.0 * neg.lowest
             ));
         }
         for (what, img) in [("indirect", &self.indirect), ("direct", &self.direct)] {
@@ -522,6 +557,7 @@ impl<'a> Harness<'a> {
             images: Vec::new(),
             warnings: Vec::new(),
             calibration_ms: Some(calibration),
+            peak_memory_mb: process_memory_mb("VmHWM"),
         };
         let images = images.expect("at least one timing pass");
         let mut result = result;
@@ -586,8 +622,11 @@ impl<'a> Harness<'a> {
         )
     }
 
-    /// The technique's irradiance, made [`non_negative`], and how many pixels were negative.
-    fn read_technique_output(&self, technique: &dyn Technique) -> Result<(Vec<[f32; 3]>, usize)> {
+    /// The technique's irradiance, made [`non_negative`], and what was negative.
+    fn read_technique_output(
+        &self,
+        technique: &dyn Technique,
+    ) -> Result<(Vec<[f32; 3]>, Negatives)> {
         let tex = technique.output().texture();
         let mut img = crate::image_io::read_rgb_f32(self.gpu, tex)?;
         let negative = non_negative(&mut img);
@@ -628,5 +667,54 @@ pub fn git_commit() -> String {
         format!("{commit}-dirty")
     } else {
         commit
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn negatives_are_told_apart_from_rounding() {
+        // Mean RGB sum: (3 + 3 + 3 - 0.003 - 0.6) / 5 = 1.6794.
+        let mut img = vec![
+            [1.0, 1.0, 1.0],
+            [1.0, 1.0, 1.0],
+            [1.0, 1.0, 1.0],
+            [-0.001, -0.001, -0.001],
+            [0.2, -0.4, -0.4],
+        ];
+        let n = non_negative(&mut img);
+        assert_eq!(n.pixels, 2);
+        // -0.003 is 0.18 % of the mean (rounding); -0.6 is 36 %.
+        assert_eq!(n.beyond_rounding, 1);
+        assert!((n.lowest - (-0.6 / 1.6794)).abs() < 1e-4, "{}", n.lowest);
+        assert_eq!(img[3], [0.0; 3]);
+        assert_eq!(img[4], [0.2, 0.0, 0.0]);
+        assert_eq!(non_negative(&mut img), Negatives::default());
+    }
+
+    #[test]
+    #[cfg(target_os = "linux")]
+    fn the_peak_resident_set_is_read_and_grows_with_use() {
+        // Resident first: the peak read after it is at least that (other threads may allocate).
+        let now = process_memory_mb("VmRSS").expect("VmRSS on Linux");
+        let peak = process_memory_mb("VmHWM").expect("VmHWM on Linux");
+        assert!(
+            now > 1.0 && peak >= now,
+            "peak {peak} MB, resident {now} MB"
+        );
+        // 64 MB touched page by page raises the peak by about that much.
+        let mut block = vec![0u8; 64 << 20];
+        for i in (0..block.len()).step_by(4096) {
+            block[i] = 1;
+        }
+        let after = process_memory_mb("VmHWM").unwrap();
+        assert!(
+            after - now >= 60.0,
+            "peak {after} MB after touching 64 MB at {now} MB"
+        );
+        std::hint::black_box(&block);
+        assert_eq!(process_memory_mb("NoSuchField"), None);
     }
 }
