@@ -201,12 +201,13 @@ pub struct FrameImages {
 pub struct Negatives {
     /// Pixels with a negative channel.
     pub pixels: usize,
-    /// Of those, the pixels whose RGB sum lies below −1 % of the image's mean RGB sum. Half
-    /// floats keep 11 significant bits (rounding ≤ 2⁻¹¹ ≈ 0.05 % of a value), so estimates
-    /// that cancel to about zero leave less than that unless they are 20 times the mean: a
-    /// pixel beyond it is the technique's estimates disagreeing, not rounding.
+    /// Of those, the pixels whose negative part (the sum of their negative channels, what is
+    /// set to 0) lies below −1 % of the image's mean RGB sum. Half floats keep 11 significant
+    /// bits (rounding ≤ 2⁻¹¹ ≈ 0.05 % of a value), so estimates that cancel to about zero
+    /// leave less than that unless they are 20 times the mean: a pixel beyond it is the
+    /// technique's estimates disagreeing, not rounding.
     pub beyond_rounding: usize,
-    /// The lowest RGB sum relative to the image's mean (−1.0: minus the mean).
+    /// The lowest negative part relative to the image's mean RGB sum (−1.0: minus the mean).
     pub lowest: f32,
 }
 
@@ -216,12 +217,12 @@ pub struct Negatives {
 /// further where the two disagree; no irradiance is negative, the compose pass clamps the same
 /// way, and the run warns with the counts. NaN is left for its own warning.
 pub fn non_negative(img: &mut [[f32; 3]]) -> Negatives {
-    let sum = |p: &[f32; 3]| p.iter().sum::<f32>();
-    let mean = img.iter().map(|p| sum(p) as f64).sum::<f64>() / img.len().max(1) as f64;
+    let mean = img.iter().flatten().map(|c| *c as f64).sum::<f64>() / img.len().max(1) as f64;
     let mut found = Negatives::default();
     for p in img.iter_mut() {
         if p.iter().any(|c| *c < 0.0) {
-            let relative = (sum(p) as f64 / mean) as f32;
+            let negative: f32 = p.iter().map(|c| c.min(0.0)).sum();
+            let relative = (negative as f64 / mean) as f32;
             found.pixels += 1;
             found.beyond_rounding += usize::from(relative < -0.01);
             found.lowest = found.lowest.min(relative);
@@ -686,9 +687,10 @@ mod tests {
         ];
         let n = non_negative(&mut img);
         assert_eq!(n.pixels, 2);
-        // -0.003 is 0.18 % of the mean (rounding); -0.6 is 36 %.
+        // -0.003 is 0.18 % of the mean (rounding); the last pixel's negative part, -0.8, is
+        // 48 % (its sum, -0.6, would hide part of it).
         assert_eq!(n.beyond_rounding, 1);
-        assert!((n.lowest - (-0.6 / 1.6794)).abs() < 1e-4, "{}", n.lowest);
+        assert!((n.lowest - (-0.8 / 1.6794)).abs() < 1e-4, "{}", n.lowest);
         assert_eq!(img[3], [0.0; 3]);
         assert_eq!(img[4], [0.2, 0.0, 0.0]);
         assert_eq!(non_negative(&mut img), Negatives::default());
