@@ -56,7 +56,8 @@
 //! pass planning), `shadow-maps`, `light-maps`, `edges`, `low-res`, `lights`, `prt-lighting`
 //! (CPU), `prt`; counters `vpls`, `maps-rendered`, `map-faces` (octahedral faces drawn into:
 //! `face-cull=on` skips those without occluders), `light-draws`, `elements`,
-//! `light-map-changes`.
+//! `light-map-changes`, and the database's size: `patches` (the scene's recorded patches or
+//! generated charts) and `leaves` (their light-mapped sub-patches).
 
 pub mod blocker_index;
 pub mod database;
@@ -364,6 +365,9 @@ impl Technique for Barczak {
         ctx.profiler.count("elements", counts.elements as f64);
         ctx.profiler
             .count("light-map-changes", counts.light_map_changes as f64);
+        let (patches, leaves) = r.scene().patches_and_leaves();
+        ctx.profiler.count("patches", patches as f64);
+        ctx.profiler.count("leaves", leaves as f64);
         Ok(())
     }
 

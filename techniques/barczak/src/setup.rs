@@ -56,6 +56,17 @@ pub struct BarczakScene {
     pub first_mover_object: u32,
 }
 
+impl BarczakScene {
+    /// The patch receivers (recorded patches or generated charts) and their leaves.
+    pub fn patches_and_leaves(&self) -> (usize, usize) {
+        let trees = self.db.receivers.iter().filter_map(|r| match &r.shape {
+            ReceiverShape::Patch(t) => Some(t),
+            ReceiverShape::Object { .. } => None,
+        });
+        trees.fold((0, 0), |(p, l), t| (p + 1, l + t.leaves().count()))
+    }
+}
+
 /// Subdivision levels at most of the chart patches of a scene that records none.
 pub const CHART_LEVELS: u32 = 2;
 /// Charts a scene without recorded patches may make by default (the `max-charts` parameter):

@@ -5,7 +5,7 @@
 use gibench_barczak::database::ReceiverShape;
 use gibench_barczak::lightmap::{contribution, texel_position};
 use gibench_barczak::samples::SampleSettings;
-use gibench_barczak::setup::{prepare, MAX_CHARTS};
+use gibench_barczak::setup::{prepare, CHART_LEVELS, MAX_CHARTS};
 use gibench_barczak::visibility::LightState;
 use gibench_harness::anim::FrameClock;
 use gibench_harness::assets::AssetPaths;
@@ -46,6 +46,11 @@ fn light_maps_agree_with_ray_casts(name: &str, direct: u32) {
     )
     .unwrap();
     assert_eq!(bz.db.lights.len(), 64);
+    // The database's size as a run reports it (counters `patches` and `leaves`): every
+    // receiver patch once, and the 4^levels leaves of its quadtree.
+    let expected = scene.receiver_patches(CHART_LEVELS, MAX_CHARTS).unwrap();
+    let leaves: usize = expected.iter().map(|p| 4usize.pow(p.levels)).sum();
+    assert_eq!(bz.patches_and_leaves(), (expected.len(), leaves));
     // The real occluders: the static mesh and the torus where frame 0 puts it.
     let mut world = scene.mesh.clone();
     for (k, mover) in scene.movers.iter().enumerate() {
