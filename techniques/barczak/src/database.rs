@@ -86,8 +86,35 @@ impl Receiver {
 #[derive(Clone, Debug, PartialEq, Default)]
 pub struct NodeEntry {
     pub state: Option<LightState>,
-    /// Blockers reaching in, by blocker index, ascending.
+    /// Blockers reaching in, by blocker index, ascending: every one, or after
+    /// [`VisibilityDatabase::keep_movers_only`] only the movable objects'.
     pub blockers: Vec<(u32, Occlusion)>,
+    /// The strongest occlusion among the blockers no longer listed (the static ones).
+    pub fixed: Option<Occlusion>,
+}
+
+impl NodeEntry {
+    /// The light's state over the node, from the blockers listed and the fixed ones.
+    fn state_in(&self, reach: &Reach) -> LightState {
+        match (reach.state(&self.blockers), self.fixed) {
+            (LightState::Behind, _) => LightState::Behind,
+            (_, Some(Occlusion::Full)) => LightState::Blocked,
+            (LightState::Unblocked, Some(Occlusion::Partial)) => LightState::Partial,
+            (state, _) => state,
+        }
+    }
+
+    /// Folds the blockers whose objects are not `movable` into [`NodeEntry::fixed`].
+    fn keep_only(&mut self, blockers: &[Blocker], movable: &[u32]) {
+        let moves = |b: u32| movable.binary_search(&blockers[b as usize].object).is_ok();
+        for &(b, o) in &self.blockers {
+            if !moves(b) && self.fixed != Some(Occlusion::Full) {
+                self.fixed = Some(o);
+            }
+        }
+        self.blockers.retain(|&(b, _)| moves(b));
+        self.blockers.shrink_to_fit();
+    }
 }
 
 /// A light added to or removed from a leaf's light map.
@@ -120,6 +147,8 @@ pub struct VisibilityDatabase {
     entries: Vec<Vec<Vec<NodeEntry>>>,
     /// The blockers' boxes, to test a root pyramid only against those that may reach in.
     index: BlockerIndex,
+    /// After [`VisibilityDatabase::keep_movers_only`]: the objects that may move, ascending.
+    movable: Option<Vec<u32>>,
 }
 
 /// Whether a light lights a node in this state (it belongs in the light map).
@@ -213,7 +242,7 @@ impl Shared<'_> {
             entry.blockers.retain(|(b, _)| !revisited(b));
             entry.blockers.extend(fresh);
             entry.blockers.sort_unstable_by_key(|(b, _)| *b);
-            entry.state = Some(reach.state(&entry.blockers));
+            entry.state = Some(entry.state_in(&reach));
         }
         if descend {
             if let Some(children) = receiver.children(n) {
@@ -237,6 +266,29 @@ impl VisibilityDatabase {
         receivers: Vec<Receiver>,
         blockers: Vec<Blocker>,
     ) -> (VisibilityDatabase, usize) {
+        Self::build_with(lights, receivers, blockers, None)
+    }
+
+    /// [`VisibilityDatabase::build`] followed by [`VisibilityDatabase::keep_movers_only`], each
+    /// receiver's lists folded as soon as they are computed (the full lists of every receiver
+    /// are never held at once).
+    pub fn build_keeping_movers(
+        lights: Vec<PointLight>,
+        receivers: Vec<Receiver>,
+        blockers: Vec<Blocker>,
+        movable: &[u32],
+    ) -> (VisibilityDatabase, usize) {
+        let mut movable = movable.to_vec();
+        movable.sort_unstable();
+        Self::build_with(lights, receivers, blockers, Some(movable))
+    }
+
+    fn build_with(
+        lights: Vec<PointLight>,
+        receivers: Vec<Receiver>,
+        blockers: Vec<Blocker>,
+        movable: Option<Vec<u32>>,
+    ) -> (VisibilityDatabase, usize) {
         let mut db = VisibilityDatabase {
             entries: receivers
                 .iter()
@@ -246,6 +298,7 @@ impl VisibilityDatabase {
             lights,
             receivers,
             blockers,
+            movable,
         };
         // Receivers are independent: computed in parallel, the same as one after another.
         let scene = Shared {
@@ -253,11 +306,37 @@ impl VisibilityDatabase {
             blockers: &db.blockers,
             index: &db.index,
         };
+        let movable = db.movable.as_deref();
         let tests = (db.receivers.par_iter())
             .zip(db.entries.par_iter_mut())
-            .map(|(receiver, entries)| scene.recompute(receiver, entries))
+            .map(|(receiver, entries)| {
+                let tests = scene.recompute(receiver, entries);
+                if let Some(movable) = movable {
+                    for entry in entries.iter_mut().flatten() {
+                        entry.keep_only(scene.blockers, movable);
+                    }
+                }
+                tests
+            })
             .sum();
         (db, tests)
+    }
+
+    /// Keeps in each entry's list only the blockers of the objects that may move (`movable`),
+    /// the others folded into [`NodeEntry::fixed`]: static blockers never change, so only the
+    /// movers' lists are read again ([`VisibilityDatabase::move_object`] revisits the mover's
+    /// blockers only). The states are unchanged; memory falls to the movers' share (none on a
+    /// scene without movers). Only the objects named here may move afterwards.
+    pub fn keep_movers_only(&mut self, movable: &[u32]) {
+        let mut movable = movable.to_vec();
+        movable.sort_unstable();
+        let blockers = &self.blockers;
+        self.entries.par_iter_mut().for_each(|receiver| {
+            for entry in receiver.iter_mut().flatten() {
+                entry.keep_only(blockers, &movable);
+            }
+        });
+        self.movable = Some(movable);
     }
 
     /// The entry of `node` of `receiver` for `light`.
@@ -280,6 +359,12 @@ impl VisibilityDatabase {
     /// Moves `object` (its blockers and receivers) by the rigid map `to` and updates the
     /// database (see the module docs).
     pub fn move_object(&mut self, object: u32, to: impl Fn(Vec3) -> Vec3) -> Update {
+        if let Some(movable) = &self.movable {
+            assert!(
+                movable.binary_search(&object).is_ok(),
+                "object {object} was not named movable when the database kept movers only"
+            );
+        }
         let leaf_states = |db: &VisibilityDatabase| -> Vec<(u32, u32, u32, bool)> {
             let mut v = Vec::new();
             for (r, rec) in db.receivers.iter().enumerate() {
@@ -330,6 +415,11 @@ impl VisibilityDatabase {
             if receiver.object == object {
                 // Moved: every node against every blocker (its reach moved).
                 tests += scene.recompute(receiver, entries);
+                if let Some(movable) = &self.movable {
+                    for entry in entries.iter_mut().flatten() {
+                        entry.keep_only(&self.blockers, movable);
+                    }
+                }
             } else {
                 for l in 0..self.lights.len() {
                     tests += scene.visit(receiver, entries, l, 0, None, &moved, false);

@@ -152,7 +152,13 @@ pub fn prepare(
         });
         movers.push(bounds);
     }
-    let (db, _) = VisibilityDatabase::build(lights, receivers, blockers);
+    // Only the movers' blockers are listed per entry (the static ones folded into a summary):
+    // what a motion revisits, and a fraction of the memory on a scene of tens of thousands of
+    // charts.
+    let movable: Vec<u32> = (0..scene.movers.len() as u32)
+        .map(|k| first_mover_object + k)
+        .collect();
+    let (db, _) = VisibilityDatabase::build_keeping_movers(lights, receivers, blockers, &movable);
     let light_maps = LightMaps::bake(&db, &flux, light_map_res);
     Ok(BarczakScene {
         samples,

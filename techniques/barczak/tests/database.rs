@@ -33,8 +33,40 @@ fn leaf_lit(db: &VisibilityDatabase) -> Vec<bool> {
 
 #[test]
 fn mover_updates_equal_a_full_recomputation() {
+    updates_equal_rebuilds(false);
+}
+
+/// The same with the static blockers folded away (`keep_movers_only` on the first database;
+/// `build_keeping_movers`, what `setup::prepare` uses, for each rebuild): the updated entries
+/// equal the folded rebuild's, and every state equals the unfolded rebuild's.
+#[test]
+fn updates_keeping_movers_only_equal_a_full_recomputation() {
+    updates_equal_rebuilds(true);
+}
+
+fn updates_equal_rebuilds(keep_movers_only: bool) {
+    const MOVERS: [u32; 2] = [7, 8];
     let (receivers, blockers) = room();
     let (mut db, _) = VisibilityDatabase::build(lights(), receivers, blockers);
+    if keep_movers_only {
+        // (all listed, the movers' listed)
+        let listed = |db: &VisibilityDatabase| -> (usize, usize) {
+            let all = db
+                .entries()
+                .iter()
+                .flatten()
+                .flatten()
+                .flat_map(|e| &e.blockers);
+            all.fold((0, 0), |(n, m), (b, _)| {
+                let mover = MOVERS.contains(&db.blockers[*b as usize].object);
+                (n + 1, m + usize::from(mover))
+            })
+        };
+        let (all, movers) = listed(&db);
+        db.keep_movers_only(&MOVERS);
+        assert!(movers < all, "the room has static blockers");
+        assert_eq!(listed(&db), (movers, movers));
+    }
     let (mut incremental, mut rebuilt, mut changes, mut maps) = (0, 0, 0, 0);
     for step in 1..=24 {
         // The box slides across the floor under the table; the sphere circles and rises.
@@ -48,8 +80,31 @@ fn mover_updates_equal_a_full_recomputation() {
                 centre + turn * (p - centre) + Vec3::new(0.0, 0.04, 0.0)
             })
         };
-        let (fresh, tests) =
+        let (mut fresh, tests) =
             VisibilityDatabase::build(db.lights.clone(), db.receivers.clone(), db.blockers.clone());
+        if keep_movers_only {
+            assert_eq!(leaf_lit(&db), leaf_lit(&fresh), "step {step}");
+            let states = |db: &VisibilityDatabase| -> Vec<Option<LightState>> {
+                db.entries()
+                    .iter()
+                    .flatten()
+                    .flatten()
+                    .map(|e| e.state)
+                    .collect()
+            };
+            let unfolded = states(&fresh);
+            (fresh, _) = VisibilityDatabase::build_keeping_movers(
+                db.lights.clone(),
+                db.receivers.clone(),
+                db.blockers.clone(),
+                &MOVERS,
+            );
+            assert_eq!(
+                states(&fresh),
+                unfolded,
+                "step {step}: folding changed a state"
+            );
+        }
         if db.entries() != fresh.entries() {
             for (r, (a, b)) in db.entries().iter().zip(fresh.entries()).enumerate() {
                 for (n, (x, y)) in a.iter().zip(b).enumerate() {
