@@ -1,7 +1,8 @@
 //! Bad input gets a clear error, a non-zero exit and no results file.
 
+mod support;
+
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -12,7 +13,7 @@ fn root() -> PathBuf {
 fn fails(args: &[&str], expect: &str) {
     let tmp = tempfile::tempdir().unwrap();
     let out = tmp.path().join("out");
-    let o = Command::new(env!("CARGO_BIN_EXE_gibench"))
+    let o = support::gibench()
         .arg("run")
         .args(args)
         .arg("--out")
@@ -60,7 +61,7 @@ fn one_direct_frame(
     scene: Option<&Path>,
     out: impl AsRef<std::ffi::OsStr>,
 ) -> std::process::Output {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_gibench"));
+    let mut c = support::gibench();
     c.args([
         "run",
         "--technique",
@@ -160,7 +161,7 @@ fn bad_resolutions() {
 #[test]
 fn zero_frames() {
     let tmp = tempfile::tempdir().unwrap();
-    let o = Command::new(env!("CARGO_BIN_EXE_gibench"))
+    let o = support::gibench()
         .args(["run", "--frames", "0", "--quiet", "--out"])
         .arg(tmp.path().join("out"))
         .output()
@@ -218,7 +219,7 @@ fn overflow_names_duplicates_and_assets() {
     let file = tmp.path().join("not-a-folder");
     std::fs::write(&file, b"x").unwrap();
     fails(&["--assets", file.to_str().unwrap()], "not a folder");
-    let o = Command::new(env!("CARGO_BIN_EXE_gibench"))
+    let o = support::gibench()
         .args([
             "sweep",
             "--technique",
@@ -234,7 +235,7 @@ fn overflow_names_duplicates_and_assets() {
         .unwrap();
     assert!(!o.status.success());
     assert!(String::from_utf8_lossy(&o.stderr).contains("listed twice"));
-    let o = Command::new(env!("CARGO_BIN_EXE_gibench"))
+    let o = support::gibench()
         .args(["reproduce", "laine-dispersion", "--frames", "0"])
         .arg("--out")
         .arg(tmp.path().join("repro"))
@@ -251,7 +252,7 @@ fn unwritable_output_folder() {
     let tmp = tempfile::tempdir().unwrap();
     let file = tmp.path().join("a-file");
     std::fs::write(&file, b"not a folder").unwrap();
-    let o = Command::new(env!("CARGO_BIN_EXE_gibench"))
+    let o = support::gibench()
         .args(["run", "--frames", "2", "--quiet", "--out"])
         .arg(file.join("sub"))
         .output()
@@ -429,7 +430,7 @@ fn half_float_saturation_is_reported() {
 #[test]
 fn dispersion_needs_two_frames() {
     let tmp = tempfile::tempdir().unwrap();
-    let o = Command::new(env!("CARGO_BIN_EXE_gibench"))
+    let o = support::gibench()
         .args(["reproduce", "laine-dispersion", "--frames", "1", "--out"])
         .arg(tmp.path().join("d"))
         .output()
@@ -453,7 +454,7 @@ fn dispersion_needs_two_frames() {
 fn device_limits_are_checked_before_any_frame() {
     let tmp = tempfile::tempdir().unwrap();
     let start = std::time::Instant::now();
-    let o = Command::new(env!("CARGO_BIN_EXE_gibench"))
+    let o = support::gibench()
         .args([
             "run",
             "--technique",
@@ -520,7 +521,7 @@ fn hostile_review_cases() {
     fails(&["--scene", d.to_str().unwrap()], "mover 'big'");
     let file = tmp.path().join("cache-file");
     std::fs::write(&file, b"x").unwrap();
-    let o = Command::new(env!("CARGO_BIN_EXE_gibench"))
+    let o = support::gibench()
         .args([
             "reference",
             "--resolution",
@@ -558,7 +559,7 @@ fn out_with_a_dot_and_a_bad_stem() {
     let o = one_direct_frame("32x24", None, tmp.path().join("new/."));
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(tmp.path().join("new/cornell-direct.json").exists());
-    let o = Command::new(env!("CARGO_BIN_EXE_gibench"))
+    let o = support::gibench()
         .arg("report")
         .arg(tmp.path().join("new"))
         .args(["--stem", "../x", "--out"])
@@ -579,7 +580,7 @@ fn out_with_a_dot_and_a_bad_stem() {
 fn a_failed_run_leaves_no_new_folder() {
     let tmp = tempfile::tempdir().unwrap();
     let out = tmp.path().join("a/b");
-    let o = Command::new(env!("CARGO_BIN_EXE_gibench"))
+    let o = support::gibench()
         .args(["run", "--technique", "laine", "--frames", "1", "--quiet"])
         .args([
             "--param",
@@ -598,7 +599,7 @@ fn a_failed_run_leaves_no_new_folder() {
 /// Runs `gibench ARGS` in folder `dir` with `env` set, expects failure whose stderr contains
 /// every string of `expect` and no panic, and returns the stderr.
 fn command_fails(dir: &Path, env: &[(&str, &str)], args: &[&str], expect: &[&str]) -> String {
-    let o = Command::new(env!("CARGO_BIN_EXE_gibench"))
+    let o = support::gibench()
         .current_dir(dir)
         .env_remove("GIBENCH_BACKEND")
         .envs(env.iter().copied())
@@ -824,7 +825,7 @@ fn plot_quality_inputs_out_and_metrics() {
         &["plot-quality", "r1", "--metric", "nope"],
         &["parameter 'metric'"],
     );
-    let help = Command::new(env!("CARGO_BIN_EXE_gibench"))
+    let help = support::gibench()
         .args(["plot-quality", "--help"])
         .output()
         .unwrap();
@@ -983,7 +984,7 @@ fn quality_options_need_quality_and_reference_sizes_have_limits() {
 fn files_named_like_journal_directives_are_published() {
     let tmp = tempfile::tempdir().unwrap();
     copy_baseline(tmp.path());
-    let o = Command::new(env!("CARGO_BIN_EXE_gibench"))
+    let o = support::gibench()
         .current_dir(tmp.path())
         .args(["report", "r1", "--stem", "replaced", "--out", "o"])
         .output()

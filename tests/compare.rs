@@ -11,8 +11,9 @@
 //! impossible calibration, a negative time, an unknown stage kind, truncated, a newer schema)
 //! says which, and fails when that file's run is in no other file of the side.
 
+mod support;
+
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 use serde_json::Value;
 
@@ -58,7 +59,7 @@ fn synthetic(dir: &Path, repeats: &[f64], factor: impl Fn(&str) -> f64, calibrat
 /// `gibench compare BASE CURRENT`: success, the rows' (stage, verdict) pairs, stderr.
 fn compare(dir: &Path, base: &str, current: &str) -> (bool, Vec<(String, String)>, String) {
     let out = dir.join(format!("cmp-{base}-{current}"));
-    let o = Command::new(env!("CARGO_BIN_EXE_gibench"))
+    let o = support::gibench()
         .arg("compare")
         .arg(dir.join(base))
         .arg(dir.join(current))
@@ -240,7 +241,7 @@ fn compare_runs_end_to_end() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path();
     let run_into = |out: &Path, slow: bool| {
-        let mut c = Command::new(env!("CARGO_BIN_EXE_gibench"));
+        let mut c = support::gibench();
         c.args(["run", "--technique", "direct", "--frames", "10"])
             .args([
                 "--warmup",

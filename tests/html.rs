@@ -5,21 +5,12 @@
 //! it these tests fail and say so, unless `GIBENCH_NO_BROWSER=1` asks to skip them knowingly.
 //! A screenshot of the run page is kept in the target folder (`html-report/screenshot.png`).
 
+mod support;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-fn gibench(args: &[&str]) -> std::process::Output {
-    let o = Command::new(env!("CARGO_BIN_EXE_gibench"))
-        .args(args)
-        .output()
-        .unwrap();
-    assert!(
-        o.status.success(),
-        "gibench {args:?}: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    o
-}
+use support::run_ok as gibench;
 
 /// The Chromium binary (`GIBENCH_CHROMIUM`, else `chromium` or `chromium-browser` on PATH);
 /// `None` only when the user skips browser checks with `GIBENCH_NO_BROWSER=1`.

@@ -4,12 +4,14 @@
 //! only it. Needs valgrind; without it the test says so on standard error and checks nothing
 //! else.
 
+mod support;
+
 use std::process::Command;
 
 const KERNELS: &str = "domain-delete-insert-disc-256,bvh-shadow-cornell";
 
 fn gate(baseline: &std::path::Path, slow: Option<&str>, write: bool) -> (bool, String) {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_gibench"));
+    let mut c = support::gibench();
     c.args(["instructions", "--kernels", KERNELS, "--baseline"])
         .arg(baseline);
     if write {

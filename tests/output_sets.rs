@@ -3,13 +3,15 @@
 //! (staging folder, lock, temporary cache files), and a second command into a folder in use is
 //! refused.
 
+mod support;
+
 use std::collections::BTreeMap;
 use std::path::Path;
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
 fn gibench() -> Command {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_gibench"));
+    let mut c = support::gibench();
     c.stdout(Stdio::null()).stderr(Stdio::piped());
     c
 }

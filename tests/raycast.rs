@@ -2,23 +2,14 @@
 //! (shadow rays end at the light, closest-hit rays are unit directions from the same origins),
 //! raycast's answers are consistent with the files, and bad ray folders are refused by name.
 
-use std::path::Path;
-use std::process::{Command, Output};
+mod support;
 
-fn gibench(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_gibench"))
-        .args(args)
-        .output()
-        .unwrap()
-}
+use std::path::Path;
+
+use support::run as gibench;
 
 fn ok(args: &[&str]) {
-    let o = gibench(args);
-    assert!(
-        o.status.success(),
-        "{args:?} failed: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
+    support::run_ok(args);
 }
 
 /// Seven little-endian f32 per ray.

@@ -6,8 +6,9 @@
 //! copied in. A README example that names a removed option, a scene that is gone or a
 //! technique that dies on a scene fails here.
 
+mod support;
+
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -71,7 +72,7 @@ fn shrunk(words: &[String]) -> Vec<String> {
 }
 
 fn gibench(dir: &Path, args: &[String]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_gibench"))
+    support::gibench()
         .args(args)
         // The scenes are found from the workspace root compiled in, wherever the command runs.
         .current_dir(dir)

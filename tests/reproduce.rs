@@ -2,10 +2,10 @@
 //! paper's figures beside ours, and its numbers say what the paper's say where a CPU adapter
 //! must agree (a small run: Cornell only, a few frames).
 
-use std::process::Command;
+mod support;
 
 fn reproduce(target: &str, out: &std::path::Path) {
-    let o = Command::new(env!("CARGO_BIN_EXE_gibench"))
+    let o = support::gibench()
         .args([
             "reproduce",
             target,
@@ -256,7 +256,7 @@ fn ism_breakdown_has_the_stages_the_published_figures_and_the_ratios() {
 #[test]
 fn gaitatzes_table1_has_the_papers_rows_and_the_scaling_figure() {
     let tmp = tempfile::tempdir().unwrap();
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_gibench"))
+    let o = support::gibench()
         .args([
             "reproduce",
             "gaitatzes-table1",
@@ -343,7 +343,7 @@ fn gibench_row(csv: &std::path::Path) -> std::collections::HashMap<String, f64> 
 }
 
 fn gibench(args: &[&str], out: &std::path::Path) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_gibench"))
+    support::gibench()
         .args(args)
         .arg("--out")
         .arg(out)
@@ -353,7 +353,7 @@ fn gibench(args: &[&str], out: &std::path::Path) -> std::process::Output {
 
 /// [`gibench`] run from `dir`, where no committed `results/reproduce-all.json` is found.
 fn gibench_in(dir: &std::path::Path, args: &[&str], out: &std::path::Path) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_gibench"))
+    support::gibench()
         .current_dir(dir)
         .args(args)
         .arg("--out")
@@ -508,7 +508,7 @@ fn reproduce_all_refuses_bad_input_before_any_work() {
 #[test]
 fn barczak2006_writes_five_figures_and_their_tables() {
     let tmp = tempfile::tempdir().unwrap();
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_gibench"))
+    let o = support::gibench()
         .args([
             "reproduce",
             "barczak2006",

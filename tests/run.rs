@@ -1,11 +1,11 @@
 //! End to end: `gibench run` writes a complete results file, images and tables.
 
-use std::process::Command;
+mod support;
 
 use gibench_harness::results::RunResult;
 
 fn run_ok(args: &[&str], out: &std::path::Path) -> String {
-    let o = Command::new(env!("CARGO_BIN_EXE_gibench"))
+    let o = support::gibench()
         .arg("run")
         .args(args)
         .arg("--out")
@@ -162,7 +162,7 @@ fn quality_columns_and_results() {
 #[test]
 fn reference_two_seeds_agree_at_default_spp() {
     let tmp = tempfile::tempdir().unwrap();
-    let o = Command::new(env!("CARGO_BIN_EXE_gibench"))
+    let o = support::gibench()
         .args([
             "reference",
             "--scene",
@@ -292,7 +292,7 @@ fn a_run_over_every_technique_skips_one_that_cannot_take_the_scene() {
         "barczak.max-charts=10",
     ];
     let dir = tempfile::tempdir().unwrap();
-    let o = Command::new(env!("CARGO_BIN_EXE_gibench"))
+    let o = support::gibench()
         .arg("run")
         .args(small)
         .arg("--out")
@@ -323,7 +323,7 @@ fn a_run_over_every_technique_skips_one_that_cannot_take_the_scene() {
         "{text}"
     );
     // The folder's results are still read as results (the list is not one).
-    let o = Command::new(env!("CARGO_BIN_EXE_gibench"))
+    let o = support::gibench()
         .arg("report")
         .arg(dir.path())
         .arg("--out")
@@ -332,7 +332,7 @@ fn a_run_over_every_technique_skips_one_that_cannot_take_the_scene() {
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let named = tempfile::tempdir().unwrap();
-    let o = Command::new(env!("CARGO_BIN_EXE_gibench"))
+    let o = support::gibench()
         .arg("run")
         .args(small)
         .args(["--technique", "barczak", "--out"])
@@ -356,7 +356,7 @@ fn a_run_that_skips_nothing_leaves_no_list_of_skipped_techniques() {
     let dir = tempfile::tempdir().unwrap();
     let stale = dir.path().join("cornell-skipped.json");
     std::fs::write(&stale, r#"{"scene": "cornell", "skipped": []}"#).unwrap();
-    let o = Command::new(env!("CARGO_BIN_EXE_gibench"))
+    let o = support::gibench()
         .arg("run")
         .args(["--resolution", "64x48", "--frames", "1", "--warmup", "0"])
         .args(["--timing", "stages", "--no-images", "--quiet", "--out"])
