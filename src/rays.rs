@@ -50,11 +50,7 @@ struct Ray {
 /// A uniform number in [0, 1) from `k` (SplitMix64's finaliser; the rays need only be fixed
 /// and well spread, not the reference's sampler).
 fn uniform(k: u64) -> f32 {
-    let mut z = k.wrapping_add(0x9e37_79b9_7f4a_7c15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    z ^= z >> 31;
-    (z >> 40) as f32 / (1u64 << 24) as f32
+    gibench_harness::rng::SplitMix64::from_state(k).next_f32()
 }
 
 /// The two ray sets of `count` rays each for `frame` of `scene` seen at `resolution`: the

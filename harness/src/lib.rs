@@ -45,6 +45,7 @@ pub mod quality;
 pub mod reference;
 pub mod report;
 pub mod results;
+pub mod rng;
 pub mod runner;
 pub mod scene;
 pub mod session;

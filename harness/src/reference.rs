@@ -223,35 +223,13 @@ pub fn frame_mesh(scene: &Scene, frame: &FrameState) -> Mesh {
     mesh
 }
 
-/// SplitMix64's output function: a strong 64-bit mix.
-fn mix64(mut z: u64) -> u64 {
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    z ^ (z >> 31)
-}
+/// The reference's generator (also the point pool's, [`crate::ir::points`]).
+pub(crate) type Rng = crate::rng::SplitMix64;
 
-/// SplitMix64: one independent stream per (seed, stream index). Also the point pool's
-/// ([`crate::ir::points`]).
-pub(crate) struct Rng(u64);
-
-impl Rng {
-    const GAMMA: u64 = 0x9e37_79b9_7f4a_7c15;
-    pub(crate) fn new(seed: u64, stream: u64) -> Rng {
-        Rng(mix64(
-            mix64(seed ^ 0x5851_f42d_4c95_7f2d) ^ stream.wrapping_mul(Rng::GAMMA),
-        ))
-    }
-    pub(crate) fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(Rng::GAMMA);
-        mix64(self.0)
-    }
-    /// Uniform in [0, 1).
-    pub(crate) fn next_f32(&mut self) -> f32 {
-        (self.next_u64() >> 40) as f32 * (1.0 / (1u64 << 24) as f32)
-    }
-    fn next_2d(&mut self) -> Vec2 {
-        Vec2::new(self.next_f32(), self.next_f32())
-    }
+/// Two uniform draws in [0, 1)², x first.
+fn next_2d(rng: &mut Rng) -> Vec2 {
+    let x = rng.next_f32();
+    Vec2::new(x, rng.next_f32())
 }
 
 /// Jittered 2D samples for `n` draws: the first ⌊√n⌋ × ⌊n/⌊√n⌋⌋ fill a grid (one per cell),
@@ -270,7 +248,7 @@ impl Stratified {
         }
     }
     fn sample(&self, j: u32, rng: &mut Rng) -> Vec2 {
-        let u = rng.next_2d();
+        let u = next_2d(rng);
         if j < self.nx * self.ny {
             Vec2::new(
                 ((j % self.nx) as f32 + u.x) / self.nx as f32,
@@ -586,7 +564,7 @@ impl<'a> ReferenceTracer<'a> {
                     if k == settings.bounces || beta == Vec3::ZERO {
                         break;
                     }
-                    dir = cosine_direction(hit.shading_normal, rng.next_2d());
+                    dir = cosine_direction(hit.shading_normal, next_2d(&mut rng));
                     if dir.dot(hit.geometric_normal) <= 0.0 {
                         break;
                     }

@@ -317,21 +317,14 @@ mod tests {
     }
     use crate::scene::cornell::{cornell_box, BOX};
 
-    /// A small deterministic generator (xorshift) so the tests need no dependency.
-    struct Rng(u64);
-    impl Rng {
-        fn next(&mut self) -> f32 {
-            self.0 ^= self.0 << 13;
-            self.0 ^= self.0 >> 7;
-            self.0 ^= self.0 << 17;
-            (self.0 >> 40) as f32 / (1u64 << 24) as f32
-        }
-        fn unit_vector(&mut self) -> Vec3 {
-            loop {
-                let v = Vec3::new(self.next(), self.next(), self.next()) * 2.0 - 1.0;
-                if v.length_squared() > 1e-4 && v.length_squared() <= 1.0 {
-                    return v.normalize();
-                }
+    use crate::rng::SplitMix64 as Rng;
+
+    /// A uniform unit vector (rejection from the cube).
+    fn unit_vector(rng: &mut Rng) -> Vec3 {
+        loop {
+            let v = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 2.0 - 1.0;
+            if v.length_squared() > 1e-4 && v.length_squared() <= 1.0 {
+                return v.normalize();
             }
         }
     }
@@ -428,15 +421,15 @@ mod tests {
     fn bvh_matches_brute_force() {
         let (mesh, _) = cornell_box(Some(30.0));
         let bvh = SceneBvh::new(&mesh);
-        let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+        let mut rng = Rng::from_state(0x9e37_79b9_7f4a_7c15);
         let mut hits = 0;
         for _ in 0..1000 {
             let origin = Vec3::new(
-                rng.next() * 556.0,
-                rng.next() * 548.0,
-                rng.next() * 900.0 - 300.0,
+                rng.next_f32() * 556.0,
+                rng.next_f32() * 548.0,
+                rng.next_f32() * 900.0 - 300.0,
             );
-            let dir = rng.unit_vector();
+            let dir = unit_vector(&mut rng);
             let expected = brute_force(&mesh, origin, dir);
             let got = bvh.closest_hit(origin, dir, 0.0, f32::INFINITY);
             match (expected, got) {
@@ -500,7 +493,7 @@ mod tests {
                 dir = [Vec3::X, -Vec3::Y, Vec3::new(-0.0, 0.0, 1.0)][i % 3];
             }
             let (t_min, t_max) = if i % 3 == 0 {
-                (rng.next() * 20.0, 20.0 + rng.next() * 80.0)
+                (rng.next_f32() * 20.0, 20.0 + rng.next_f32() * 80.0)
             } else {
                 (0.0, f32::INFINITY)
             };
@@ -549,12 +542,12 @@ mod tests {
 
     #[test]
     fn tree_matches_brute_force_on_a_triangle_soup() {
-        let mut rng = Rng(0x2545_f491_4f6c_dd1d);
+        let mut rng = Rng::from_state(0x2545_f491_4f6c_dd1d);
         let mut mesh = Mesh::default();
         for i in 0..3000 {
-            let size = [0.3, 3.0, 30.0][i % 3] * rng.next();
-            let c = Vec3::new(rng.next(), rng.next(), rng.next()) * 100.0;
-            let mut corners = [0, 1, 2].map(|_| c + rng.unit_vector() * size);
+            let size = [0.3, 3.0, 30.0][i % 3] * rng.next_f32();
+            let c = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 100.0;
+            let mut corners = [0, 1, 2].map(|_| c + unit_vector(&mut rng) * size);
             if i % 5 == 0 {
                 // Flat in one axis: a box of zero thickness.
                 let axis = i % 3;
@@ -565,8 +558,8 @@ mod tests {
             push_triangle(&mut mesh, corners);
         }
         let hits = check_against_brute_force(&mesh, 4000, &mut rng, |rng| {
-            let origin = Vec3::new(rng.next(), rng.next(), rng.next()) * 120.0 - 10.0;
-            (origin, rng.unit_vector())
+            let origin = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 120.0 - 10.0;
+            (origin, unit_vector(rng))
         });
         assert!(hits > 1500, "{hits}");
     }
@@ -578,25 +571,28 @@ mod tests {
     /// tree misses hits the scalar test finds.
     #[test]
     fn rays_through_corners_and_edges_find_what_brute_force_finds() {
-        let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+        let mut rng = Rng::from_state(0x9e37_79b9_7f4a_7c15);
         let mut mesh = Mesh::default();
         for _ in 0..2000 {
-            let c = Vec3::new(rng.next(), rng.next(), rng.next()) * 100.0;
-            let size = 0.5 + 5.0 * rng.next();
-            push_triangle(&mut mesh, [0, 1, 2].map(|_| c + rng.unit_vector() * size));
+            let c = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 100.0;
+            let size = 0.5 + 5.0 * rng.next_f32();
+            push_triangle(
+                &mut mesh,
+                [0, 1, 2].map(|_| c + unit_vector(&mut rng) * size),
+            );
         }
         let corners: Vec<[Vec3; 3]> = (0..mesh.triangle_count())
             .map(|t| mesh.triangle(t))
             .collect();
         let hits = check_against_brute_force(&mesh, 6000, &mut rng, |rng| {
-            let tri = corners[(rng.next() * corners.len() as f32) as usize % corners.len()];
-            let k = (rng.next() * 3.0) as usize % 3;
-            let target = if rng.next() < 0.5 {
+            let tri = corners[(rng.next_f32() * corners.len() as f32) as usize % corners.len()];
+            let k = (rng.next_f32() * 3.0) as usize % 3;
+            let target = if rng.next_f32() < 0.5 {
                 tri[k]
             } else {
-                tri[k].lerp(tri[(k + 1) % 3], rng.next())
+                tri[k].lerp(tri[(k + 1) % 3], rng.next_f32())
             };
-            let origin = Vec3::new(rng.next(), rng.next(), rng.next()) * 140.0 - 20.0;
+            let origin = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 140.0 - 20.0;
             (origin, (target - origin).normalize())
         });
         assert!(hits > 3000, "{hits}");
@@ -625,9 +621,9 @@ mod tests {
             stack > wide::FIXED_STACK,
             "the tree is not deep: {stack} entries"
         );
-        let mut rng = Rng(7);
+        let mut rng = Rng::from_state(7);
         let hits = check_against_brute_force(&mesh, 600, &mut rng, |rng| {
-            let origin = Vec3::new(-1.0, rng.next() - 0.5, rng.next() - 0.5);
+            let origin = Vec3::new(-1.0, rng.next_f32() - 0.5, rng.next_f32() - 0.5);
             // Along the axis, so that the ray enters every box on the way.
             (origin, Vec3::X)
         });

@@ -333,13 +333,8 @@ mod tests {
     /// in random planes, some bent out of plane).
     #[test]
     fn charts_partition_the_triangles_and_hold_them() {
-        let mut state = 0x9e3779b97f4a7c15u64;
-        let mut rnd = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut rng = crate::rng::SplitMix64::from_state(0x9e3779b97f4a7c15);
+        let mut rnd = move || rng.next_f32();
         for round in 0..20 {
             let mut tris = Vec::new();
             for _ in 0..5 {

@@ -5,20 +5,7 @@ use std::collections::BTreeMap;
 
 use gibench_barczak::passes::{one_per_object, optimise, total_passes, LightSet};
 
-/// SplitMix64.
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    fn below(&mut self, n: u64) -> u64 {
-        self.next() % n
-    }
-}
+use gibench_harness::rng::SplitMix64 as Rng;
 
 /// Objects whose partial lights cluster (neighbouring objects see overlapping ranges of
 /// lights, as walls near the same blockers do), plus random strays.
@@ -59,7 +46,7 @@ fn pairs(elements: &[gibench_barczak::passes::Element]) -> BTreeMap<(u32, u32), 
 
 #[test]
 fn never_more_passes_and_every_pair_exactly_once() {
-    let mut rng = Rng(3);
+    let mut rng = Rng::from_state(3);
     let (mut before_all, mut after_all) = (0, 0);
     for case in 0..150 {
         let objects = 1 + rng.below(40) as usize;
@@ -129,7 +116,7 @@ fn merges_that_save_nothing_are_not_made() {
 #[test]
 fn many_elements_keep_every_pair_once() {
     use gibench_barczak::passes::MAX_GREEDY;
-    let mut rng = Rng(11);
+    let mut rng = Rng::from_state(11);
     let objects = 3 * MAX_GREEDY + 17;
     let mut lights = instance(&mut rng, objects, 64);
     // Many objects with the same few light sets, as neighbouring charts have.

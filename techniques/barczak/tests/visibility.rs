@@ -7,29 +7,18 @@ use gibench_barczak::visibility::{
 };
 use glam::Vec3;
 
-/// A small deterministic generator (SplitMix64).
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f32 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
-    }
-    fn range(&mut self, lo: f32, hi: f32) -> f32 {
-        lo + (hi - lo) * self.next()
-    }
-    fn unit(&mut self) -> Vec3 {
-        loop {
-            let v = Vec3::new(
-                self.range(-1.0, 1.0),
-                self.range(-1.0, 1.0),
-                self.range(-1.0, 1.0),
-            );
-            if v.length_squared() > 0.01 && v.length_squared() <= 1.0 {
-                return v.normalize();
-            }
+use gibench_harness::rng::SplitMix64 as Rng;
+
+/// A uniform unit vector (rejection from the cube, away from its centre).
+fn unit(rng: &mut Rng) -> Vec3 {
+    loop {
+        let v = Vec3::new(
+            rng.range(-1.0, 1.0),
+            rng.range(-1.0, 1.0),
+            rng.range(-1.0, 1.0),
+        );
+        if v.length_squared() > 0.01 && v.length_squared() <= 1.0 {
+            return v.normalize();
         }
     }
 }
@@ -60,7 +49,7 @@ struct Case {
 /// the space between: rectangles, triangles and spheres of other objects, plus the patch's own
 /// polygon (which must never count).
 fn case(rng: &mut Rng) -> Case {
-    let n = rng.unit();
+    let n = unit(rng);
     let c = Vec3::new(
         rng.range(-1.0, 1.0),
         rng.range(-1.0, 1.0),
@@ -74,21 +63,16 @@ fn case(rng: &mut Rng) -> Case {
         rng.range(0.0, 6.3),
     );
     let tree = PatchTree::new(0, corners, n, 2);
-    let light_pos = c + (n + 0.8 * rng.unit()).normalize_or(n) * rng.range(1.0, 5.0);
+    let light_pos = c + (n + 0.8 * unit(rng)).normalize_or(n) * rng.range(1.0, 5.0);
     let light_pos = if n.dot(light_pos - c) < 0.3 {
         c + n * rng.range(1.0, 4.0)
     } else {
         light_pos
     };
-    let normal = match (rng.next() * 3.0) as u32 {
+    let normal = match (rng.next_f32() * 3.0) as u32 {
         0 => None,
         // Mostly facing the patch, sometimes away.
-        _ => Some(
-            (c - light_pos)
-                .normalize()
-                .lerp(rng.unit(), 0.7)
-                .normalize(),
-        ),
+        _ => Some((c - light_pos).normalize().lerp(unit(rng), 0.7).normalize()),
     };
     let mut blockers = vec![Blocker {
         object: 0,
@@ -96,28 +80,22 @@ fn case(rng: &mut Rng) -> Case {
     }];
     for i in 0..rng.range(1.0, 5.0) as u32 {
         let t = rng.range(0.1, 0.9);
-        let at = c.lerp(light_pos, t) + rng.unit() * rng.range(0.0, 2.0);
-        let shape = match (rng.next() * 3.0) as u32 {
+        let at = c.lerp(light_pos, t) + unit(rng) * rng.range(0.0, 2.0);
+        let shape = match (rng.next_f32() * 3.0) as u32 {
             0 => Shape::Sphere {
                 center: at,
                 radius: rng.range(0.05, 0.8),
             },
             1 => {
-                let r = rectangle(
-                    at,
-                    rng.unit(),
-                    rng.range(0.1, 3.0),
-                    rng.range(0.1, 3.0),
-                    0.0,
-                );
+                let r = rectangle(at, unit(rng), rng.range(0.1, 3.0), rng.range(0.1, 3.0), 0.0);
                 Shape::Polygon(r.to_vec())
             }
             _ => {
                 let s = rng.range(0.2, 3.0);
                 Shape::Polygon(vec![
-                    at + rng.unit() * s,
-                    at + rng.unit() * s,
-                    at + rng.unit() * s,
+                    at + unit(rng) * s,
+                    at + unit(rng) * s,
+                    at + unit(rng) * s,
                 ])
             }
         };
@@ -162,7 +140,7 @@ fn blocked(p: Vec3, light: Vec3, blockers: &[Blocker], own: u32) -> bool {
 /// a sliver near the patch's edges, between samples). Every state occurs often enough to matter.
 #[test]
 fn classification_agrees_with_ray_sampling() {
-    let mut rng = Rng(7);
+    let mut rng = Rng::from_state(7);
     let mut count = std::collections::HashMap::new();
     let (mut partial, mut mixed) = (0, 0);
     for k in 0..600 {
@@ -237,7 +215,7 @@ fn classification_agrees_with_ray_sampling() {
 /// leaf against every blocker gives.
 #[test]
 fn hierarchy_equals_testing_every_leaf() {
-    let mut rng = Rng(11);
+    let mut rng = Rng::from_state(11);
     let mut tested_below_root = 0;
     for _ in 0..600 {
         let case = case(&mut rng);
@@ -318,7 +296,7 @@ fn walls_meeting_the_patch_are_not_blockers() {
 /// agrees with segments from the light to points of the sphere.
 #[test]
 fn object_pyramids_hold_the_sphere_and_agree_with_ray_sampling() {
-    let mut rng = Rng(5);
+    let mut rng = Rng::from_state(5);
     let mut count = std::collections::HashMap::new();
     for k in 0..400 {
         let center = Vec3::new(
@@ -327,19 +305,20 @@ fn object_pyramids_hold_the_sphere_and_agree_with_ray_sampling() {
             rng.range(-1.0, 1.0),
         );
         let radius = rng.range(0.2, 1.0);
-        let light = center + rng.unit() * rng.range(radius * 1.5, 6.0);
+        let light = center + unit(&mut rng) * rng.range(radius * 1.5, 6.0);
         let pyramid = Pyramid::to_sphere(light, center, radius).unwrap();
         // Points of the sphere: none is blocked by a polygon the pyramid misses.
         let pts: Vec<Vec3> = (0..200)
-            .map(|_| center + rng.unit() * radius * rng.next().sqrt())
+            .map(|_| center + unit(&mut rng) * radius * rng.next_f32().sqrt())
             .collect();
         for _ in 0..4 {
-            let at = center.lerp(light, rng.range(0.1, 0.95)) + rng.unit() * rng.range(0.0, 1.5);
-            let shape = if rng.next() < 0.5 {
+            let at =
+                center.lerp(light, rng.range(0.1, 0.95)) + unit(&mut rng) * rng.range(0.0, 1.5);
+            let shape = if rng.next_f32() < 0.5 {
                 Shape::Polygon(
                     rectangle(
                         at,
-                        rng.unit(),
+                        unit(&mut rng),
                         rng.range(0.1, 3.0),
                         rng.range(0.1, 3.0),
                         0.0,

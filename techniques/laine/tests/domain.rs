@@ -7,30 +7,8 @@ use glam::{DVec2, DVec3};
 
 const SIZES: [usize; 3] = [16, 256, 1024];
 
-/// SplitMix64: a tiny deterministic generator of uniform doubles in [0, 1).
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^= z >> 31;
-        (z >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
-
-fn radical_inverse(base: u64, mut i: u64) -> f64 {
-    let inv = 1.0 / base as f64;
-    let (mut f, mut r) = (inv, 0.0);
-    while i > 0 {
-        r += (i % base) as f64 * f;
-        i /= base;
-        f *= inv;
-    }
-    r
-}
+use gibench_harness::rng::SplitMix64 as Rng;
+use gibench_harness::vpl::radical_inverse;
 
 /// Uniform disc point from the unit square (polar mapping).
 fn to_disc(u: f64, v: f64) -> DVec3 {
@@ -48,11 +26,11 @@ fn to_sphere(u: f64, v: f64) -> DVec3 {
 }
 
 fn point_set(kind: DomainKind, n: usize, random: bool) -> Vec<DVec3> {
-    let mut rng = Rng(0x1234_5678 + n as u64);
+    let mut rng = Rng::from_state(0x1234_5678 + n as u64);
     (0..n)
         .map(|i| {
             let (u, v) = if random {
-                (rng.next(), rng.next())
+                (rng.next_f64(), rng.next_f64())
             } else {
                 (
                     radical_inverse(2, i as u64 + 1),
@@ -592,26 +570,26 @@ fn lec_cache_equals_the_scan() {
     let runs = (0..400u64).map(|seed| (seed, 20)).chain([(77, 1500)]);
     for ((seed, steps), kind) in runs.flat_map(|r| [(r, DomainKind::Disc), (r, DomainKind::Sphere)])
     {
-        let mut rng = Rng(seed);
+        let mut rng = Rng::from_state(seed);
         let mut d = SamplingDomain::new(kind);
         let mut live: Vec<u64> = Vec::new();
         let mut next = 0u64;
         for step in 0..steps {
-            let r = rng.next();
+            let r = rng.next_f64();
             if r < 0.15 && live.len() > 3 {
-                let k = (rng.next() * live.len() as f64) as usize;
+                let k = (rng.next_f64() * live.len() as f64) as usize;
                 let id = live.swap_remove(k.min(live.len() - 1));
                 d.remove(id);
             } else {
                 let p = if r < 0.6 {
                     d.largest_empty_circle().unwrap().0
                 } else if r < 0.7 && kind == DomainKind::Disc {
-                    let phi = 2.0 * PI * rng.next();
+                    let phi = 2.0 * PI * rng.next_f64();
                     DVec3::new(phi.cos(), phi.sin(), 0.0)
                 } else {
                     match kind {
-                        DomainKind::Disc => to_disc(rng.next(), rng.next()),
-                        DomainKind::Sphere => to_sphere(rng.next(), rng.next()),
+                        DomainKind::Disc => to_disc(rng.next_f64(), rng.next_f64()),
+                        DomainKind::Sphere => to_sphere(rng.next_f64(), rng.next_f64()),
                     }
                 };
                 if d.insert(next, p).is_ok() {
@@ -642,7 +620,7 @@ fn hinted_inserts_build_the_same_triangulation() {
     for kind in [DomainKind::Disc, DomainKind::Sphere] {
         for random in [true, false] {
             let mut pts = point_set(kind, 400, random);
-            let mut rng = Rng(5);
+            let mut rng = Rng::from_state(5);
             // Every third disc point on the rim: outside the hull of the points before it.
             if kind == DomainKind::Disc {
                 for p in pts.iter_mut().step_by(3) {
@@ -653,7 +631,7 @@ fn hinted_inserts_build_the_same_triangulation() {
             let mut hinted = SamplingDomain::new(kind);
             for (i, p) in pts.iter().enumerate() {
                 let a = plain.insert(i as u64, *p);
-                let hint = (i > 0).then(|| (rng.next() * i as f64) as u64);
+                let hint = (i > 0).then(|| (rng.next_f64() * i as f64) as u64);
                 let b = hinted.insert_near(i as u64, *p, hint);
                 assert_eq!(a, b, "{kind:?} point {i}");
                 assert_eq!(plain.triangles(), hinted.triangles(), "{kind:?} point {i}");
@@ -772,7 +750,7 @@ fn moved_domain_equals_the_bulk_built_one() {
             .map(|(i, p)| (i as u64 * 5 + 2, *p))
             .collect();
         let (mut d, _) = SamplingDomain::from_sites(kind, &sites);
-        let mut rng = Rng(0x5eed + kind as u64);
+        let mut rng = Rng::from_state(0x5eed + kind as u64);
         let (mut rebuilt, mut reinserted) = (0, 0);
         let check = |d: &SamplingDomain, sites: &[(u64, DVec3)], got: &[bool], frame: usize| {
             let (want_d, want) = SamplingDomain::from_sites(kind, sites);
@@ -807,7 +785,7 @@ fn moved_domain_equals_the_bulk_built_one() {
             let (sin, cos) = f64::sin_cos(angle);
             for s in &mut sites {
                 let p = s.1;
-                let mut jitter = DVec3::new(rng.next(), rng.next(), rng.next()) - 0.5;
+                let mut jitter = DVec3::new(rng.next_f64(), rng.next_f64(), rng.next_f64()) - 0.5;
                 let q = match kind {
                     DomainKind::Disc => {
                         jitter.z = 0.0;
@@ -827,7 +805,7 @@ fn moved_domain_equals_the_bulk_built_one() {
                 s.1 = q + 0.003 * jitter;
             }
             for _ in 0..3 {
-                let k = (rng.next() * sites.len() as f64) as usize;
+                let k = (rng.next_f64() * sites.len() as f64) as usize;
                 sites.swap_remove(k);
             }
             let u = d.update_sites(&sites);
@@ -905,9 +883,9 @@ fn sphere_voronoi_area_of_a_site_of_high_degree() {
     let theta = 0.2f64;
     for m in [100usize, 600] {
         let mut sites = vec![(0u64, -DVec3::Z), (1, DVec3::Z)];
-        let mut rng = Rng(3);
+        let mut rng = Rng::from_state(3);
         for k in 0..m {
-            let phi = 2.0 * PI * (k as f64 + 0.1 * rng.next()) / m as f64;
+            let phi = 2.0 * PI * (k as f64 + 0.1 * rng.next_f64()) / m as f64;
             let p = DVec3::new(
                 theta.sin() * phi.cos(),
                 theta.sin() * phi.sin(),
