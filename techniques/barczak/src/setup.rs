@@ -71,7 +71,8 @@ impl BarczakScene {
 pub const CHART_LEVELS: u32 = 2;
 /// Charts a scene without recorded patches may make by default (the `max-charts` parameter):
 /// Sibenik (25,010), Sponza (26,414) and Maze (53,219) fit; the conference room's (115,302)
-/// visibility database is beyond a 2-core, 24 GB machine.
+/// visibility database takes longer to build than a run on a 2-core machine should (its
+/// memory is no longer the limit: static blockers are folded, see [`crate::database`]).
 pub const MAX_CHARTS: usize = 60_000;
 
 /// Prepares `scene` at `frame` (the movers' poses) with light `light` (see the module docs).
