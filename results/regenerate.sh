@@ -3,9 +3,10 @@
 # result (the README lists the same commands beside each result). Run from the repository root
 # on a clean checkout so that every results file records a clean git commit:
 #
-#   bash results/regenerate.sh            # everything (about 25 minutes on a 2-core CPU)
+#   bash results/regenerate.sh            # everything (the targets' times in results/reproduce-all.json, then some minutes more)
 #   bash results/regenerate.sh laine      # only the targets whose output is under results/laine
 #   bash results/regenerate.sh baseline   # only CI's baseline (instruction counts, timing)
+#   bash results/regenerate.sh barczak-scenes  # only barczak on Sibenik, Sponza and Maze
 #
 # Paper-size runs (`gibench reproduce all` without --quick) are for a GPU and are not part of
 # this script.
