@@ -14,7 +14,6 @@
 mod registry;
 
 use gibench_harness::assets::AssetPaths;
-use gibench_harness::gpu::{GpuContext, GpuOptions};
 use gibench_harness::profiler::{ProfileMode, Profiler};
 use gibench_harness::runner::{process_memory_mb, Harness, RunConfig, TimingMode};
 use gibench_harness::scene::Scene;
@@ -31,13 +30,7 @@ fn rss_mb() -> f64 {
 
 #[test]
 fn memory_stays_flat_over_long_runs() {
-    let present = gibench_harness::gpu::available_backends();
-    assert!(!present.is_empty(), "no Vulkan or GL adapter");
-    if present.len() < 2 {
-        gibench_harness::gpu::say_uncaptured(&format!(
-            "memory: only {present:?} present on this machine"
-        ));
-    }
+    let present = gibench_harness::gpu::backends_for("memory");
     let scene = Scene::load_named("cornell", &AssetPaths::standard(None)).unwrap();
     let config = RunConfig {
         resolution: [96, 72],
@@ -50,11 +43,7 @@ fn memory_stays_flat_over_long_runs() {
     };
     let mut failures = Vec::new();
     for backend in present {
-        let gpu = GpuContext::new(&GpuOptions {
-            backend: Some(backend.into()),
-            ..Default::default()
-        })
-        .expect("a GPU adapter");
+        let gpu = gibench_harness::gpu::backend_context(backend);
         let h = Harness::new(&gpu, &scene, &config).unwrap();
         for info in registry::all() {
             let params = info.parse_params(&[]).expect("defaults parse");

@@ -132,6 +132,29 @@ pub fn available_backends() -> Vec<&'static str> {
         .collect()
 }
 
+/// The portable backends present ([`available_backends`]) for a check that must hold on each
+/// (the tests' backend loop): at least one, else it panics; when only one is, `check` says so
+/// past the test harness's capture, so that a machine without the other is never silent.
+pub fn backends_for(check: &str) -> Vec<&'static str> {
+    let present = available_backends();
+    assert!(!present.is_empty(), "{check}: no Vulkan or GL adapter");
+    if present.len() < 2 {
+        say_uncaptured(&format!(
+            "{check}: only {present:?} present on this machine"
+        ));
+    }
+    present
+}
+
+/// A context on `backend`, one of [`available_backends`].
+pub fn backend_context(backend: &str) -> GpuContext {
+    GpuContext::new(&GpuOptions {
+        backend: Some(backend.into()),
+        ..Default::default()
+    })
+    .unwrap_or_else(|e| panic!("a {backend} adapter: {e}"))
+}
+
 /// Writes `message` to the process's standard error directly, past the test harness's output
 /// capture: for a test that must say plainly what it could not check on this machine.
 pub fn say_uncaptured(message: &str) {

@@ -55,14 +55,8 @@ fn cpu_mask(g: &GBufferTexels, s: EdgeSettings) -> Vec<u32> {
 #[test]
 fn edge_mask_matches_the_rule_and_finds_the_boundaries() {
     let scene = Scene::load_named("cornell", &AssetPaths::standard(None)).unwrap();
-    let present = gibench_harness::gpu::available_backends();
-    assert!(!present.is_empty());
-    for backend in present {
-        let gpu = GpuContext::new(&GpuOptions {
-            backend: Some(backend.into()),
-            ..Default::default()
-        })
-        .unwrap();
+    for backend in gibench_harness::gpu::backends_for("edges") {
+        let gpu = gibench_harness::gpu::backend_context(backend);
         let config = RunConfig {
             resolution: [W, H],
             frames: 1,

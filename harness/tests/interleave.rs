@@ -5,25 +5,14 @@
 
 use gibench_harness::assets::AssetPaths;
 use gibench_harness::glam::Vec3;
-use gibench_harness::gpu::{GpuContext, GpuOptions};
+use gibench_harness::gpu::GpuContext;
+use gibench_harness::gpu::{backend_context, backends_for};
 use gibench_harness::ir::interleave::{FilterSettings, Interleave, INTERLEAVE_WGSL};
 use gibench_harness::passes::{shader_module, GBufferTexels};
 use gibench_harness::runner::{Harness, RunConfig, TimingMode};
 use gibench_harness::scene::Scene;
 use gibench_harness::wgpu;
 use gibench_harness::Error;
-
-/// The portable backends present (an absent one is named once, not failed).
-fn backends() -> Vec<&'static str> {
-    let present = gibench_harness::gpu::available_backends();
-    assert!(!present.is_empty(), "no Vulkan or GL adapter");
-    if present.len() < 2 {
-        gibench_harness::gpu::say_uncaptured(&format!(
-            "interleave: only {present:?} present on this machine"
-        ));
-    }
-    present
-}
 
 const CORNELL: FilterSettings = FilterSettings {
     alpha: 30.0,
@@ -34,16 +23,6 @@ const PERMISSIVE: FilterSettings = FilterSettings {
     alpha: f32::MAX,
     beta: -2.0,
 };
-
-fn gpu(backend: &str) -> GpuContext {
-    let gpu = GpuContext::new(&GpuOptions {
-        backend: Some(backend.into()),
-        ..Default::default()
-    })
-    .expect("a GPU adapter (install mesa-vulkan-drivers)");
-    eprintln!("{backend}: {} ({})", gpu.info.adapter, gpu.info.backend);
-    gpu
-}
 
 /// Builds a harness on the Cornell box at `resolution`, renders the G-buffer of frame 17 and
 /// hands the harness and the exported G-buffer to `f`.
@@ -137,8 +116,8 @@ fn close(a: f32, b: f32, rel: f32) -> bool {
 /// and w = 0 elsewhere. Also checks the split layout itself against the definition.
 #[test]
 fn split_then_combine_is_identity() {
-    for backend in backends() {
-        let gpu = gpu(backend);
+    for backend in backends_for("interleave") {
+        let gpu = backend_context(backend);
         for size in [[96, 72], [97, 70]] {
             with_cornell(&gpu, size, |h, g| {
                 let [w, ht] = size;
@@ -255,8 +234,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         valid + 2.0 * split_position[i].w + 4.0 * split_normal[i].w);
 }
 "#;
-    for backend in backends() {
-        let gpu = gpu(backend);
+    for backend in backends_for("interleave") {
+        let gpu = backend_context(backend);
         let size = [97, 70];
         with_cornell(&gpu, size, |h, g| {
             let output = output_texture(&gpu, size);
@@ -333,8 +312,8 @@ fn plane_ids(g: &GBufferTexels) -> Vec<Option<usize>> {
 /// enough to cross the step.
 #[test]
 fn filter_respects_discontinuities() {
-    for backend in backends() {
-        let gpu = gpu(backend);
+    for backend in backends_for("interleave") {
+        let gpu = backend_context(backend);
         for size in [[96, 72], [97, 70]] {
             with_cornell(&gpu, size, |h, g| {
                 let output = output_texture(&gpu, size);
@@ -429,8 +408,8 @@ fn filter_respects_discontinuities() {
 /// background pixels are 0.
 #[test]
 fn filter_preserves_a_constant() {
-    for backend in backends() {
-        let gpu = gpu(backend);
+    for backend in backends_for("interleave") {
+        let gpu = backend_context(backend);
         for size in [[96, 72], [97, 70]] {
             with_cornell(&gpu, size, |h, g| {
                 let output = output_texture(&gpu, size);
@@ -516,8 +495,8 @@ fn cpu_filter(
 /// The GPU filter matches a CPU implementation of Figure 5 on a noisy input.
 #[test]
 fn filter_matches_cpu_reference() {
-    for backend in backends() {
-        let gpu = gpu(backend);
+    for backend in backends_for("interleave") {
+        let gpu = backend_context(backend);
         let size = [97, 70];
         with_cornell(&gpu, size, |h, g| {
             let output = output_texture(&gpu, size);
@@ -575,8 +554,8 @@ fn expect_param_error(result: Result<Interleave, Error>, name: &str, what: &str)
 /// errors naming the parameter.
 #[test]
 fn rejects_bad_parameters() {
-    for backend in backends() {
-        let gpu = gpu(backend);
+    for backend in backends_for("interleave") {
+        let gpu = backend_context(backend);
         let size = [96, 72];
         with_cornell(&gpu, size, |h, _| {
             let output = output_texture(&gpu, size);

@@ -6,7 +6,8 @@
 mod support;
 
 use gibench_harness::glam::Vec3;
-use gibench_harness::gpu::{GpuContext, GpuOptions};
+use gibench_harness::gpu::GpuContext;
+use gibench_harness::gpu::{backend_context, backends_for};
 use gibench_harness::ir::atlas::{AtlasFormat, AtlasSettings, MapKind, ShadowAtlas};
 use gibench_harness::ir::pullpush::PullPush;
 use gibench_harness::ir::splat::PointSplat;
@@ -14,25 +15,6 @@ use gibench_harness::ir::store::VplStore;
 use gibench_harness::scene::{Mesh, SceneExtent};
 use gibench_harness::vpl::{frame_from_normal, Vpl};
 use gibench_harness::wgpu;
-
-fn backends() -> Vec<&'static str> {
-    let present = gibench_harness::gpu::available_backends();
-    assert!(!present.is_empty(), "no Vulkan or GL adapter");
-    if present.len() < 2 {
-        gibench_harness::gpu::say_uncaptured(&format!(
-            "ism_kit: only {present:?} present on this machine"
-        ));
-    }
-    present
-}
-
-fn gpu(backend: &str) -> GpuContext {
-    GpuContext::new(&GpuOptions {
-        backend: Some(backend.into()),
-        ..Default::default()
-    })
-    .expect("a GPU adapter")
-}
 
 /// The plane z = 1, x and y in [-2, 2], as a mesh (for the scene extent the atlas's far
 /// distance and lift come from).
@@ -120,8 +102,8 @@ fn ramp(x: u32, y: u32) -> Option<f32> {
 
 #[test]
 fn pull_push_fills_holes_and_never_changes_a_valid_texel() {
-    for backend in backends() {
-        let gpu = gpu(backend);
+    for backend in backends_for("ism_kit") {
+        let gpu = backend_context(backend);
         let extent = SceneExtent::of(&plane());
         let atlas = float_atlas(&gpu, &extent, 2, SIZE);
         let store = VplStore::new(&gpu, 2).unwrap();
@@ -193,8 +175,8 @@ fn pull_push_fills_holes_and_never_changes_a_valid_texel() {
 #[test]
 fn dense_splats_of_a_plane_reproduce_its_exact_map() {
     const MAP: u32 = 64;
-    for backend in backends() {
-        let gpu = gpu(backend);
+    for backend in backends_for("ism_kit") {
+        let gpu = backend_context(backend);
         let extent = SceneExtent::of(&plane());
         let atlas = float_atlas(&gpu, &extent, 1, MAP);
         let store = VplStore::new(&gpu, 1).unwrap();
@@ -368,8 +350,8 @@ fn sampled_vpls_carry_the_flux_the_map_saw() {
         .map(|t| flux[t].truncate())
         .sum();
     let total_lum = luminance(total);
-    for backend in backends() {
-        let gpu = gpu(backend);
+    for backend in backends_for("ism_kit") {
+        let gpu = backend_context(backend);
         let upload = |data: &[gibench_harness::glam::Vec4]| {
             let raw: Vec<[f32; 4]> = data.iter().map(|v| v.to_array()).collect();
             let b = gpu.device.create_buffer(&wgpu::BufferDescriptor {
@@ -459,8 +441,8 @@ fn reflective_shadow_map_carries_the_first_bounce_flux() {
     use gibench_harness::runner::{Harness, RunConfig, TimingMode};
     use gibench_harness::scene::Scene;
     use gibench_harness::vpl::{self, VplSettings};
-    for backend in backends() {
-        let gpu = gpu(backend);
+    for backend in backends_for("ism_kit") {
+        let gpu = backend_context(backend);
         for name in ["cornell", "cornell-omni", "cornell-area", "cornell-sun"] {
             let mut scene = Scene::load_named(name, &AssetPaths::standard(None)).unwrap();
             scene.movers.clear();

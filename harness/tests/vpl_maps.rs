@@ -6,7 +6,7 @@
 
 use gibench_harness::assets::AssetPaths;
 use gibench_harness::glam::Vec3;
-use gibench_harness::gpu::{GpuContext, GpuOptions};
+use gibench_harness::gpu::{backend_context, backends_for};
 use gibench_harness::ir::accumulate::{Accumulation, IrradianceClamp};
 use gibench_harness::ir::atlas::{AtlasFormat, AtlasSettings, MapKind, ShadowAtlas};
 use gibench_harness::ir::interleave::{FilterSettings, Interleave};
@@ -67,11 +67,7 @@ fn one_vpl_in(
     clamp: IrradianceClamp,
 ) -> Vec<Option<(f32, f32, bool)>> {
     let off = 5e-4 * scene.extent.diagonal;
-    let gpu = GpuContext::new(&GpuOptions {
-        backend: Some(backend.into()),
-        ..Default::default()
-    })
-    .expect("a GPU adapter");
+    let gpu = backend_context(backend);
     let [w, h] = [96u32, 72];
     let config = RunConfig {
         resolution: [w, h],
@@ -219,18 +215,6 @@ fn one_vpl_in(
         .collect()
 }
 
-/// The portable backends present (Vulkan, GL); at least one.
-fn backends() -> Vec<&'static str> {
-    let present = gibench_harness::gpu::available_backends();
-    assert!(!present.is_empty(), "no Vulkan or GL adapter");
-    if present.len() < 2 {
-        gibench_harness::gpu::say_uncaptured(&format!(
-            "vpl_maps: only {present:?} present on this machine"
-        ));
-    }
-    present
-}
-
 /// A VPL on the floor between the blocks, and one on the red wall, facing into the box.
 fn test_vpls() -> [Vpl; 2] {
     [
@@ -272,7 +256,7 @@ fn interior(px: &[Option<(f32, f32, bool)>]) -> Vec<bool> {
 }
 
 fn check(fill: Fill) {
-    for backend in backends() {
+    for backend in backends_for("vpl_maps") {
         for vpl in test_vpls() {
             let px = one_vpl(backend, fill, vpl);
             let inside = interior(&px);
@@ -341,7 +325,7 @@ fn paraboloid_maps_agree_with_ray_casts() {
 #[test]
 fn maps_from_the_gpu_store_equal_maps_from_the_cpu_list() {
     check(Fill::RasterStore);
-    for backend in backends() {
+    for backend in backends_for("vpl_maps") {
         for vpl in test_vpls() {
             let a = one_vpl(backend, Fill::RasterStore, vpl);
             let b = one_vpl(backend, Fill::Raster(MapKind::Paraboloid), vpl);
@@ -379,7 +363,7 @@ fn octahedral_maps_agree_with_ray_casts() {
 #[test]
 fn float_atlas_from_outside_the_rasteriser_matches_the_rasterised_one() {
     check(Fill::CpuFloat);
-    for backend in backends() {
+    for backend in backends_for("vpl_maps") {
         for vpl in test_vpls() {
             let a = one_vpl(backend, Fill::CpuFloat, vpl);
             let b = one_vpl(backend, Fill::Raster(MapKind::Paraboloid), vpl);
@@ -430,7 +414,7 @@ fn the_clamp_bounds_each_vpls_irradiance_relative_to_the_summed_flux() {
         flux: Vec3::new(3.0, 1.0, 3.0) * vpl.flux,
         ..vpl
     };
-    for backend in backends() {
+    for backend in backends_for("vpl_maps") {
         let free = one_vpl(backend, Fill::Raster(MapKind::Paraboloid), vpl);
         let mut lit: Vec<f32> = free
             .iter()
@@ -534,7 +518,7 @@ fn octahedral_maps_do_not_leak_under_a_large_wall() {
         flux: Vec3::ONE,
         ..test_vpl()
     };
-    for backend in backends() {
+    for backend in backends_for("vpl_maps") {
         let mut wrong = Vec::new();
         for kind in [MapKind::Paraboloid, MapKind::Octahedral, MapKind::Cube] {
             let px = one_vpl_in(

@@ -13,7 +13,7 @@
 
 use gibench_gaitatzes::slab::{measure, model, Irradiance, Slabs};
 use gibench_gaitatzes::volume::Transport;
-use gibench_harness::gpu::{GpuContext, GpuOptions};
+use gibench_harness::gpu::{backend_context, backends_for};
 
 const N: u32 = 32;
 /// The two-plane scene's grid: its walls are 16 cells apart and 64 iterations long, and light
@@ -35,20 +35,6 @@ const TOLERANCE: f64 = 0.01;
 /// gain); 0.03 at 64³.
 const TOLERANCE_PYRAMID_PLANES: f64 = 0.03;
 
-fn backends() -> Vec<&'static str> {
-    let present = gibench_harness::gpu::available_backends();
-    assert!(!present.is_empty(), "no Vulkan or GL adapter");
-    present
-}
-
-fn gpu(backend: &str) -> GpuContext {
-    GpuContext::new(&GpuOptions {
-        backend: Some(backend.into()),
-        ..Default::default()
-    })
-    .expect("a GPU adapter")
-}
-
 fn check(backend: &str, what: &str, got: Irradiance, want: Irradiance, tolerance: f64) {
     assert!(
         (got.receiver - want.receiver).abs() <= tolerance
@@ -66,8 +52,8 @@ fn check(backend: &str, what: &str, got: Irradiance, want: Irradiance, tolerance
 /// (0.84, 0.75, 0.63).
 #[test]
 fn a_lit_layer_gives_the_facing_layer_the_modelled_irradiance() {
-    for backend in backends() {
-        let gpu = gpu(backend);
+    for backend in backends_for("transfer") {
+        let gpu = backend_context(backend);
         for transport in [Transport::Cosine, Transport::Carry, Transport::Pyramid] {
             for apart in [2, 3, 5] {
                 let s = Slabs {
@@ -125,8 +111,8 @@ fn a_lit_layer_gives_the_facing_layer_the_modelled_irradiance() {
 /// `transport=carry` meets the reference: the ceiling within 15 %, the floor below 0.01.
 #[test]
 fn lit_floor_and_black_ceiling_match_the_model() {
-    for backend in backends() {
-        let gpu = gpu(backend);
+    for backend in backends_for("transfer") {
+        let gpu = backend_context(backend);
         for transport in [Transport::Cosine, Transport::Carry, Transport::Pyramid] {
             let s = Slabs {
                 apart: 16,

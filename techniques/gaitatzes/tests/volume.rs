@@ -8,24 +8,11 @@ use gibench_gaitatzes::volume::{
     Grid, Mode, Propagation, Transport, Volumes, Voxelizer, CELL_BYTES,
 };
 use gibench_harness::glam::{Vec2, Vec3};
-use gibench_harness::gpu::{GpuContext, GpuOptions};
+use gibench_harness::gpu::GpuContext;
+use gibench_harness::gpu::{backend_context, backends_for};
 use gibench_harness::runner::{Harness, RunConfig, TimingMode};
 use gibench_harness::scene::{Material, Mesh, Scene};
 use gibench_harness::wgpu;
-
-fn backends() -> Vec<&'static str> {
-    let present = gibench_harness::gpu::available_backends();
-    assert!(!present.is_empty(), "no Vulkan or GL adapter");
-    present
-}
-
-fn gpu(backend: &str) -> GpuContext {
-    GpuContext::new(&GpuOptions {
-        backend: Some(backend.into()),
-        ..Default::default()
-    })
-    .expect("a GPU adapter")
-}
 
 fn read(gpu: &GpuContext, buffer: &wgpu::Buffer) -> Vec<f32> {
     let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
@@ -123,8 +110,8 @@ fn propagate(
 #[test]
 fn one_lit_voxel_propagates_symmetrically_and_loses_no_energy() {
     let c = N / 2;
-    for backend in backends() {
-        let gpu = gpu(backend);
+    for backend in backends_for("volume") {
+        let gpu = backend_context(backend);
         let empty = vec![0f32; N.pow(3) as usize * CELL];
         let iso = [1.0, 0.0, 0.0, 0.0];
         let (fields, _) = propagate(&gpu, Mode::Occluded, &empty, (c, c, c), iso, 6);
@@ -239,8 +226,8 @@ fn an_occluding_wall_blocks_propagation() {
         }
         e
     };
-    for backend in backends() {
-        let gpu = gpu(backend);
+    for backend in backends_for("volume") {
+        let gpu = backend_context(backend);
         let iso = [1.0, 0.0, 0.0, 0.0];
         let source = 3.0 * (4.0 * std::f64::consts::PI).sqrt();
         let run = |wall| propagate(&gpu, Mode::Occluded, &wall_voxels(wall), (5, 8, 8), iso, 12);
@@ -325,8 +312,8 @@ fn voxelize_triangle(a: Vec3, b: Vec3, c: Vec3) {
         gltf_lights: Vec::new(),
         patches: Vec::new(),
     };
-    for backend in backends() {
-        let gpu = gpu(backend);
+    for backend in backends_for("volume") {
+        let gpu = backend_context(backend);
         let config = RunConfig {
             resolution: [32, 24],
             frames: 1,

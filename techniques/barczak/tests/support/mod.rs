@@ -5,7 +5,7 @@
 
 use gibench_barczak::database::{Receiver, ReceiverShape, VisibilityDatabase};
 use gibench_barczak::visibility::{Blocker, PatchTree, PointLight, Shape};
-use gibench_harness::gpu::{GpuContext, GpuOptions};
+use gibench_harness::gpu::GpuContext;
 use gibench_harness::runner::{Harness, RunConfig, TimingMode};
 use gibench_harness::scene::Scene;
 use glam::Vec3;
@@ -213,12 +213,8 @@ pub fn each_backend(
     size: [u32; 2],
     mut body: impl FnMut(&str, &GpuContext, &Harness),
 ) {
-    for backend in gibench_harness::gpu::available_backends() {
-        let gpu = GpuContext::new(&GpuOptions {
-            backend: Some(backend.into()),
-            ..Default::default()
-        })
-        .unwrap();
+    for backend in gibench_harness::gpu::backends_for("barczak") {
+        let gpu = gibench_harness::gpu::backend_context(backend);
         let config = RunConfig {
             resolution: size,
             frames: 1,
