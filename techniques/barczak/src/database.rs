@@ -123,6 +123,13 @@ impl NodeEntry {
     }
 }
 
+/// [`NodeEntry::keep_only`] on every entry of one receiver (`[node][light]`).
+fn keep_only(entries: &mut [Vec<NodeEntry>], blockers: &[Blocker], movable: &[u32]) {
+    for entry in entries.iter_mut().flatten() {
+        entry.keep_only(blockers, movable);
+    }
+}
+
 /// A light added to or removed from a leaf's light map.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct LightMapChange {
@@ -318,9 +325,7 @@ impl VisibilityDatabase {
             .map(|(receiver, entries)| {
                 let tests = scene.recompute(receiver, entries);
                 if let Some(movable) = movable {
-                    for entry in entries.iter_mut().flatten() {
-                        entry.keep_only(scene.blockers, movable);
-                    }
+                    keep_only(entries, scene.blockers, movable);
                 }
                 tests
             })
@@ -337,11 +342,7 @@ impl VisibilityDatabase {
         let mut movable = movable.to_vec();
         movable.sort_unstable();
         let blockers = &self.blockers;
-        self.entries.par_iter_mut().for_each(|receiver| {
-            for entry in receiver.iter_mut().flatten() {
-                entry.keep_only(blockers, &movable);
-            }
-        });
+        (self.entries.par_iter_mut()).for_each(|entries| keep_only(entries, blockers, &movable));
         self.movable = Some(movable);
     }
 
@@ -422,9 +423,7 @@ impl VisibilityDatabase {
                 // Moved: every node against every blocker (its reach moved).
                 tests += scene.recompute(receiver, entries);
                 if let Some(movable) = &self.movable {
-                    for entry in entries.iter_mut().flatten() {
-                        entry.keep_only(&self.blockers, movable);
-                    }
+                    keep_only(entries, &self.blockers, movable);
                 }
             } else {
                 for l in 0..self.lights.len() {

@@ -317,12 +317,19 @@ fn create(
         p.renderer,
         prepared,
     )?;
-    Ok(Box::new(Barczak { renderer }))
+    // The database's size never changes after preparation: counted once, reported per frame.
+    let patches_and_leaves = renderer.scene().patches_and_leaves();
+    Ok(Box::new(Barczak {
+        renderer,
+        patches_and_leaves,
+    }))
 }
 
 /// `barczak`.
 pub struct Barczak {
     renderer: Renderer,
+    /// The database's patch receivers and their leaves (the `patches` and `leaves` counters).
+    patches_and_leaves: (usize, usize),
 }
 
 impl Technique for Barczak {
@@ -365,7 +372,7 @@ impl Technique for Barczak {
         ctx.profiler.count("elements", counts.elements as f64);
         ctx.profiler
             .count("light-map-changes", counts.light_map_changes as f64);
-        let (patches, leaves) = r.scene().patches_and_leaves();
+        let (patches, leaves) = self.patches_and_leaves;
         ctx.profiler.count("patches", patches as f64);
         ctx.profiler.count("leaves", leaves as f64);
         Ok(())
