@@ -245,6 +245,24 @@ pub const TARGETS: &[Target] = &[
         },
     },
     Target {
+        name: "ism-sampling",
+        dir: "ism/sampling",
+        what: "ism's per-frame error and flicker for the two VPL warps (the flattened luminance CDF and a row, then a column) in the Cornell box with the light and the bunny moving",
+        kind: Kind::Command {
+            quick: "sweep --scene cornell-bunny --technique ism --sweep vpl-warp=flat,row-column --param vpls=256 --param ism.points-per-vpl=8192 --quality --quality-all --frames 60 --warmup 0 --timing stages --spp 64",
+            paper: "sweep --scene cornell-bunny --technique ism --sweep vpl-warp=flat,row-column --param vpls=256 --param ism.points-per-vpl=8192 --quality --quality-all --frames 60 --warmup 0 --timing stages --spp 64",
+        },
+    },
+    Target {
+        name: "ism-sampling-still",
+        dir: "ism/sampling-still",
+        what: "the same with the light held still (cornell-bunny-still-light): the flicker the bunny and the camera alone cause",
+        kind: Kind::Command {
+            quick: "sweep --scene cornell-bunny-still-light --technique ism --sweep vpl-warp=flat,row-column --param vpls=256 --param ism.points-per-vpl=8192 --quality --quality-all --frames 60 --warmup 0 --timing stages --spp 64",
+            paper: "sweep --scene cornell-bunny-still-light --technique ism --sweep vpl-warp=flat,row-column --param vpls=256 --param ism.points-per-vpl=8192 --quality --quality-all --frames 60 --warmup 0 --timing stages --spp 64",
+        },
+    },
+    Target {
         name: "ism-breakdown",
         dir: "ism/breakdown",
         what: "",

@@ -182,6 +182,11 @@ impl ReflectiveShadowMap {
         })
     }
 
+    /// Edge of each face, texels (the texel buffers' rows are this long).
+    pub fn size(&self) -> u32 {
+        self.size
+    }
+
     /// Texels of all faces (6 · size²).
     pub fn texels(&self) -> u32 {
         6 * self.size * self.size

@@ -8,11 +8,21 @@
 //! Writes: the [`VplStore`] — slots 0..N, and its header (N, and the texels' total flux as the
 //! summed flux the accumulation's clamp is relative to); its own CDF and totals buffers.
 //!
-//! One workgroup scans the texels' luminance into a CDF (and sums their flux); VPL i takes the
-//! texel where the CDF crosses (i + ξᵢ)/N of the total, ξᵢ ∈ [0, 1) a fixed hash of i
-//! (stratified and jittered, so unbiased; the same texels while the map does not change) and carries that texel's flux × total luminance / (its luminance · N).
-//! Every VPL then has luminance total / N, so the VPLs' luminance sums to the texels' exactly
-//! and their flux per channel is an unbiased estimate of the texels'.
+//! One workgroup scans the texels' luminance into a CDF (and sums their flux). VPL i has a
+//! fixed point of the unit square, (uᵢ, vᵢ) = ((i + ξᵢ)/N, φ₂(i) ⊕ η): ξᵢ ∈ [0, 1) a fixed hash
+//! of i, φ₂ the base-2 radical inverse, η one fixed shift (a jittered Hammersley set: stratified,
+//! so the estimate is unbiased, and the same texels while the map does not change). The point
+//! picks a texel with probability its luminance / the total, by one of two warps
+//! ([`VplWarp`]): the texel where the CDF over the flattened map crosses uᵢ, or a row (face
+//! row) by its luminance at uᵢ, then a texel in that row at vᵢ. The VPL carries that texel's
+//! flux × total luminance / (its luminance · N): every VPL has luminance total / N, so the
+//! VPLs' luminance sums to the texels' exactly and their flux per channel is an unbiased
+//! estimate of the texels'.
+//!
+//! The warps differ in how far a VPL moves when the map changes a little (a moving light or
+//! mover): along the flattened order a small shift of the CDF carries VPLs past the ends of
+//! rows, to the other side of the face; the row-then-column warp moves them to a neighbouring
+//! row or texel (the flicker this causes is measured by `gibench reproduce ism-sampling`).
 
 use bytemuck::{Pod, Zeroable};
 
@@ -36,6 +46,32 @@ pub struct VplSampler {
     count: u32,
 }
 
+/// How a VPL's point of the unit square picks its texel (see the module docs).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum VplWarp {
+    /// The luminance CDF over the flattened map (rows one after another) at u.
+    Flattened,
+    /// A row by the rows' luminance at u, then a texel of that row by its CDF at v.
+    RowColumn,
+}
+
+impl VplWarp {
+    /// The names a parameter gives them.
+    pub const NAMES: &'static [&'static str] = &["flat", "row-column"];
+
+    /// The warp a parameter value names.
+    pub fn from_name(name: &str) -> Result<VplWarp> {
+        match name {
+            "flat" => Ok(VplWarp::Flattened),
+            "row-column" => Ok(VplWarp::RowColumn),
+            other => Err(Error::Invalid(format!(
+                "unknown VPL warp '{other}': expected one of {}",
+                Self::NAMES.join(", ")
+            ))),
+        }
+    }
+}
+
 /// The texels' buffers the sampler reads.
 pub struct RsmTexels<'a> {
     pub position: &'a wgpu::Buffer,
@@ -43,15 +79,19 @@ pub struct RsmTexels<'a> {
     pub flux: &'a wgpu::Buffer,
     /// Texels in each buffer.
     pub texels: u32,
+    /// Texels in a row (the buffers hold `texels / row` rows, one after another).
+    pub row: u32,
 }
 
 impl VplSampler {
-    /// Sampling `count` VPLs (at most the store's capacity) from `rsm` into `store`.
+    /// Sampling `count` VPLs (at most the store's capacity) from `rsm` into `store` through
+    /// `warp`.
     pub fn new(
         gpu: &GpuContext,
         store: &VplStore,
         rsm: &RsmTexels,
         count: u32,
+        warp: VplWarp,
     ) -> Result<VplSampler> {
         if count == 0 || count > store.capacity() {
             return Err(Error::param(
@@ -62,10 +102,11 @@ impl VplSampler {
                 ),
             ));
         }
-        if rsm.texels == 0 {
-            return Err(Error::Invalid(
-                "the reflective shadow map has no texels".into(),
-            ));
+        if rsm.texels == 0 || rsm.row == 0 || !rsm.texels.is_multiple_of(rsm.row) {
+            return Err(Error::Invalid(format!(
+                "the reflective shadow map's {} texels are not whole rows of {}",
+                rsm.texels, rsm.row
+            )));
         }
         let device = &gpu.device;
         let params = device.create_buffer(&wgpu::BufferDescriptor {
@@ -78,7 +119,12 @@ impl VplSampler {
             &params,
             0,
             bytemuck::bytes_of(&ParamsData {
-                counts: [rsm.texels, count, 0, 0],
+                counts: [
+                    rsm.texels,
+                    count,
+                    rsm.row,
+                    (warp == VplWarp::RowColumn) as u32,
+                ],
             }),
         );
         let buffer = |label: &str, size: u64| {

@@ -39,7 +39,7 @@ use gibench_harness::ir::pullpush::PullPush;
 use gibench_harness::ir::raster::StoreViews;
 use gibench_harness::ir::rsm::ReflectiveShadowMap;
 use gibench_harness::ir::splat::PointSplat;
-use gibench_harness::ir::vpl_sample::{RsmTexels, VplSampler};
+use gibench_harness::ir::vpl_sample::{RsmTexels, VplSampler, VplWarp};
 use gibench_harness::passes::DrawSet;
 use gibench_harness::technique::{
     Conformance, FrameContext, ParamKind, ParamSpec, Params, PrepareContext, Prepared, Technique,
@@ -87,6 +87,12 @@ const OWN_PARAMS: &[ParamSpec] = &[
         default: "3",
         doc: "pyramid levels of the pull-push: holes up to 2^levels texels wide are filled (0: none)",
     },
+    ParamSpec {
+        name: "vpl-warp",
+        kind: ParamKind::Choice(VplWarp::NAMES),
+        default: "row-column",
+        doc: "how each VPL's fixed point picks its texel of the reflective shadow map: 'flat', the luminance CDF over the flattened map; 'row-column', a row by luminance, then a texel of it",
+    },
 ];
 
 /// The kit's gather parameters that apply to imperfect maps: tiles, map size, clamp (the maps
@@ -94,7 +100,7 @@ const OWN_PARAMS: &[ParamSpec] = &[
 const GATHER: &[ParamSpec] = &[GATHER_PARAMS[0], GATHER_PARAMS[2], GATHER_PARAMS[4]];
 
 /// The parameters `ism-classic` shares with `ism` (no points, no pull-push).
-const CLASSIC_PARAMS: &[ParamSpec] = &[OWN_PARAMS[0], OWN_PARAMS[3]];
+const CLASSIC_PARAMS: &[ParamSpec] = &[OWN_PARAMS[0], OWN_PARAMS[3], OWN_PARAMS[5]];
 
 /// `ism-classic` registry entry.
 pub const INFO_CLASSIC: TechniqueInfo = TechniqueInfo {
@@ -145,6 +151,7 @@ pub struct IsmParams {
     pub pool: u32,
     pub rsm_size: u32,
     pub levels: u32,
+    pub warp: VplWarp,
     pub gather: GatherParams,
 }
 
@@ -157,6 +164,7 @@ impl IsmParams {
             pool: params.int("point-pool") as u32,
             rsm_size: params.int("rsm-size") as u32,
             levels: params.int("pull-push-levels") as u32,
+            warp: VplWarp::from_name(params.choice("vpl-warp"))?,
             gather: Self::gather(params, AtlasFormat::Float32),
         };
         if p.points_per_vpl > p.pool {
@@ -210,15 +218,16 @@ impl IsmParams {
     }
 
     /// `ism-classic`'s parameters (no points, no pull-push: those fields are 0).
-    pub fn classic_from_params(params: &Params) -> IsmParams {
-        IsmParams {
+    pub fn classic_from_params(params: &Params) -> Result<IsmParams> {
+        Ok(IsmParams {
             vpls: params.int("vpls") as u32,
             points_per_vpl: 0,
             pool: 0,
             rsm_size: params.int("rsm-size") as u32,
             levels: 0,
+            warp: VplWarp::from_name(params.choice("vpl-warp"))?,
             gather: Self::gather(params, AtlasFormat::Depth32),
-        }
+        })
     }
 
     /// The gather over paraboloid maps in `format`.
@@ -248,7 +257,7 @@ fn prepare(params: &Params, ctx: &PrepareContext) -> Result<Prepared> {
 
 /// `ism-classic` prepares nothing (it checks its sizes against the device).
 fn prepare_classic(params: &Params, ctx: &PrepareContext) -> Result<Prepared> {
-    IsmParams::classic_from_params(params).check_device(ctx.gpu)?;
+    IsmParams::classic_from_params(params)?.check_device(ctx.gpu)?;
     Ok(Box::new(()))
 }
 
@@ -301,8 +310,10 @@ impl Ism {
                 normal,
                 flux,
                 texels: rsm.texels(),
+                row: rsm.size(),
             },
             p.vpls,
+            p.warp,
         )?;
         let maps = maps(&gather)?;
         Ok(Ism {
@@ -377,7 +388,7 @@ fn create_classic(
     ctx: &PrepareContext,
     _: &Prepared,
 ) -> Result<Box<dyn Technique>> {
-    let p = IsmParams::classic_from_params(params);
+    let p = IsmParams::classic_from_params(params)?;
     let ism = Ism::new(&p, ctx, Some(DrawSet::CastersAndMovers), |gather| {
         let raster = gather
             .raster

@@ -1,13 +1,17 @@
 // VPLs importance-sampled from reflective-shadow-map texels by brightness (imperfect shadow
 // maps, Ritschel et al. 2008; reflective shadow maps, Dachsbacher and Stamminger 2005).
 // `scan`: one workgroup builds the inclusive prefix sums of the texels' luminance (the CDF)
-// and the texels' total flux. `sample`: VPL i takes the texel where the CDF crosses
-// (i + ξ_i) / N of the total (ξ_i a fixed hash of i), and carries that texel's flux scaled by total luminance /
-// (its luminance · N): every VPL has the same luminance, and their sum is an unbiased
-// estimate of the texels' total flux. Expects VplStore::wgsl(0, 0, true).
+// and the texels' total flux. `sample`: VPL i's fixed point (u, v) = ((i + ξ_i) / N,
+// φ2(i) ⊕ η) picks a texel with probability its share of the luminance, either where the CDF
+// over the flattened map crosses u, or a row where the rows' CDF crosses u and then the texel
+// where that row's CDF crosses v (the row ends are read off the same CDF). The VPL carries the
+// texel's flux scaled by total luminance / (its luminance · N): every VPL has the same
+// luminance, and their sum is an unbiased estimate of the texels' total flux. Expects
+// VplStore::wgsl(0, 0, true).
 
 struct SampleParams {
-    // x: texels; y: VPLs to place; z, w: unused
+    // x: texels; y: VPLs to place; z: texels per row; w: 1 for the row-then-column warp, 0 for
+    // the flattened CDF
     counts: vec4<u32>,
 };
 
@@ -85,6 +89,51 @@ fn jitter(i: u32) -> f32 {
     return f32(h >> 8u) / 16777216.0;
 }
 
+// The first texel in [lo, hi] whose inclusive sum exceeds `u` (hi if none does).
+fn first_above(first: u32, last: u32, u: f32) -> u32 {
+    var lo = first;
+    var hi = last;
+    while (lo < hi) {
+        let mid = (lo + hi) / 2u;
+        if (cdf[mid] > u) {
+            hi = mid;
+        } else {
+            lo = mid + 1u;
+        }
+    }
+    return lo;
+}
+
+// The texel VPL i's point picks, the CDF's total being `total`.
+fn pick(i: u32, count: u32, total: f32) -> u32 {
+    let n = sample_params.counts.x;
+    let u = (f32(i) + jitter(i)) / f32(count) * total;
+    if (sample_params.counts.w == 0u) {
+        return first_above(0u, n - 1u, u);
+    }
+    // A row: the first whose inclusive end exceeds u.
+    let row = sample_params.counts.z;
+    var lo = 0u;
+    var hi = n / row - 1u;
+    while (lo < hi) {
+        let mid = (lo + hi) / 2u;
+        if (cdf[(mid + 1u) * row - 1u] > u) {
+            hi = mid;
+        } else {
+            lo = mid + 1u;
+        }
+    }
+    let start = lo * row;
+    var before = 0.0;
+    if (start > 0u) {
+        before = cdf[start - 1u];
+    }
+    // v: the base-2 radical inverse of i, shifted by one fixed amount (a Cranley–Patterson
+    // rotation keeps the set's stratification).
+    let v = fract(f32(reverseBits(i) >> 8u) / 16777216.0 + jitter(count ^ 0x5bd1e995u));
+    return first_above(start, start + row - 1u, before + v * (cdf[start + row - 1u] - before));
+}
+
 // An orthonormal frame about unit `n` (any works: the atlas and the splat read it from the
 // store).
 fn frame_of(n: vec3<f32>) -> mat2x3<f32> {
@@ -112,18 +161,7 @@ fn sample(@builtin(global_invocation_id) id: vec3<u32>) {
     v.bitangent = vec4<f32>(0.0, 1.0, 0.0, 0.0);
     let total = totals.x;
     if (total > 0.0 && n > 0u) {
-        let u = (f32(i) + jitter(i)) / f32(count) * total;
-        // The first texel whose inclusive sum exceeds u (it has a positive weight).
-        var lo = 0u;
-        var hi = n - 1u;
-        while (lo < hi) {
-            let mid = (lo + hi) / 2u;
-            if (cdf[mid] > u) {
-                hi = mid;
-            } else {
-                lo = mid + 1u;
-            }
-        }
+        let lo = pick(i, count, total);
         let w = texel_weight(lo);
         if (w > 0.0) {
             let nrm = normalize(rsm_normal[lo].xyz);
