@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Regenerates every committed result under results/ from the current commit, one command per
-# result (the README lists the same commands beside each result). Run from the repository root
-# on a clean checkout so that every results file records a clean git commit:
+# result (each results folder's README.md lists the same commands beside its results). Run from
+# the repository root on a clean checkout so that every results file records a clean git commit:
 #
 #   bash results/regenerate.sh            # everything (the targets' times in results/reproduce-all.json, then some minutes more)
 #   bash results/regenerate.sh laine      # only the targets whose output is under results/laine
@@ -28,9 +28,9 @@ run() { # run OUTPUT_DIR command... (OUTPUT_DIR is emptied first: no stale files
 }
 
 # Every paper table, figure and sweep: the targets of `gibench reproduce all` (listed, with their
-# commands, by `gibench reproduce all --quick --list`; README: "Every paper result in one
-# command"). `bash results/regenerate.sh laine` runs only the targets whose folder is under
-# results/laine (and `results/keller`, `results/clamp`, `results/reference` likewise).
+# commands, by `gibench reproduce all --quick --list`; docs/reproducing.md). `bash
+# results/regenerate.sh laine` runs only the targets whose folder is under results/laine (and
+# `results/keller`, `results/clamp`, `results/reference` likewise).
 if [ -z "$only" ]; then
   echo "== gibench reproduce all --quick --html"
   "$g" reproduce all --quick --html --out results
@@ -47,7 +47,7 @@ elif [ "$only" != baseline ]; then
 fi
 
 # Gaitatzes' two-wall transfer sweep (model and GPU): an example of its crate, not a gibench
-# command (README: "Voxel SH propagation").
+# command (results/gaitatzes/README.md).
 case "results/gaitatzes/transfer" in "results/$only"*) run_transfer=1 ;; *) [ -n "$only" ] && run_transfer=0 || run_transfer=1 ;; esac
 if [ "$run_transfer" = 1 ] && [ "$only" != baseline ]; then
   echo "== cargo run --release -p gibench-gaitatzes --example transfer -- results/gaitatzes/transfer"
@@ -65,7 +65,7 @@ for i in 1 2 3; do
 done
 # Barczak on the papers' large scenes (charts as patches): preparation time, peak memory and
 # error against the reference, one process per scene so that the peak is barczak's own
-# (README: "On any mesh").
+# (results/barczak-scenes/README.md).
 for s in sibenik sponza maze; do
   run results/barczak-scenes/$s run --scene $s --technique barczak --frames 3 --warmup 0 --timing stages --resolution 128x96 --quality --quiet --out results/barczak-scenes/$s
 done

@@ -450,8 +450,8 @@ fn table2(pairs: &[Pair]) -> Result<Table> {
         rows,
         notes: vec![
             "gibench rows: `laine`'s stages, medians over the measured frames, flushed per stage. The paper's split and \
-             combine were fragment passes over textures; gibench's are compute passes over storage buffers (see the \
-             README's deviations)."
+             combine were fragment passes over textures; gibench's are compute passes over storage buffers (see \
+             docs/deviations.md)."
                 .into(),
             format!("Paper rows: {}.", paper["source"].as_str().unwrap_or("")),
             device_note(&all),
