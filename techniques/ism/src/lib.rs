@@ -24,9 +24,10 @@
 //! (the kit's [`AtlasRasteriser`](gibench_harness::ir::raster::AtlasRasteriser), views written
 //! from the GPU store), 32-bit depth, as the `vpl-shadow-maps` stage.
 //!
-//! Deviations (README): points are splatted with a storage-buffer atomic, one texel each; the
-//! push takes the nearest parent; the strata of the VPL sampling are jittered once (fixed per
-//! VPL index); an area light's map is taken from its centre.
+//! Deviations (docs/deviations.md): points are splatted with a storage-buffer atomic, one
+//! texel each; the push takes the nearest parent; each VPL's point of the sampling is fixed per
+//! VPL index, and picks a row of the map, then a texel of it (`vpl-warp`); an area light's map
+//! is taken from its centre.
 //!
 //! Needs: compute shaders, storage buffers with atomics (GL ES 3.1 / Vulkan), no optional
 //! features.
