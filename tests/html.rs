@@ -53,6 +53,11 @@ fn url(page: &Path) -> String {
 
 /// The page's self-check verdict after loading it in Chromium.
 fn verdict(browser: &Path, page: &Path) -> String {
+    attribute(browser, page, "data-selfcheck")
+}
+
+/// The value of attribute `name` (written by the page's scripts) in the DOM Chromium dumps.
+fn attribute(browser: &Path, page: &Path, name: &str) -> String {
     let profile = tempfile::tempdir().unwrap();
     let o = Command::new(browser)
         .args(FLAGS)
@@ -62,12 +67,13 @@ fn verdict(browser: &Path, page: &Path) -> String {
         .output()
         .unwrap();
     let dom = String::from_utf8_lossy(&o.stdout);
-    let start = dom.find("data-selfcheck=\"").unwrap_or_else(|| {
+    let key = format!("{name}=\"");
+    let start = dom.find(&key).unwrap_or_else(|| {
         panic!(
-            "no self-check in the DOM Chromium dumped:\n{dom}\n{}",
+            "no {name} in the DOM Chromium dumped:\n{dom}\n{}",
             String::from_utf8_lossy(&o.stderr)
         )
-    }) + "data-selfcheck=\"".len();
+    }) + key.len();
     let end = dom[start..].find('"').unwrap() + start;
     dom[start..end].replace("&quot;", "\"")
 }
@@ -159,6 +165,31 @@ fn run_page_loads_clean_and_fails_on_a_broken_image_or_console_error() {
     assert!(!html.contains(env!("CARGO_BIN_EXE_gibench")));
     assert!(!html.contains("driver )") && !html.contains("driver ;"));
     assert_clean(&browser, &page);
+    // The frame player: each technique's film strip of the compared frames (two here) beside
+    // the reference's; advancing shows the next tile of every strip, and the strip's tiles are
+    // really different frames (the light moves between them).
+    for t in ["keller-full", "laine"] {
+        assert!(
+            html.contains(&format!("class=\"film\" src=\"cornell-{t}-frames.png\"")),
+            "{t}"
+        );
+        let strip = image::open(out.join(format!("cornell-{t}-frames.png")))
+            .unwrap()
+            .to_rgba8();
+        assert_eq!(
+            strip.dimensions(),
+            (2 * 64, 48),
+            "{t}: two 64x48 frames side by side"
+        );
+        let tile = |i: u32| image::imageops::crop_imm(&strip, 64 * i, 0, 64, 48).to_image();
+        assert_ne!(
+            tile(0),
+            tile(1),
+            "{t}: the strip's two frames are the same image"
+        );
+    }
+    assert!(html.contains("-reference-frames.png\""));
+    assert_eq!(attribute(&browser, &page, "data-players"), "ok 1");
     let shot = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("html-report/screenshot.png");
     screenshot(&browser, &page, &shot);
 
@@ -176,6 +207,17 @@ fn run_page_loads_clean_and_fails_on_a_broken_image_or_console_error() {
         v.starts_with("fail") && v.contains("cornell-laine-flip.png"),
         "{v}"
     );
+
+    // A player whose step does not advance: its check fails.
+    let stuck = broken.join("stuck.html");
+    let text = html.replace("show(+p.dataset.frame+1)", "show(+p.dataset.frame)");
+    assert_ne!(
+        text, html,
+        "the player's step is where this test expects it"
+    );
+    std::fs::write(&stuck, text).unwrap();
+    let v = attribute(&browser, &stuck, "data-players");
+    assert!(v.starts_with("fail") && v.contains("same tile"), "{v}");
 
     // A console error: the check fails and quotes it.
     let noisy = broken.join("noisy.html");

@@ -9,19 +9,22 @@
 //! Sections: the summary table and any further tables (a paper's rows beside ours), sortable
 //! by any column; per scene, an image viewer flipping or sliding between any two of the
 //! reference's and every technique's images (composed, and indirect light alone at one
-//! exposure), with the FLIP error maps; time versus error; the figures (per-stage bars,
+//! exposure), with the FLIP error maps, and a frame player stepping through every compared
+//! frame's indirect light beside the reference's; time versus error; the figures (per-stage bars,
 //! per-frame error and flicker, sweep plots); the device, driver, commit, command line and each
 //! run's settings.
 //!
 //! The page checks itself when it loads: every image must decode and no script error or
 //! `console.error` may occur; it records the outcome on its root element
-//! (`data-selfcheck="ok N"` for N images, else `fail …`), which `tests/html.rs` reads from
-//! headless Chromium.
+//! (`data-selfcheck="ok N"` for N images, else `fail …`), and whether every frame player
+//! advances to another tile of strips of the expected size (`data-players="ok N"`), which
+//! `tests/html.rs` reads from headless Chromium.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use crate::output::absolute;
+use crate::quality::FilmStrip;
 use crate::report::{self, Table};
 use crate::results::RunResult;
 use crate::session::QUALITY_IMAGES;
@@ -118,6 +121,16 @@ fn table_html(t: &Table) -> String {
         let _ = writeln!(h, "<p class=\"note\">{}</p>", esc(n));
     }
     h
+}
+
+/// One frame player of a scene: the runs compared on the same frames at the same size.
+struct Player {
+    frames: Vec<u32>,
+    size: [u32; 2],
+    /// (label, film strip URL): the references first met, then each technique, in run order.
+    rows: Vec<(String, String)>,
+    /// The reference components shown.
+    references: Vec<String>,
 }
 
 /// One image of a scene's viewer: its label and URL.
@@ -296,48 +309,7 @@ impl Page {
             } else {
                 h.push_str("<p class=\"note\">The last measured frame (run with --quality to compare with the reference).</p>\n");
             }
-            // A: the first image (the reference where there is one); B: the first technique's.
-            let a = 0;
-            let b = shots
-                .iter()
-                .position(|s| !s.label.starts_with("reference"))
-                .filter(|&i| i != a)
-                .unwrap_or(if shots.len() > 1 { 1 } else { 0 });
-            let options = |sel: usize| {
-                shots
-                    .iter()
-                    .enumerate()
-                    .map(|(i, s)| {
-                        format!(
-                            "<option value=\"{}\"{}>{}</option>",
-                            esc(&s.url),
-                            if i == sel { " selected" } else { "" },
-                            esc(&s.label)
-                        )
-                    })
-                    .collect::<String>()
-            };
-            let _ = writeln!(
-                h,
-                "<div class=\"viewer\" id=\"viewer{v}\">\n<div class=\"controls\">A <select class=\"pick-a\">{}</select> \
-                 B <select class=\"pick-b\">{}</select> <button class=\"swap\">flip A/B</button> \
-                 <input class=\"slider\" type=\"range\" min=\"0\" max=\"100\" value=\"50\" aria-label=\"A/B split\"></div>\n\
-                 <div class=\"stack\"><img class=\"img-a\" src=\"{}\" alt=\"A\"><img class=\"img-b\" src=\"{}\" alt=\"B\"></div>\n\
-                 <div class=\"strip\">{}</div>\n</div>",
-                options(a),
-                options(b),
-                esc(&shots[a].url),
-                esc(&shots[b].url),
-                shots
-                    .iter()
-                    .map(|s| format!(
-                        "<figure><img class=\"thumb\" src=\"{}\" alt=\"{}\"><figcaption>{}</figcaption></figure>",
-                        esc(&s.url),
-                        esc(&s.label),
-                        esc(&s.label)
-                    ))
-                    .collect::<String>()
-            );
+            h.push_str(&viewer(v, &shots));
             if !flips.is_empty() {
                 let _ = writeln!(
                     h,
@@ -356,6 +328,101 @@ impl Page {
                 }
                 h.push_str("</div>\n");
             }
+            h.push_str(&self.players(dir, scene, &all));
+        }
+        h
+    }
+
+    /// Per scene, the frame player: every compared frame's indirect light of each technique
+    /// beside the reference's (the quality pass's film strips), stepped or played, so that lag
+    /// and flicker can be seen. Runs compared on different frames get a player each.
+    fn players(&self, dir: &Path, scene: &str, all: &[RunResult]) -> String {
+        let mut groups: Vec<Player> = Vec::new();
+        for (folder, r) in self.runs.iter().filter(|(_, r)| r.scene == scene) {
+            let Some(q) = &r.quality else { continue };
+            let Some(stem) = r
+                .images
+                .iter()
+                .find_map(|i| i.strip_suffix(QUALITY_IMAGES[5]))
+                .filter(|s| !s.ends_with("-reference"))
+            else {
+                continue;
+            };
+            let frames: Vec<u32> = q.frames.iter().map(|f| f.frame).collect();
+            let reference_strip = format!("{stem}{}", QUALITY_IMAGES[6]);
+            if frames.len() < 2 || !r.images.contains(&reference_strip) {
+                continue;
+            }
+            let url = |name: &str| relative_url(dir, &folder.join(name));
+            let i = match groups
+                .iter()
+                .position(|g| g.frames == frames && g.size == r.resolution)
+            {
+                Some(i) => i,
+                None => {
+                    groups.push(Player {
+                        frames,
+                        size: r.resolution,
+                        rows: Vec::new(),
+                        references: Vec::new(),
+                    });
+                    groups.len() - 1
+                }
+            };
+            let g = &mut groups[i];
+            let component = q
+                .reference
+                .split(',')
+                .next()
+                .unwrap_or("")
+                .trim()
+                .to_string();
+            if !g.references.contains(&component) {
+                g.rows
+                    .push((format!("reference ({component})"), url(&reference_strip)));
+                g.references.push(component);
+            }
+            g.rows.push((
+                report::distinct_label(all, r),
+                url(&format!("{stem}{}", QUALITY_IMAGES[5])),
+            ));
+        }
+        let mut h = String::new();
+        for Player {
+            frames, size, rows, ..
+        } in &groups
+        {
+            let n = frames.len();
+            let columns = FilmStrip::columns(size[0], n);
+            // Shown 256 pixels wide, whatever the resolution.
+            let (w, hgt) = (256.0, 256.0 * size[1] as f64 / size[0].max(1) as f64);
+            let _ = writeln!(
+                h,
+                "<h3>Frames: {} (indirect light alone, every compared frame at the last one's exposure)</h3>\n\
+                 <div class=\"player\" data-frames=\"{}\" data-columns=\"{columns}\" data-tile-width=\"{w}\" \
+                 data-tile-height=\"{hgt:.3}\" data-strip-width=\"{}\" data-strip-height=\"{}\">\n\
+                 <div class=\"controls\"><button class=\"play\">play</button> <button class=\"step\">next frame</button> \
+                 <input class=\"scrub\" type=\"range\" min=\"0\" max=\"{}\" value=\"0\" aria-label=\"frame\"> \
+                 <span class=\"frame-label\">frame {} (1 of {n})</span></div>\n<div class=\"strip\">",
+                esc(scene),
+                frames.iter().map(|f| f.to_string()).collect::<Vec<_>>().join(","),
+                size[0] as usize * columns,
+                size[1] as usize * n.div_ceil(columns),
+                n - 1,
+                frames[0],
+            );
+            for (label, u) in rows {
+                let _ = write!(
+                    h,
+                    "<figure><div class=\"tile\" style=\"width:{w}px;height:{hgt:.3}px\"><img class=\"film\" src=\"{}\" \
+                     alt=\"{} frames\" style=\"width:{}px\"></div><figcaption>{}</figcaption></figure>",
+                    esc(u),
+                    esc(label),
+                    w * columns as f64,
+                    esc(label)
+                );
+            }
+            h.push_str("</div>\n</div>\n");
         }
         h
     }
@@ -449,6 +516,55 @@ pub fn write_index(path: &Path, title: &str, command: &str, entries: &[IndexEntr
     crate::error::write_atomic(path, html.as_bytes())
 }
 
+/// The A/B image viewer `v` of a scene over `shots` (A: the first image, the reference where
+/// there is one; B: the first technique's), with every image as a thumbnail.
+fn viewer(v: usize, shots: &[Shot]) -> String {
+    // A: the first image (the reference where there is one); B: the first technique's.
+    let a = 0;
+    let b = shots
+        .iter()
+        .position(|s| !s.label.starts_with("reference"))
+        .filter(|&i| i != a)
+        .unwrap_or(if shots.len() > 1 { 1 } else { 0 });
+    let options = |sel: usize| {
+        shots
+            .iter()
+            .enumerate()
+            .map(|(i, s)| {
+                format!(
+                    "<option value=\"{}\"{}>{}</option>",
+                    esc(&s.url),
+                    if i == sel { " selected" } else { "" },
+                    esc(&s.label)
+                )
+            })
+            .collect::<String>()
+    };
+    let mut h = String::new();
+    let _ = writeln!(
+                h,
+                "<div class=\"viewer\" id=\"viewer{v}\">\n<div class=\"controls\">A <select class=\"pick-a\">{}</select> \
+                 B <select class=\"pick-b\">{}</select> <button class=\"swap\">flip A/B</button> \
+                 <input class=\"slider\" type=\"range\" min=\"0\" max=\"100\" value=\"50\" aria-label=\"A/B split\"></div>\n\
+                 <div class=\"stack\"><img class=\"img-a\" src=\"{}\" alt=\"A\"><img class=\"img-b\" src=\"{}\" alt=\"B\"></div>\n\
+                 <div class=\"strip\">{}</div>\n</div>",
+                options(a),
+                options(b),
+                esc(&shots[a].url),
+                esc(&shots[b].url),
+                shots
+                    .iter()
+                    .map(|s| format!(
+                        "<figure><img class=\"thumb\" src=\"{}\" alt=\"{}\"><figcaption>{}</figcaption></figure>",
+                        esc(&s.url),
+                        esc(&s.label),
+                        esc(&s.label)
+                    ))
+                    .collect::<String>()
+            );
+    h
+}
+
 /// A relative path (with `/` separators) as a URL, each segment percent-encoded.
 fn url_of(relative: &str) -> String {
     relative
@@ -466,6 +582,7 @@ tr.paper td{background:#fff7e0;font-style:italic}.note{font-size:13px;color:#555
 .stack img{width:768px;image-rendering:pixelated}.img-b{position:absolute;left:0;top:0;clip-path:inset(0 0 0 50%)}\
 .strip{display:flex;flex-wrap:wrap;gap:8px}.strip figure{margin:0;font-size:12px;max-width:260px}\
 .thumb{width:256px;image-rendering:pixelated;cursor:pointer}img.plot{max-width:100%}.scroll{overflow-x:auto}\
+.tile{overflow:hidden;line-height:0}.tile img.film{max-width:none;image-rendering:pixelated}\
 dl.provenance{display:grid;grid-template-columns:max-content auto;gap:2px 12px;font-size:14px}dt{font-weight:bold}";
 
 /// Runs first: records script errors, `console.error` calls and images that fail to decode,
@@ -489,7 +606,23 @@ var pa=v.querySelector('.pick-a'),pb=v.querySelector('.pick-b'),s=v.querySelecto
 pa.addEventListener('change',function(){a.src=pa.value;});pb.addEventListener('change',function(){b.src=pb.value;});\
 s.addEventListener('input',function(){b.style.clipPath='inset(0 0 0 '+s.value+'%)';});\
 v.querySelector('.swap').addEventListener('click',function(){var t=pa.value;pa.value=pb.value;pb.value=t;a.src=pa.value;b.src=pb.value;});\
-v.querySelectorAll('.thumb').forEach(function(th){th.addEventListener('click',function(){pa.value=th.getAttribute('src');a.src=pa.value;});});});";
+v.querySelectorAll('.thumb').forEach(function(th){th.addEventListener('click',function(){pa.value=th.getAttribute('src');a.src=pa.value;});});});\
+var players=[];document.querySelectorAll('.player').forEach(function(p){var frames=p.dataset.frames.split(',');var n=frames.length;\
+var cols=+p.dataset.columns,w=+p.dataset.tileWidth,h=+p.dataset.tileHeight;var scrub=p.querySelector('.scrub'),label=p.querySelector('.frame-label');\
+var films=Array.prototype.slice.call(p.querySelectorAll('img.film'));var timer=null;\
+function show(i){i=((i%n)+n)%n;p.dataset.frame=i;scrub.value=i;label.textContent='frame '+frames[i]+' ('+(i+1)+' of '+n+')';\
+films.forEach(function(f){f.style.transform='translate('+(-(i%cols)*w)+'px,'+(-Math.floor(i/cols)*h)+'px)';});}\
+p.querySelector('.step').addEventListener('click',function(){show(+p.dataset.frame+1);});\
+scrub.addEventListener('input',function(){show(+scrub.value);});\
+p.querySelector('.play').addEventListener('click',function(e){if(timer){clearInterval(timer);timer=null;e.target.textContent='play';}\
+else{timer=setInterval(function(){show(+p.dataset.frame+1);},400);e.target.textContent='pause';}});\
+show(0);players.push({p:p,films:films,show:show,n:n,cols:cols});});\
+window.addEventListener('load',function(){var bad=[];players.forEach(function(q,k){\
+q.films.forEach(function(f){if(f.naturalWidth!=+q.p.dataset.stripWidth||f.naturalHeight!=+q.p.dataset.stripHeight)bad.push('player '+k+': '+f.getAttribute('src')+' is '+f.naturalWidth+'x'+f.naturalHeight);});\
+var before=q.films.map(function(f){return f.style.transform;});q.p.querySelector('.step').click();\
+var after=q.films.map(function(f){return f.style.transform;});\
+if(+q.p.dataset.frame!==1||before.some(function(t,j){return t===after[j];}))bad.push('player '+k+': the next frame shows the same tile');q.show(0);});\
+document.documentElement.setAttribute('data-players',bad.length?('fail '+JSON.stringify(bad)):('ok '+players.length));});";
 
 #[cfg(test)]
 mod tests {

@@ -406,10 +406,12 @@ pub struct CapturedFrame {
     pub radiance: Vec<Vec3>,
 }
 
-/// Images kept for a person to look at, all of the last compared frame (sRGB RGBA8): the
+/// Images kept for a person to look at (sRGB RGBA8). Of the last compared frame: the
 /// technique's composed image and the reference's at the scene's exposure, the FLIP map, and
 /// the indirect light alone (ρ/π · E_indirect) of both at one exposure derived from the
 /// reference ([`indirect_exposure`]), so every technique compared on the same frame shares it.
+/// Of every compared frame, in order: the indirect light alone of the technique and of the
+/// reference at that same exposure, as film strips ([`FilmStrip`]) that the HTML page plays.
 pub struct QualityImages {
     pub size: [u32; 2],
     pub compared_display: Vec<u8>,
@@ -417,6 +419,74 @@ pub struct QualityImages {
     pub flip_map: Vec<u8>,
     pub indirect_display: Vec<u8>,
     pub reference_indirect_display: Vec<u8>,
+    /// The compared frames' technique indirect images, tiled.
+    pub indirect_strip: FilmStrip,
+    /// The same frames' reference indirect images, tiled the same way.
+    pub reference_indirect_strip: FilmStrip,
+}
+
+/// Frames of one size tiled into one image, left to right and then top to bottom, in
+/// [`FilmStrip::columns`] columns: one file per run for the HTML page's frame player, which
+/// shows one tile at a time.
+pub struct FilmStrip {
+    /// The whole image's size.
+    pub size: [u32; 2],
+    /// sRGB RGBA8, row-major.
+    pub rgba: Vec<u8>,
+}
+
+impl FilmStrip {
+    /// The widest a strip grows before it wraps (pixels): wide enough for a row of frames at
+    /// the default resolutions, small enough for every browser and image viewer.
+    pub const MAX_WIDTH: u32 = 8192;
+
+    /// The number of columns a strip of `frames` tiles `width` pixels wide is laid out in (the
+    /// HTML page computes the same from the run's resolution and frame count).
+    pub fn columns(width: u32, frames: usize) -> usize {
+        (Self::MAX_WIDTH / width.max(1)).clamp(1, frames.max(1) as u32) as usize
+    }
+
+    /// `tiles` (each `tile` in size, RGBA8) tiled in [`FilmStrip::columns`] columns; unused
+    /// cells of the last row are transparent.
+    pub fn tile(tile: [u32; 2], tiles: &[Vec<u8>]) -> FilmStrip {
+        let columns = Self::columns(tile[0], tiles.len());
+        let rows = tiles.len().div_ceil(columns).max(1);
+        let size = [tile[0] * columns as u32, tile[1] * rows as u32];
+        let row_bytes = 4 * tile[0] as usize;
+        let mut rgba = vec![0u8; 4 * size[0] as usize * size[1] as usize];
+        for (i, t) in tiles.iter().enumerate() {
+            let (cx, cy) = (i % columns, i / columns);
+            for y in 0..tile[1] as usize {
+                let dst =
+                    ((cy * tile[1] as usize + y) * size[0] as usize + cx * tile[0] as usize) * 4;
+                rgba[dst..dst + row_bytes].copy_from_slice(&t[y * row_bytes..(y + 1) * row_bytes]);
+            }
+        }
+        FilmStrip { size, rgba }
+    }
+}
+
+/// `rgb` (sRGB8 triples) with an opaque alpha channel.
+fn opaque_rgba(rgb: &[u8]) -> Vec<u8> {
+    rgb.chunks_exact(3)
+        .flat_map(|p| [p[0], p[1], p[2], 255])
+        .collect()
+}
+
+/// The indirect light alone, ρ/π · `e`, over the reference's hits (black elsewhere).
+fn indirect_radiance(r: &ReferenceImages, e: &[Vec3]) -> Vec<Vec3> {
+    r.hit
+        .iter()
+        .zip(&r.albedo)
+        .zip(e)
+        .map(|((h, a), e)| {
+            if *h {
+                *a * std::f32::consts::FRAC_1_PI * *e
+            } else {
+                Vec3::ZERO
+            }
+        })
+        .collect()
 }
 
 /// The exposure that puts the 99th percentile of the reference's indirect radiance (the
@@ -481,35 +551,33 @@ pub fn compare(
             temporal,
         });
         if i + 1 == captured.len() {
-            let rgba = |rgb: &[u8]| {
-                rgb.chunks_exact(3)
-                    .flat_map(|p| [p[0], p[1], p[2], 255])
-                    .collect::<Vec<u8>>()
-            };
-            // Indirect light alone: ρ/π · E over the reference's hits.
-            let indirect = |e: &[Vec3]| -> Vec<Vec3> {
-                r.hit
-                    .iter()
-                    .zip(&r.albedo)
-                    .zip(e)
-                    .map(|((h, a), e)| {
-                        if *h {
-                            *a * std::f32::consts::FRAC_1_PI * *e
-                        } else {
-                            Vec3::ZERO
-                        }
-                    })
-                    .collect()
-            };
-            let (test_ind, ref_ind) = (indirect(&c.indirect), indirect(component));
+            let (test_ind, ref_ind) = (
+                indirect_radiance(r, &c.indirect),
+                indirect_radiance(r, component),
+            );
             let k = indirect_exposure(&ref_ind, &r.hit);
+            // Every compared frame's indirect light at this frame's exposure, so that a change
+            // of brightness from frame to frame shows.
+            let strip = |image: &dyn Fn(usize) -> Vec<Vec3>| {
+                let tiles: Vec<Vec<u8>> = (0..captured.len())
+                    .map(|j| opaque_rgba(&metrics::tonemap_srgb8(&image(j), k)))
+                    .collect();
+                FilmStrip::tile(size, &tiles)
+            };
+            let component_of = config.component();
             images = Some(QualityImages {
                 size,
-                compared_display: rgba(&test8),
-                reference_display: rgba(&ref8),
+                compared_display: opaque_rgba(&test8),
+                reference_display: opaque_rgba(&ref8),
                 flip_map: metrics::flip_error_png(&flip, size),
-                indirect_display: rgba(&metrics::tonemap_srgb8(&test_ind, k)),
-                reference_indirect_display: rgba(&metrics::tonemap_srgb8(&ref_ind, k)),
+                indirect_display: opaque_rgba(&metrics::tonemap_srgb8(&test_ind, k)),
+                reference_indirect_display: opaque_rgba(&metrics::tonemap_srgb8(&ref_ind, k)),
+                indirect_strip: strip(&|j| {
+                    indirect_radiance(&references[j], &captured[j].indirect)
+                }),
+                reference_indirect_strip: strip(&|j| {
+                    indirect_radiance(&references[j], component_of.of(&references[j]))
+                }),
             });
         }
     }

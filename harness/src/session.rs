@@ -20,16 +20,19 @@ use crate::scene::Scene;
 use crate::technique::{Params, TechniqueInfo};
 use crate::{Error, Result};
 
-/// The quality pass's images, by file-name suffix after the run's stem, all of the last
-/// compared frame ([`crate::quality::QualityImages`]): the technique's composed image, the
-/// reference's, the FLIP error map, and the indirect light alone of the technique and of the
-/// reference at one shared exposure.
-pub const QUALITY_IMAGES: [&str; 5] = [
+/// The quality pass's images, by file-name suffix after the run's stem
+/// ([`crate::quality::QualityImages`]). Of the last compared frame: the technique's composed
+/// image, the reference's, the FLIP error map, and the indirect light alone of the technique
+/// and of the reference at one shared exposure. Then the film strips of every compared frame's
+/// indirect light, the technique's and the reference's, which the HTML page's player shows.
+pub const QUALITY_IMAGES: [&str; 7] = [
     "-compared.png",
     "-reference.png",
     "-flip.png",
     "-indirect.png",
     "-reference-indirect.png",
+    "-frames.png",
+    "-reference-frames.png",
 ];
 
 /// The run's own images, by file-name suffix after its stem: the composed image, the indirect
@@ -211,6 +214,14 @@ fn execute_one(
             ] {
                 let png = out(suffix);
                 write_png(&png, qimages.size, rgba)?;
+                extra_images.push(file_name(&png));
+            }
+            for (suffix, strip) in [
+                (QUALITY_IMAGES[5], &qimages.indirect_strip),
+                (QUALITY_IMAGES[6], &qimages.reference_indirect_strip),
+            ] {
+                let png = out(suffix);
+                write_png(&png, strip.size, &strip.rgba)?;
                 extra_images.push(file_name(&png));
             }
         }
