@@ -35,47 +35,30 @@
 
 pub mod domain;
 mod lec;
+mod params;
+
+pub use params::LaineParams;
 
 use domain::{DomainKind, SamplingDomain};
 use gibench_harness::anim::LightPose;
 use gibench_harness::bvh::SceneBvh;
 use gibench_harness::glam::Vec3;
-use gibench_harness::ir::gather::{GatherParams, VplGather, GATHER_PARAMS};
+use gibench_harness::ir::gather::{VplGather, GATHER_PARAMS};
 use gibench_harness::ir::raster::AtlasClear;
 use gibench_harness::light::SampleDomain;
 use gibench_harness::passes::DrawSet;
 use gibench_harness::scene::Scene;
 use gibench_harness::technique::{
-    prepare_nothing, Conformance, FrameContext, ParamKind, ParamSpec, Params, PrepareContext,
-    Prepared, Technique, TechniqueInfo,
+    prepare_nothing, Conformance, FrameContext, Params, PrepareContext, Prepared, Technique,
+    TechniqueInfo,
 };
 use gibench_harness::vpl::{self, Vpl};
-use gibench_harness::{wgpu, Error, Result};
+use gibench_harness::{wgpu, Result};
+use params::OWN_PARAMS;
 use rayon::prelude::*;
 
 /// Stage: the CPU VPL management of §4 (validity, deletion, creation, intensities).
 pub const STAGE_VPL_MANAGEMENT: &str = "vpl-management";
-
-const OWN_PARAMS: &[ParamSpec] = &[
-    ParamSpec {
-        name: "vpls",
-        kind: ParamKind::Int { min: 1, max: 4096 },
-        default: "64",
-        doc: "VPLs lighting each frame, at most (Laine's maxLights: 256); fewer while sampling points miss the scene",
-    },
-    ParamSpec {
-        name: "recalc-min",
-        kind: ParamKind::Int { min: 0, max: 4096 },
-        default: "4",
-        doc: "VPLs deleted each frame at least (free slots kept), the least-useful first",
-    },
-    ParamSpec {
-        name: "recalc-max",
-        kind: ParamKind::Int { min: 1, max: 4096 },
-        default: "8",
-        doc: "new sampling points (and shadow maps) per frame at most",
-    },
-];
 
 /// `laine` registry entry.
 pub const INFO: TechniqueInfo = TechniqueInfo {
@@ -94,48 +77,6 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     prepare: prepare_nothing,
     create,
 };
-
-/// `laine`'s parameters, read once.
-#[derive(Clone, Copy, Debug)]
-pub struct LaineParams {
-    pub max_lights: u32,
-    pub recalc_min: u32,
-    pub recalc_max: u32,
-    pub gather: GatherParams,
-}
-
-impl LaineParams {
-    /// Reads and cross-checks the parameters: `recalc-min` above `recalc-max` would delete
-    /// more VPLs each frame than it may create, and `recalc-min` at or above `vpls` would
-    /// delete every VPL; both drain the VPL count, so both are errors.
-    pub fn from_params(params: &Params) -> Result<LaineParams> {
-        let p = LaineParams {
-            max_lights: params.int("vpls") as u32,
-            recalc_min: params.int("recalc-min") as u32,
-            recalc_max: params.int("recalc-max") as u32,
-            gather: GatherParams::from_params(params)?,
-        };
-        if p.recalc_min > p.recalc_max {
-            return Err(Error::param(
-                "laine.recalc-min",
-                format!(
-                    "{} is above recalc-max ({}): more VPLs would be deleted each frame than created",
-                    p.recalc_min, p.recalc_max
-                ),
-            ));
-        }
-        if p.recalc_min >= p.max_lights {
-            return Err(Error::param(
-                "laine.recalc-min",
-                format!(
-                    "{} must be below vpls ({}): every VPL would be deleted each frame",
-                    p.recalc_min, p.max_lights
-                ),
-            ));
-        }
-        Ok(p)
-    }
-}
 
 /// A managed VPL.
 #[derive(Clone, Copy, Debug)]
