@@ -32,6 +32,10 @@
 //! and is timed as its own CPU stage (the paper overlapped it with GPU work with a one-frame
 //! delay; the `vpl-management` stage shows what that overlap hides). Area lights are managed as
 //! spot lights at their centre.
+//!
+//! Layout: `params` (the parameters), `manager` (the per-frame management, one phase per
+//! step), [`domain`] (the sampling points and their triangulation), `lec` (the kept
+//! largest-empty-circle candidates); this file holds the registry entry and the technique.
 
 pub mod domain;
 mod lec;
