@@ -32,7 +32,7 @@ use gibench_harness::{Error, Result};
 use super::{
     device_note, load_scene, ms, paper_cells, sum_ms, PaperModule, ReproduceArgs, Reproduction,
 };
-use crate::Bars;
+use crate::cli::progress::Bars;
 use gibench_harness::gpu::GpuContext;
 
 /// The module's entry for `reproduce all`.
@@ -186,7 +186,7 @@ pub fn runs_folder(args: &ReproduceArgs) -> std::path::PathBuf {
 fn paper() -> Result<serde_json::Value> {
     super::paper(
         "laine2007",
-        include_str!("../../results/papers/laine2007.json"),
+        include_str!("../../../results/papers/laine2007.json"),
     )
 }
 
@@ -291,7 +291,7 @@ fn run_pairs(args: &ReproduceArgs, gpu: Option<&GpuContext>, bars: &Bars) -> Res
     let gpu = super::gpu_or_open(gpu, args, &mut opened)?;
     let mut out = Vec::new();
     for (name, res, spec) in &specs {
-        let mut results = crate::execute_with_bar(bars, gpu, spec)?;
+        let mut results = crate::cli::progress::execute_with_bar(bars, gpu, spec)?;
         let keller = results.pop().expect("two runs");
         let laine = results.pop().expect("two runs");
         out.push((name.clone(), *res, laine, keller));

@@ -40,7 +40,7 @@ use gibench_harness::technique::TechniqueInfo;
 use gibench_harness::{Error, Result};
 
 use super::{device_note, ms, sum_ms, PaperModule, ReproduceArgs, Reproduced};
-use crate::Bars;
+use crate::cli::progress::Bars;
 
 /// The module's entry for `reproduce all`.
 pub const MODULE: PaperModule = PaperModule {
@@ -72,7 +72,7 @@ pub fn describe(_: &str) -> &'static str {
 fn paper() -> Result<serde_json::Value> {
     super::paper(
         "barczak2006",
-        include_str!("../../results/papers/barczak2006.json"),
+        include_str!("../../../results/papers/barczak2006.json"),
     )
 }
 

@@ -28,7 +28,7 @@ use gibench_ism::{STAGE_POINT_SPLAT, STAGE_PULL_PUSH, STAGE_RSM, STAGE_VPL_SAMPL
 use gibench_keller::STAGE_VPL_GENERATION;
 
 use super::{device_note, load_scene, ms, sum_ms, PaperModule, ReproduceArgs, Reproduction};
-use crate::Bars;
+use crate::cli::progress::Bars;
 use gibench_harness::gpu::GpuContext;
 
 /// The module's entry for `reproduce all`.
@@ -209,14 +209,17 @@ pub fn reproduce(
     spec.validate()?;
     let mut opened = None;
     let gpu = super::gpu_or_open(gpu, args, &mut opened)?;
-    let runs = crate::execute_with_bar(bars, gpu, &spec)?;
+    let runs = crate::cli::progress::execute_with_bar(bars, gpu, &spec)?;
     let table = breakdown(args, &scene, &runs)?;
     Ok((vec![(table, "ism-breakdown")], runs))
 }
 
 /// The published figures.
 fn paper() -> Result<serde_json::Value> {
-    super::paper("ism2008", include_str!("../../results/papers/ism2008.json"))
+    super::paper(
+        "ism2008",
+        include_str!("../../../results/papers/ism2008.json"),
+    )
 }
 
 /// The time a run spends making its VPLs' maps: `ism`'s splat and pull-push, the others'

@@ -31,7 +31,7 @@ use gibench_harness::technique::TechniqueInfo;
 use gibench_harness::{Error, Result};
 
 use super::{device_note, load_scene, ms, PaperModule, ReproduceArgs, Reproduced};
-use crate::Bars;
+use crate::cli::progress::Bars;
 
 /// The module's entry for `reproduce all`.
 pub const MODULE: PaperModule = PaperModule {
@@ -108,7 +108,7 @@ pub const CORNELL_STEPS: [CornellStep; 5] = [
 fn paper() -> Result<serde_json::Value> {
     super::paper(
         "gaitatzes2010",
-        include_str!("../../results/papers/gaitatzes2010.json"),
+        include_str!("../../../results/papers/gaitatzes2010.json"),
     )
 }
 

@@ -12,11 +12,13 @@
 //! * [`all`]: every paper table, figure and sweep (`gibench reproduce all`), and the sweeps
 //!   that are gibench commands (Keller's and Laine's tile, VPL and clamp sweeps, the lag and
 //!   quality runs, the reference) as targets of their own.
+//! * [`job`]: a run, sweep or reference command checked and run as a target of `reproduce`.
 
 pub mod all;
 pub mod barczak2006;
 pub mod gaitatzes2010;
 pub mod ism2008;
+pub(crate) mod job;
 pub mod laine2007;
 
 use std::path::PathBuf;
@@ -28,6 +30,8 @@ use gibench_harness::report::{Cell, Table};
 use gibench_harness::results::RunResult;
 use gibench_harness::scene::{Scene, SceneDescriptor};
 use gibench_harness::{Error, Result};
+
+use super::progress::{execute_with_bar, Bars};
 
 #[derive(Args, Clone)]
 pub struct ReproduceArgs {
@@ -97,7 +101,7 @@ pub struct PaperModule {
     pub needs_gpu: fn(&str) -> bool,
     /// Regenerates the target on `gpu` (opened by the module if `None`): its tables and the
     /// runs behind them.
-    pub reproduce: fn(&str, &ReproduceArgs, Option<&GpuContext>, &crate::Bars) -> Reproduced,
+    pub reproduce: fn(&str, &ReproduceArgs, Option<&GpuContext>, &Bars) -> Reproduced,
     /// The folder of the runs behind the tables.
     pub runs_folder: fn(&ReproduceArgs) -> PathBuf,
     /// The figures (SVG) the target writes beside its tables into the output folder.
@@ -145,7 +149,7 @@ pub fn run_specs(
     specs: &[gibench_harness::session::RunSpec],
     args: &ReproduceArgs,
     gpu: Option<&GpuContext>,
-    bars: &crate::Bars,
+    bars: &Bars,
 ) -> Result<Vec<RunResult>> {
     for s in specs {
         s.validate()?;
@@ -154,7 +158,7 @@ pub fn run_specs(
     let gpu = gpu_or_open(gpu, args, &mut opened)?;
     let mut runs = Vec::new();
     for s in specs {
-        runs.extend(crate::execute_with_bar(bars, gpu, s)?);
+        runs.extend(execute_with_bar(bars, gpu, s)?);
     }
     Ok(runs)
 }
@@ -230,7 +234,7 @@ pub fn out_dir(args: &ReproduceArgs, dir: &str) -> PathBuf {
 }
 
 /// Runs `args.target` (one target, or `all`) and writes its files.
-pub fn reproduce(args: &ReproduceArgs) -> Result<()> {
+pub fn exec(args: &ReproduceArgs) -> Result<()> {
     if args.frames == Some(0) {
         // Statistics of no samples are not a table.
         return Err(Error::param(
@@ -239,7 +243,7 @@ pub fn reproduce(args: &ReproduceArgs) -> Result<()> {
         ));
     }
     if let Some(frames) = args.frames {
-        crate::check_frame_number("frames", frames)?;
+        super::params::check_frame_number("frames", frames)?;
     }
     all::reproduce(args)
 }

@@ -63,10 +63,10 @@ fn ply(positions: &[[f32; 3]], tris: &[[u32; 3]]) -> Vec<u8> {
     out
 }
 
-pub(crate) fn export_scene(args: &ExportArgs) -> Result<()> {
-    let resolution = crate::parse_resolution(&args.resolution)?;
+pub(crate) fn exec(args: &ExportArgs) -> Result<()> {
+    let resolution = super::params::parse_resolution(&args.resolution)?;
     gibench_harness::runner::check_resolution(resolution)?;
-    crate::check_frame_number("frame", args.frame)?;
+    super::params::check_frame_number("frame", args.frame)?;
     if args.rays > crate::rays::MAX_RAYS {
         return Err(Error::param(
             "rays",
@@ -80,7 +80,7 @@ pub(crate) fn export_scene(args: &ExportArgs) -> Result<()> {
     }
     let desc = SceneDescriptor::resolve(&args.scene)?;
     let scene = Scene::load(&desc, &AssetPaths::standard(args.assets.as_deref()))?;
-    crate::writable_dir("out", &args.out)?;
+    super::files::writable_dir("out", &args.out)?;
     let frame = gibench_harness::anim::FrameClock::new(&desc).frame(args.frame);
     let mesh = gibench_harness::reference::frame_mesh(&scene, &frame);
     // Triangles per material (a triangle's material is its first vertex's), each with its

@@ -1,0 +1,116 @@
+//! `gibench compare`: CURRENT runs against BASE runs stage by stage, with a noise band and a
+//! verdict, refusing to compare runs with themselves.
+
+use std::path::{Path, PathBuf};
+
+use clap::Args;
+use gibench_harness::output::OutputSet;
+use gibench_harness::report;
+use gibench_harness::results::RunResult;
+use gibench_harness::{Error, Result};
+
+use super::files::check_stem;
+use super::results_io::results_under;
+
+#[derive(Args)]
+pub(crate) struct CompareArgs {
+    /// Folder of the BASE runs (searched recursively for results files; one subfolder per repeat).
+    base: PathBuf,
+    /// Folder of the CURRENT runs, likewise.
+    current: PathBuf,
+    /// Relative change a verdict needs beyond the band: slower when every pairing is above
+    /// 1 + tolerance (0.25 keeps a shared CPU's run-to-run noise from deciding).
+    #[arg(long, default_value_t = 0.25)]
+    tolerance: f64,
+    /// Output directory for the comparison (Markdown, CSV, LaTeX, JSON).
+    #[arg(long, default_value = "results/local")]
+    out: PathBuf,
+    /// File name stem of the outputs.
+    #[arg(long, default_value = "compare")]
+    stem: String,
+}
+
+/// `gibench compare`: reads both sides, compares, prints and writes the table and JSON.
+pub(crate) fn exec(args: &CompareArgs) -> Result<()> {
+    check_stem(&args.stem)?;
+    let base = results_under("base", &args.base)?;
+    let current = results_under("current", &args.current)?;
+    check_distinct_runs(args, &base, &current)?;
+    let (base, current): (Vec<RunResult>, Vec<RunResult>) = (
+        base.into_iter().map(|(_, r)| r).collect(),
+        current.into_iter().map(|(_, r)| r).collect(),
+    );
+    let rows = gibench_harness::compare::compare(&base, &current, args.tolerance)?;
+    let table = gibench_harness::compare::compare_table(&rows, args.tolerance);
+    println!("{}", table.to_terminal());
+    let set = OutputSet::begin("out", &args.out)?;
+    report::write_tables(&table, &args.out, &args.stem)?;
+    let json = serde_json::to_vec_pretty(&rows).map_err(|e| Error::Invalid(e.to_string()))?;
+    gibench_harness::error::write_atomic(&args.out.join(format!("{}.json", args.stem)), &json)?;
+    set.publish()?;
+    eprintln!(
+        "wrote {stem}.md, .csv, .tex and .json to {}",
+        args.out.display(),
+        stem = args.stem
+    );
+    Ok(())
+}
+
+/// Refuses a comparison of runs with themselves: BASE and CURRENT the same folder, a results
+/// file reached from both sides or twice from one (through a link), or two byte-identical
+/// copies of one run (counted as two repeats, a copy would narrow the noise band falsely).
+fn check_distinct_runs(
+    args: &CompareArgs,
+    base: &[(PathBuf, RunResult)],
+    current: &[(PathBuf, RunResult)],
+) -> Result<()> {
+    let folder = |p: &Path| p.canonicalize().map_err(|e| Error::io(p, e));
+    if folder(&args.base)? == folder(&args.current)? {
+        return Err(Error::param(
+            "current",
+            format!(
+                "{} is the same folder as BASE ({}); compare needs two different sets of runs",
+                args.current.display(),
+                args.base.display()
+            ),
+        ));
+    }
+    let side = |i: usize| if i < base.len() { "BASE" } else { "CURRENT" };
+    // Each file's canonical path and a hash of its bytes; equal hashes are confirmed on the bytes.
+    let mut seen: Vec<(PathBuf, u64, &Path)> = Vec::new();
+    for (i, (path, _)) in base.iter().chain(current).enumerate() {
+        let canonical = folder(path)?;
+        let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+        let hash = {
+            use std::hash::{Hash, Hasher};
+            let mut h = std::hash::DefaultHasher::new();
+            bytes.hash(&mut h);
+            h.finish()
+        };
+        for (j, (c, other_hash, other)) in seen.iter().enumerate() {
+            let same_file = *c == canonical;
+            let same_bytes = !same_file
+                && *other_hash == hash
+                && std::fs::read(other).map_err(|e| Error::io(*other, e))? == bytes;
+            if same_file || same_bytes {
+                return Err(Error::bad_file(
+                    path,
+                    format!(
+                        "in {}, {} {} in {}; compare needs distinct runs (every repeat run anew, \
+                         BASE and CURRENT different folders)",
+                        side(i),
+                        if same_file {
+                            "the same file as"
+                        } else {
+                            "a byte-identical copy of"
+                        },
+                        other.display(),
+                        side(j)
+                    ),
+                ));
+            }
+        }
+        seen.push((canonical, hash, path));
+    }
+    Ok(())
+}

@@ -1,0 +1,78 @@
+//! Option groups several commands flatten into their arguments: the CPU reference's settings
+//! and cache ([`ReferenceOpts`]) and the adapter choice ([`GpuArgs`]).
+
+use std::path::PathBuf;
+
+use clap::Args;
+use gibench_harness::quality::ReferenceCache;
+use gibench_harness::reference::ReferenceSettings;
+use gibench_harness::{Error, Result};
+
+#[derive(Args, Clone)]
+pub(crate) struct ReferenceOpts {
+    /// Reference samples per pixel (cosine-weighted hemisphere paths at each visible point).
+    #[arg(long = "spp", default_value_t = ReferenceSettings::default().spp)]
+    pub(crate) spp: u32,
+    /// Reference bounce limit for the multi-bounce image.
+    #[arg(long = "bounces", default_value_t = ReferenceSettings::default().bounces)]
+    pub(crate) bounces: u32,
+    /// Reference seed.
+    #[arg(long = "reference-seed", default_value_t = ReferenceSettings::default().seed)]
+    pub(crate) reference_seed: u64,
+    /// Directory of the reference cache.
+    #[arg(long, default_value = "results/cache")]
+    pub(crate) cache: PathBuf,
+    /// Do not read or write the reference cache.
+    #[arg(long)]
+    pub(crate) no_cache: bool,
+}
+
+/// The most reference samples per pixel a command takes (at 256x192 and 8 bounces, hours on
+/// two cores already).
+const MAX_SPP: u32 = 1 << 16;
+/// The most reference bounces a command takes.
+const MAX_BOUNCES: u32 = 64;
+
+impl ReferenceOpts {
+    pub(crate) fn settings(&self) -> Result<ReferenceSettings> {
+        if !(1..=MAX_SPP).contains(&self.spp) {
+            return Err(Error::param(
+                "spp",
+                format!(
+                    "expected 1..={MAX_SPP} samples per pixel (got {})",
+                    self.spp
+                ),
+            ));
+        }
+        if !(1..=MAX_BOUNCES).contains(&self.bounces) {
+            return Err(Error::param(
+                "bounces",
+                format!("expected 1..={MAX_BOUNCES} bounces (got {})", self.bounces),
+            ));
+        }
+        Ok(ReferenceSettings {
+            spp: self.spp,
+            bounces: self.bounces,
+            seed: self.reference_seed,
+        })
+    }
+    pub(crate) fn cache(&self) -> ReferenceCache {
+        ReferenceCache {
+            dir: (!self.no_cache).then(|| self.cache.clone()),
+        }
+    }
+}
+
+#[derive(Args, Clone)]
+pub(crate) struct GpuArgs {
+    /// Restrict the adapter to one backend: vulkan, gl, metal or dx12.
+    #[arg(long, env = "GIBENCH_BACKEND")]
+    pub(crate) backend: Option<String>,
+    /// Use the adapter whose name contains this (case-insensitive).
+    #[arg(long, env = "GIBENCH_ADAPTER")]
+    pub(crate) adapter: Option<String>,
+    /// Fail when the GPU takes longer than this many seconds over one submission (default:
+    /// wait as long as the work takes; a note is printed after 30 s).
+    #[arg(long, env = "GIBENCH_GPU_TIMEOUT", value_name = "SECONDS")]
+    pub(crate) gpu_timeout: Option<f64>,
+}

@@ -1,0 +1,51 @@
+//! The HTML page a command writes with `--html` ([`gibench_harness::html`]): its command line,
+//! the runs with their folders, and the line pointing the user at it.
+
+use std::path::{Path, PathBuf};
+
+use gibench_harness::report;
+use gibench_harness::results::RunResult;
+use gibench_harness::Result;
+
+/// The runs paired with the folder they were written to.
+pub(crate) fn with_folder(dir: &Path, results: Vec<RunResult>) -> Vec<(PathBuf, RunResult)> {
+    results
+        .into_iter()
+        .map(|r| (dir.to_path_buf(), r))
+        .collect()
+}
+
+/// This command as a user would type it: `gibench` and its arguments (not the executable's
+/// path on this machine, which names a user's folders and means nothing elsewhere).
+pub(crate) fn command_line() -> String {
+    std::iter::once("gibench".to_string())
+        .chain(std::env::args().skip(1))
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// Writes an HTML page ([`gibench_harness::html`]) with this process's command line.
+pub(crate) fn write_page(
+    path: &Path,
+    title: String,
+    tables: Vec<report::Table>,
+    figures: Vec<PathBuf>,
+    runs: Vec<(PathBuf, RunResult)>,
+) -> Result<()> {
+    gibench_harness::html::Page {
+        title,
+        command: command_line(),
+        tables,
+        figures,
+        runs,
+    }
+    .write(path)
+}
+
+/// "\nreport: PATH (open it in a browser)", the page's path made absolute.
+pub(crate) fn page_line(page: &Path) -> String {
+    let shown = std::env::current_dir()
+        .map(|d| d.join(page))
+        .unwrap_or_else(|_| page.to_path_buf());
+    format!("\nreport: {} (open it in a browser)", shown.display())
+}

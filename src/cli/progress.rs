@@ -1,0 +1,99 @@
+//! Progress bars and where a command reports: a bar of its own, or its share of `gibench
+//! reproduce all`'s ([`Bars`]); and the typed runs executed under them.
+
+use gibench_harness::gpu::GpuContext;
+use gibench_harness::report;
+use gibench_harness::results::RunResult;
+use gibench_harness::session::{self, Progress, RunSpec};
+use gibench_harness::Result;
+
+use super::reproduce;
+
+/// Runs `spec` with a progress bar (hidden when `quiet`).
+pub(crate) fn execute_with_bar(
+    bars: &Bars,
+    gpu: &GpuContext,
+    spec: &RunSpec,
+) -> Result<Vec<RunResult>> {
+    execute_skipping_with_bar(bars, gpu, spec, false).map(|(results, _)| results)
+}
+
+/// [`execute_with_bar`] leaving out, with `skip_unfit`, the techniques that cannot take the
+/// scene or the device ([`session::execute_skipping`]); each is named with its reason.
+pub(crate) fn execute_skipping_with_bar(
+    bars: &Bars,
+    gpu: &GpuContext,
+    spec: &RunSpec,
+    skip_unfit: bool,
+) -> Result<(Vec<RunResult>, Vec<session::Skipped>)> {
+    let executed = match bars {
+        Bars::Own(quiet) => {
+            let bar = progress_bar(*quiet, spec.total_frames());
+            let executed = session::execute_skipping(gpu, spec, skip_unfit, &mut |p| match p {
+                Progress::Technique(name) => bar.set_message(name.to_string()),
+                Progress::Frame => bar.inc(1),
+            });
+            bar.finish_and_clear();
+            executed
+        }
+        Bars::Shared(all) => session::execute_skipping(gpu, spec, skip_unfit, &mut |p| match p {
+            Progress::Technique(name) => all.technique(name),
+            Progress::Frame => all.frame(),
+        }),
+    };
+    if let Ok((results, skipped)) = &executed {
+        for s in skipped {
+            bars.note(&format!(
+                "skipped {} on {}: {}",
+                s.technique, spec.scene.descriptor.name, s.reason
+            ));
+        }
+        for r in results {
+            for w in &r.warnings {
+                bars.note(&format!("warning: {} on {}: {w}", r.technique, r.scene));
+            }
+        }
+    }
+    executed
+}
+
+/// Where a command reports its progress: a bar of its own (hidden when quiet), or its share of
+/// `gibench reproduce all`'s bar.
+pub(crate) enum Bars<'a> {
+    Own(bool),
+    Shared(&'a reproduce::all::Overall),
+}
+
+impl Bars<'_> {
+    /// A line for the terminal (above the shared bar, not through it).
+    pub(crate) fn note(&self, line: &str) {
+        match self {
+            Bars::Own(_) => eprintln!("{line}"),
+            Bars::Shared(all) => all.note(line),
+        }
+    }
+
+    /// A result table for the terminal: printed by a command of its own; under `reproduce all`
+    /// it is in the files only.
+    pub(crate) fn table(&self, table: &report::Table) {
+        if let Bars::Own(_) = self {
+            println!("{}", table.to_terminal());
+        }
+    }
+}
+
+/// A bar of `total` frames with the technique running as its message (hidden when `quiet`).
+pub(crate) fn progress_bar(quiet: bool, total: u64) -> indicatif::ProgressBar {
+    let bar = if quiet {
+        indicatif::ProgressBar::hidden()
+    } else {
+        indicatif::ProgressBar::new(total)
+    };
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{msg:>24} [{bar:30}] {pos}/{len} frames ({elapsed})",
+        )
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    bar
+}

@@ -1,0 +1,66 @@
+//! `gibench report`: tables (Markdown, CSV, LaTeX), a stacked-bar SVG and optionally an HTML
+//! page from results files.
+
+use std::path::PathBuf;
+
+use clap::Args;
+use gibench_harness::output::OutputSet;
+use gibench_harness::report;
+use gibench_harness::results::RunResult;
+use gibench_harness::Result;
+
+use super::files::check_stem;
+use super::page::{page_line, write_page};
+use super::results_io::read_results_with_folders;
+
+#[derive(Args)]
+pub(crate) struct ReportArgs {
+    /// Results JSON files (or directories holding them).
+    #[arg(required = true)]
+    inputs: Vec<PathBuf>,
+    /// Output directory for the tables and the plot.
+    #[arg(long, default_value = "results/local")]
+    out: PathBuf,
+    /// File name stem of the outputs.
+    #[arg(long, default_value = "report")]
+    stem: String,
+    /// Also print full statistics (median, mean, p5, p95, min, max) per stage.
+    #[arg(long)]
+    detailed: bool,
+    /// Also write an HTML page (`{stem}.html`): the table, the runs' images beside the
+    /// reference (from their folders), error maps, time versus error.
+    #[arg(long)]
+    html: bool,
+}
+
+/// `gibench report`: the tables, plots and page of the given results.
+pub(crate) fn exec(args: &ReportArgs) -> Result<()> {
+    check_stem(&args.stem)?;
+    let runs = read_results_with_folders(&args.inputs)?;
+    let results: Vec<RunResult> = runs.iter().map(|(_, r)| r.clone()).collect();
+    let set = OutputSet::begin("out", &args.out)?;
+    let table = report::stage_table(&results);
+    println!("{}", table.to_terminal());
+    if args.detailed {
+        for r in &results {
+            println!("{}", report::stage_table_detailed(r).to_terminal());
+        }
+    }
+    report::write_tables(&table, &args.out, &args.stem)?;
+    let mut figures = vec![args.out.join(format!("{}.svg", args.stem))];
+    report::stacked_bar_svg(&results, &figures[0], "Per-stage times")?;
+    if !report::time_error_points(&results).is_empty() {
+        let svg = args.out.join(format!("{}-time-vs-error.svg", args.stem));
+        report::time_vs_error_svg(&results, &svg, "Time versus error")?;
+        figures.push(svg);
+    }
+    let page = args.out.join(format!("{}.html", args.stem));
+    if args.html {
+        write_page(&page, table.title.clone(), vec![table], figures, runs)?;
+    }
+    set.publish()?;
+    if args.html {
+        eprintln!("{}", page_line(&page).trim_start());
+    }
+    Ok(())
+}

@@ -1,0 +1,81 @@
+//! A run, sweep or reference command as a target of `gibench reproduce`: parsed with the
+//! top-level command line, checked before anything runs, then run into its `--out`.
+
+use clap::Parser;
+use gibench_harness::gpu::GpuContext;
+use gibench_harness::session::RunSpec;
+use gibench_harness::{Error, Result};
+
+use crate::cli::progress::Bars;
+use crate::cli::reference::{reference_plan, reference_planned, ReferenceArgs, ReferencePlan};
+use crate::cli::run::{plan, run_planned, Plan, RunArgs};
+use crate::cli::sweep::{sweep_plan, sweep_planned, SweepArgs, SweepPlan};
+use crate::{Cli, Command};
+
+/// A gibench command run as a target of `gibench reproduce`, checked before anything runs.
+pub(crate) enum Job {
+    Run(Box<RunArgs>, Box<Plan>),
+    Sweep(Box<SweepArgs>, Box<SweepPlan>),
+    Reference(Box<ReferenceArgs>, Box<ReferencePlan>),
+}
+
+impl Job {
+    /// Parses and checks `gibench ARGV...` (run, sweep or reference).
+    pub(crate) fn plan(argv: &[String]) -> Result<Job> {
+        let cli =
+            Cli::try_parse_from(std::iter::once("gibench").chain(argv.iter().map(String::as_str)))
+                .map_err(|e| Error::Invalid(e.to_string().trim().to_string()))?;
+        match cli.command {
+            Some(Command::Run(a)) => {
+                let p = plan(&a, &[])?;
+                p.spec(&a).validate()?;
+                Ok(Job::Run(Box::new(a), Box::new(p)))
+            }
+            Some(Command::Sweep(a)) => {
+                let p = sweep_plan(&a)?;
+                Ok(Job::Sweep(Box::new(a), Box::new(p)))
+            }
+            Some(Command::Reference(a)) => {
+                let p = reference_plan(&a)?;
+                Ok(Job::Reference(Box::new(a), Box::new(p)))
+            }
+            _ => Err(Error::Invalid(format!(
+                "`gibench {}` is not a run, sweep or reference command",
+                argv.join(" ")
+            ))),
+        }
+    }
+
+    pub(crate) fn needs_gpu(&self) -> bool {
+        !matches!(self, Job::Reference(..))
+    }
+
+    /// (frames rendered, frames × pixels; reference: samples × pixels).
+    pub(crate) fn work(&self) -> (u64, u64) {
+        let of = |spec: &RunSpec| {
+            let frames = spec.total_frames();
+            let [w, h] = spec.config.resolution;
+            (frames, frames * w as u64 * h as u64)
+        };
+        match self {
+            Job::Run(a, p) => of(&p.spec(a)),
+            Job::Sweep(a, p) => of(&p.spec(a)),
+            Job::Reference(a, p) => {
+                let seeds = 1 + a.error_estimate as u64;
+                let [w, h] = p.resolution;
+                (0, seeds * p.settings.spp as u64 * w as u64 * h as u64)
+            }
+        }
+    }
+
+    /// Runs it into its `--out` (inside an open output set) on `gpu`; returns what it wrote.
+    pub(crate) fn execute(&self, gpu: Option<&GpuContext>, bars: &Bars) -> Result<String> {
+        let gpu =
+            || gpu.ok_or_else(|| Error::Invalid("no adapter was opened for a GPU run".into()));
+        match self {
+            Job::Run(a, p) => run_planned(a, p, gpu()?, bars),
+            Job::Sweep(a, p) => sweep_planned(a, p, gpu()?, bars),
+            Job::Reference(a, p) => reference_planned(a, p, bars),
+        }
+    }
+}

@@ -1,0 +1,454 @@
+//! `gibench run` (and `gibench` with no arguments): its arguments, the plan checked before
+//! anything runs or is written, and the run itself with its tables, plots and page.
+
+use std::path::PathBuf;
+
+use clap::{Args, Parser};
+use gibench_harness::assets::AssetPaths;
+use gibench_harness::gpu::{GpuContext, GpuOptions};
+use gibench_harness::output::OutputSet;
+use gibench_harness::quality::{IndirectComponent, QualityConfig};
+use gibench_harness::report;
+use gibench_harness::runner::{RunConfig, TimingMode};
+use gibench_harness::scene::{Scene, SceneDescriptor};
+use gibench_harness::session::{RunSpec, TechniqueRun};
+use gibench_harness::technique::{Params, TechniqueInfo};
+use gibench_harness::{Error, Result};
+
+use super::files::{file_name, writable_dir};
+use super::options::{GpuArgs, ReferenceOpts};
+use super::page::{page_line, with_folder, write_page};
+use super::params::{assign_params, parse_resolution};
+use super::progress::{execute_skipping_with_bar, Bars};
+use crate::registry;
+
+#[derive(Args, Clone)]
+pub(crate) struct RunArgs {
+    /// Scene: a built-in name (see `gibench list`) or a path to a descriptor JSON.
+    #[arg(long, default_value = "cornell")]
+    pub(crate) scene: String,
+    /// Techniques, comma-separated (default: every registered technique).
+    #[arg(long, value_delimiter = ',')]
+    pub(crate) technique: Vec<String>,
+    /// Technique parameter `name=value` (applies to every selected technique that declares it)
+    /// or `technique.name=value`. Repeatable.
+    #[arg(long = "param", short = 'p')]
+    pub(crate) params: Vec<String>,
+    /// Measured frames.
+    #[arg(long, default_value_t = 60)]
+    pub(crate) frames: u32,
+    /// Warm-up frames run first and dropped from the statistics.
+    #[arg(long, default_value_t = 5)]
+    pub(crate) warmup: u32,
+    /// Animation frame to start at.
+    #[arg(long, default_value_t = 0)]
+    pub(crate) first_frame: u32,
+    /// Image size WIDTHxHEIGHT (the papers used 1024x768 and 1600x1200).
+    #[arg(long, default_value = "256x192")]
+    pub(crate) resolution: String,
+    /// Edge length of each face of the primary light's cube shadow map (Laine: 1024).
+    #[arg(long, default_value_t = 256)]
+    pub(crate) shadow_size: u32,
+    /// `stages` (per-stage, flushed), `frame` (whole frames, no added sync) or `both`.
+    #[arg(long, default_value = "both")]
+    pub(crate) timing: String,
+    /// Seed for every random choice a technique makes.
+    #[arg(long, default_value_t = 1)]
+    pub(crate) seed: u64,
+    /// Directory for results JSON, images and tables.
+    #[arg(long, default_value = "results/local")]
+    pub(crate) out: PathBuf,
+    /// Extra directory searched first for scene assets (glTF files).
+    #[arg(long)]
+    pub(crate) assets: Option<PathBuf>,
+    /// Do not write images.
+    #[arg(long)]
+    pub(crate) no_images: bool,
+    /// Do not show a progress bar.
+    #[arg(long)]
+    pub(crate) quiet: bool,
+    /// Also measure image error against the CPU reference (RMSE, relative MSE, MAE, FLIP,
+    /// flicker) on consecutive frame pairs spread over the measured frames.
+    #[arg(long)]
+    pub(crate) quality: bool,
+    /// Frame pairs compared with the reference when --quality is given [default: 2].
+    #[arg(long)]
+    pub(crate) quality_pairs: Option<u32>,
+    /// With --quality, compare every measured frame (per-frame error and lag plots).
+    #[arg(long)]
+    pub(crate) quality_all: bool,
+    /// The reference component the indirect irradiance is compared with: one-bounce,
+    /// multi-bounce, or direct (for a technique's direct light samples: `barczak set=direct`)
+    /// (default: each technique's declared component, see `gibench list`).
+    #[arg(long)]
+    pub(crate) quality_reference: Option<String>,
+    /// Also write an HTML page of the run (`{scene}-report.html`, or `{stem}.html` for a
+    /// sweep): tables, images beside the reference, error maps, time versus error.
+    #[arg(long)]
+    pub(crate) html: bool,
+    #[command(flatten)]
+    pub(crate) reference: ReferenceOpts,
+    #[command(flatten)]
+    pub(crate) gpu: GpuArgs,
+}
+
+impl RunArgs {
+    /// `gibench` with no arguments: `gibench run`'s defaults, compared with the CPU reference
+    /// (cached after the first run) and written up as an HTML page.
+    pub(crate) fn parse_default() -> RunArgs {
+        RunArgs::parse_args(["gibench", "--quality", "--html"])
+    }
+
+    /// `gibench run` options from an argument list (the first item is the program name).
+    fn parse_args<I: IntoIterator<Item = T>, T: Into<std::ffi::OsString> + Clone>(
+        args: I,
+    ) -> RunArgs {
+        #[derive(Parser)]
+        struct Only {
+            #[command(flatten)]
+            run: RunArgs,
+        }
+        Only::parse_from(args).run
+    }
+}
+
+/// Everything a run needs, checked before anything runs or is written.
+pub(crate) struct Plan {
+    pub(crate) config: RunConfig,
+    pub(crate) quality: Option<QualityConfig>,
+    pub(crate) techniques: Vec<&'static TechniqueInfo>,
+    pub(crate) params: Vec<Params>,
+    pub(crate) desc: SceneDescriptor,
+    pub(crate) scene: Scene,
+}
+
+/// Checks `args` (with `extra_params` after its `--param`s) and loads the scene: everything a
+/// run needs, before any GPU work or file.
+pub(crate) fn plan(args: &RunArgs, extra_params: &[String]) -> Result<Plan> {
+    let config = RunConfig {
+        resolution: parse_resolution(&args.resolution)?,
+        frames: args.frames,
+        warmup: args.warmup,
+        first_frame: args.first_frame,
+        timing: TimingMode::parse(&args.timing)?,
+        seed: args.seed,
+        shadow_size: args.shadow_size,
+    };
+    config.validate()?;
+    gpu_options(args).validate()?;
+    let quality_options = [
+        ("quality-pairs", args.quality_pairs.is_some()),
+        ("quality-all", args.quality_all),
+        ("quality-reference", args.quality_reference.is_some()),
+    ];
+    if let Some((name, _)) = quality_options
+        .iter()
+        .find(|(_, given)| *given && !args.quality)
+    {
+        return Err(Error::param(
+            *name,
+            "applies to the error measurement: add --quality (without it nothing is compared)",
+        ));
+    }
+    let pairs = args.quality_pairs.unwrap_or(2);
+    if args.quality && pairs == 0 {
+        return Err(Error::param(
+            "quality-pairs",
+            "at least one frame pair is needed (got 0)",
+        ));
+    }
+    let quality = if args.quality {
+        Some(QualityConfig {
+            pairs,
+            all: args.quality_all,
+            reference: args.reference.settings()?,
+            component: args
+                .quality_reference
+                .as_deref()
+                .map(IndirectComponent::parse)
+                .transpose()?,
+        })
+    } else {
+        None
+    };
+    let registry = registry::all();
+    let names: Vec<String> = if args.technique.is_empty() {
+        registry.iter().map(|t| t.name.to_string()).collect()
+    } else {
+        args.technique.clone()
+    };
+    let techniques: Vec<&'static TechniqueInfo> = names
+        .iter()
+        .map(|n| TechniqueInfo::find(registry, n.trim()))
+        .collect::<Result<_>>()?;
+    for (i, t) in techniques.iter().enumerate() {
+        if techniques[..i].iter().any(|o| o.name == t.name) {
+            return Err(Error::param(
+                "technique",
+                format!(
+                    "'{}' is listed twice; its second run would overwrite the first's files",
+                    t.name
+                ),
+            ));
+        }
+    }
+    if let Some(dir) = &args.assets {
+        if !dir.is_dir() {
+            return Err(Error::param(
+                "assets",
+                format!("{} is not a folder", dir.display()),
+            ));
+        }
+    }
+    let mut raw = args.params.clone();
+    raw.extend_from_slice(extra_params);
+    let params = assign_params(&techniques, &raw)?;
+    if let Some(given) = quality.as_ref().and_then(|q| q.component) {
+        for line in other_components(&techniques, &params, given) {
+            eprintln!("warning: {line}");
+        }
+    }
+    let desc = SceneDescriptor::resolve(&args.scene)?;
+    let scene = Scene::load(&desc, &AssetPaths::standard(args.assets.as_deref()))?;
+    // Where files will go must be usable before any GPU work.
+    writable_dir("out", &args.out)?;
+    if args.quality && !args.reference.no_cache {
+        writable_dir("cache", &args.reference.cache)?;
+    }
+    Ok(Plan {
+        config,
+        quality,
+        techniques,
+        params,
+        desc,
+        scene,
+    })
+}
+
+/// A line for each technique whose parameters compute another component than `given`
+/// (`--quality-reference`): its error column is then against light it does not compute.
+fn other_components(
+    techniques: &[&TechniqueInfo],
+    params: &[Params],
+    given: IndirectComponent,
+) -> Vec<String> {
+    techniques
+        .iter()
+        .zip(params)
+        .filter_map(|(t, p)| {
+            let computed = (t.reference)(p);
+            (computed != given).then(|| {
+                format!(
+                    "--quality-reference {}: {} computes the {} component with these parameters; its error is measured against light it does not compute",
+                    given.name(),
+                    t.name,
+                    computed.name()
+                )
+            })
+        })
+        .collect()
+}
+
+impl Plan {
+    /// The typed run of these techniques, files named `{scene}-{technique}`.
+    pub(crate) fn spec(&self, args: &RunArgs) -> RunSpec<'_> {
+        let runs = self
+            .techniques
+            .iter()
+            .zip(&self.params)
+            .map(|(info, params)| TechniqueRun {
+                info,
+                params: params.clone(),
+                stem: format!("{}-{}", self.desc.name, info.name),
+            })
+            .collect();
+        RunSpec {
+            scene: &self.scene,
+            runs,
+            config: self.config.clone(),
+            quality: self.quality.clone(),
+            cache: args.reference.cache(),
+            out: args.out.clone(),
+            images: !args.no_images,
+        }
+    }
+}
+
+/// The line a run starts with: scene, size, adapter, frames and timing mode.
+pub(crate) fn announcement(plan: &Plan, gpu: &GpuContext) -> String {
+    let c = &plan.config;
+    format!(
+        "gibench: scene '{}' ({} triangles) at {}x{} on {} ({}), {} measured + {} warm-up frames, timing '{}'",
+        plan.desc.name,
+        plan.scene.mesh.triangle_count(),
+        c.resolution[0],
+        c.resolution[1],
+        gpu.info.adapter,
+        gpu.info.backend,
+        c.frames,
+        c.warmup,
+        c.timing.name()
+    )
+}
+
+/// The adapter choice `args` ask for.
+fn gpu_options(args: &RunArgs) -> GpuOptions {
+    GpuOptions {
+        backend: args.gpu.backend.clone(),
+        adapter: args.gpu.adapter.clone(),
+        gpu_timeout: args.gpu.gpu_timeout,
+    }
+}
+
+/// The adapter `args` ask for, opened.
+pub(crate) fn open_gpu(args: &RunArgs) -> Result<GpuContext> {
+    GpuContext::new(&gpu_options(args))
+}
+
+/// `gibench run`: plan, open the output set and the adapter, run, publish.
+pub(crate) fn exec(args: &RunArgs) -> Result<()> {
+    // Everything that can be checked without running is checked before anything is written.
+    let plan = plan(args, &[])?;
+    plan.spec(args).validate()?;
+    let set = OutputSet::begin("out", &args.out)?;
+    if args.technique.is_empty() {
+        // A run over every technique says which it skipped; one that skipped none leaves no
+        // earlier run's list behind.
+        set.replace_files(&skipped_file(&plan.desc.name))?;
+    }
+    let gpu = open_gpu(args)?;
+    let done = run_planned(args, &plan, &gpu, &Bars::Own(args.quiet))?;
+    set.publish()?;
+    eprintln!("{done}");
+    Ok(())
+}
+
+/// The file in which a run over every technique on `scene` lists those it skipped and why.
+fn skipped_file(scene: &str) -> String {
+    format!("{scene}-skipped.json")
+}
+
+/// The work of `gibench run` once planned and its output set is open: runs, tables, plots.
+/// Returns what it wrote, as a line for the terminal.
+pub(crate) fn run_planned(
+    args: &RunArgs,
+    plan: &Plan,
+    gpu: &GpuContext,
+    bars: &Bars,
+) -> Result<String> {
+    let spec = plan.spec(args);
+    bars.note(&announcement(plan, gpu));
+    // A run over every technique leaves out one that cannot take the scene or the device; one
+    // named with --technique is an error.
+    let (results, skipped) =
+        execute_skipping_with_bar(bars, gpu, &spec, args.technique.is_empty())?;
+    let name = &plan.desc.name;
+    if results.is_empty() {
+        let reasons: Vec<String> = skipped
+            .iter()
+            .map(|s| format!("{}: {}", s.technique, s.reason))
+            .collect();
+        return Err(Error::Invalid(format!(
+            "no technique could run on scene '{name}': {}",
+            reasons.join("; ")
+        )));
+    }
+    let mut table = report::stage_table(&results);
+    for s in &skipped {
+        table
+            .notes
+            .push(format!("Skipped {}: {}", s.technique, s.reason));
+    }
+    bars.table(&table);
+    let stem = format!("{name}-summary");
+    let mut written: Vec<String> = report::write_tables(&table, &args.out, &stem)?
+        .iter()
+        .map(|p| file_name(p))
+        .collect();
+    if !skipped.is_empty() {
+        let list: Vec<serde_json::Value> = (skipped.iter())
+            .map(|s| serde_json::json!({ "technique": s.technique, "reason": s.reason }))
+            .collect();
+        let record = serde_json::json!({
+            "scene": name,
+            "note": "techniques a run over every technique left out, each with its reason (not a results file)",
+            "skipped": list,
+        });
+        let path = args.out.join(skipped_file(name));
+        let bytes =
+            serde_json::to_vec_pretty(&record).map_err(|e| Error::Invalid(e.to_string()))?;
+        gibench_harness::error::write_atomic(&path, &bytes)?;
+        written.push(file_name(&path));
+    }
+    report::stacked_bar_svg(
+        &results,
+        &args.out.join(format!("{stem}.svg")),
+        &format!("Per-stage times on {name}"),
+    )?;
+    written.push(format!("{stem}.svg"));
+    if plan.quality.is_some() {
+        // Per compared frame (every measured frame with --quality-all); flicker where a frame
+        // pair was compared.
+        let flicker = results.iter().any(|r| {
+            r.quality
+                .as_ref()
+                .is_some_and(|q| q.frames.iter().any(|f| f.temporal.is_some()))
+        });
+        for metric in ["rmse", "flicker"]
+            .into_iter()
+            .filter(|m| *m == "rmse" || flicker)
+        {
+            let svg = args.out.join(format!("{name}-{metric}-per-frame.svg"));
+            if report::per_frame_lines(&results, metric)?.is_empty() {
+                // Every value is not a number (each run's warnings say why): what is valid
+                // is still written.
+                eprintln!(
+                    "note: no {metric} value is a number; {} not drawn",
+                    file_name(&svg)
+                );
+                continue;
+            }
+            report::quality_over_frames_svg(
+                &results,
+                metric,
+                &svg,
+                &format!("{metric} against the reference on {name}"),
+            )?;
+            written.push(file_name(&svg));
+        }
+    }
+    if plan.quality.is_some() {
+        let svg = args.out.join(format!("{name}-time-vs-error.svg"));
+        if report::time_error_points(&results).is_empty() {
+            eprintln!(
+                "note: no run has an error that is a number; {} not drawn",
+                file_name(&svg)
+            );
+        } else {
+            report::time_vs_error_svg(&results, &svg, &format!("Time versus error on {name}"))?;
+            written.push(file_name(&svg));
+        }
+    }
+    let mut done = format!(
+        "wrote {} results, images and {} to {}",
+        results.len(),
+        written.join(", "),
+        args.out.display()
+    );
+    if args.html {
+        let page = args.out.join(format!("{name}-report.html"));
+        write_page(
+            &page,
+            format!("gibench run on {name}"),
+            vec![table],
+            written
+                .iter()
+                .filter(|w| w.ends_with(".svg"))
+                .map(|w| args.out.join(w))
+                .collect(),
+            with_folder(&args.out, results),
+        )?;
+        done.push_str(&page_line(&page));
+    }
+    Ok(done)
+}

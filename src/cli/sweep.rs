@@ -1,0 +1,274 @@
+//! `gibench sweep`: one technique, one parameter over a list of values: its arguments, the
+//! plan of every point checked before any runs, and the table, plots and page of the points.
+
+use std::path::{Path, PathBuf};
+
+use clap::Args;
+use gibench_harness::gpu::GpuContext;
+use gibench_harness::output::OutputSet;
+use gibench_harness::report;
+use gibench_harness::results::RunResult;
+use gibench_harness::session::{RunSpec, TechniqueRun};
+use gibench_harness::technique::{Params, TechniqueInfo};
+use gibench_harness::{Error, Result};
+
+use super::page::{page_line, with_folder, write_page};
+use super::params::assign_params;
+use super::progress::{execute_with_bar, Bars};
+use super::run::{announcement, open_gpu, plan, Plan, RunArgs};
+use crate::registry;
+
+#[derive(Args)]
+pub(crate) struct SweepArgs {
+    /// The swept parameter and its values: name=v1,v2,...
+    #[arg(long)]
+    pub(crate) sweep: String,
+    #[command(flatten)]
+    pub(crate) run: RunArgs,
+}
+
+/// `gibench sweep`: one technique, one parameter over a list of values.
+pub(crate) fn exec(args: &SweepArgs) -> Result<()> {
+    let planned = sweep_plan(args)?;
+    let set = OutputSet::begin("out", &args.run.out)?;
+    // The folder's points of this scene, technique and parameter are this sweep's alone: an
+    // earlier sweep's points at values this one does not run are removed when it publishes
+    // (they would otherwise sit beside its table as if part of it).
+    for stale in planned.earlier_points(&args.run.out) {
+        gibench_harness::output::replace_in_open_set(&stale)?;
+    }
+    let gpu = open_gpu(&args.run)?;
+    let done = sweep_planned(args, &planned, &gpu, &Bars::Own(args.run.quiet))?;
+    set.publish()?;
+    eprintln!("{done}");
+    Ok(())
+}
+
+/// A sweep checked before it runs: the parameter, its values and one plan per value.
+pub(crate) struct SweepPlan {
+    name: String,
+    values: Vec<String>,
+    plans: Vec<Plan>,
+}
+
+impl SweepPlan {
+    /// The typed run of every point.
+    pub(crate) fn spec(&self, args: &SweepArgs) -> RunSpec<'_> {
+        let first = &self.plans[0];
+        let info = first.techniques[0];
+        let mut spec = first.spec(&args.run);
+        spec.runs = self
+            .values
+            .iter()
+            .zip(&self.plans)
+            .map(|(v, p)| TechniqueRun {
+                info,
+                params: p.params[0].clone(),
+                stem: format!("{}{v}", self.point_prefix()),
+            })
+            .collect();
+        spec
+    }
+
+    /// What every point's files are named after: `SCENE-TECHNIQUE-PARAMETER-` (the value
+    /// follows).
+    fn point_prefix(&self) -> String {
+        let first = &self.plans[0];
+        let info = first.techniques[0];
+        format!("{}-{}-{}-", first.desc.name, info.name, self.name)
+    }
+
+    /// The files in `dir` named as points of a sweep of this scene, technique and parameter
+    /// (any value) — not those of a parameter whose name extends this one's (`vpl-map-size`
+    /// beside `vpl-map`).
+    fn earlier_points(&self, dir: &Path) -> Vec<PathBuf> {
+        let prefix = self.point_prefix();
+        let first = &self.plans[0];
+        let info = first.techniques[0];
+        let bare = self.name.rsplit('.').next().unwrap_or(&self.name);
+        let longer: Vec<String> = (info.params.iter().flat_map(|g| g.iter()))
+            .filter(|p| p.name.starts_with(&format!("{bare}-")))
+            .map(|p| format!("{}-{}-{}-", first.desc.name, info.name, p.name))
+            .collect();
+        let Ok(entries) = std::fs::read_dir(dir) else {
+            return Vec::new();
+        };
+        entries
+            .flatten()
+            .filter(|e| e.file_type().is_ok_and(|t| t.is_file()))
+            .filter(|e| {
+                let name = e.file_name().to_string_lossy().into_owned();
+                name.starts_with(&prefix) && !longer.iter().any(|l| name.starts_with(l))
+            })
+            .map(|e| e.path())
+            .collect()
+    }
+}
+
+/// Checks a sweep's arguments and plans every point before any runs.
+pub(crate) fn sweep_plan(args: &SweepArgs) -> Result<SweepPlan> {
+    let (name, values) = args
+        .sweep
+        .split_once('=')
+        .map(|(n, v)| {
+            (
+                n.trim().to_string(),
+                v.split(',')
+                    .map(|x| x.trim().to_string())
+                    .collect::<Vec<_>>(),
+            )
+        })
+        .filter(|(n, v)| !n.is_empty() && !v.is_empty() && v.iter().all(|x| !x.is_empty()))
+        .ok_or_else(|| {
+            Error::param(
+                "sweep",
+                format!("expected name=v1,v2,... (got '{}')", args.sweep),
+            )
+        })?;
+    if args.run.technique.len() != 1 {
+        return Err(Error::param(
+            "technique",
+            "a sweep runs exactly one technique",
+        ));
+    }
+    check_swept_not_given(&args.sweep, &name, &args.run.params)?;
+    let info = TechniqueInfo::find(registry::all(), args.run.technique[0].trim())?;
+    check_distinct_values(info, &name, &values)?;
+    // Check every point before running any.
+    let plans: Vec<Plan> = values
+        .iter()
+        .map(|v| plan(&args.run, &[format!("{name}={v}")]))
+        .collect::<Result<_>>()?;
+    let planned = SweepPlan {
+        name,
+        values,
+        plans,
+    };
+    planned.spec(args).validate()?;
+    Ok(planned)
+}
+
+/// Refuses a `--param` that sets the swept parameter `name` (with or without a `technique.`
+/// prefix): every point would silently override it.
+fn check_swept_not_given(sweep: &str, name: &str, params: &[String]) -> Result<()> {
+    let bare = |key: &str| key.split_once('.').map_or(key, |(_, n)| n).to_string();
+    let swept = bare(name);
+    let given = params
+        .iter()
+        .find(|p| p.split_once('=').is_some_and(|(k, _)| bare(k) == swept));
+    if let Some(p) = given {
+        return Err(Error::param(
+            swept,
+            format!(
+                "given both as --param ('{p}') and as the swept parameter (--sweep {sweep}); \
+                 give it once"
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Refuses a sweep value listed twice, compared as the technique reads them (`08` and `8`, `1`
+/// and `1.0` are one setting): the second point would repeat the first's run, or overwrite its
+/// files.
+fn check_distinct_values(info: &TechniqueInfo, name: &str, values: &[String]) -> Result<()> {
+    let parsed: Vec<Params> = values
+        .iter()
+        .map(|v| assign_params(&[info], &[format!("{name}={v}")]).map(|mut p| p.remove(0)))
+        .collect::<Result<_>>()?;
+    for (i, p) in parsed.iter().enumerate() {
+        if let Some(j) = parsed[..i].iter().position(|q| q == p) {
+            let (a, b) = (&values[j], &values[i]);
+            let message = if a == b {
+                format!("the value '{b}' is listed twice; its second run would overwrite the first's files")
+            } else {
+                format!(
+                    "the values '{a}' and '{b}' are listed twice: {} reads both as the same \
+                     {name}, so the second run would only repeat the first",
+                    info.name
+                )
+            };
+            return Err(Error::param("sweep", message));
+        }
+    }
+    Ok(())
+}
+
+/// The work of `gibench sweep` once planned and its output set is open. Returns what it
+/// wrote, as a line for the terminal.
+pub(crate) fn sweep_planned(
+    args: &SweepArgs,
+    planned: &SweepPlan,
+    gpu: &GpuContext,
+    bars: &Bars,
+) -> Result<String> {
+    let SweepPlan {
+        name,
+        values,
+        plans,
+    } = planned;
+    let (name, values) = (name.clone(), values.clone());
+    let first = &plans[0];
+    let info = first.techniques[0];
+    let spec = planned.spec(args);
+    bars.note(&announcement(first, gpu));
+    let runs = execute_with_bar(bars, gpu, &spec)?;
+    let points: Vec<(String, RunResult)> = values.iter().cloned().zip(runs).collect();
+    let results: Vec<RunResult> = points.iter().map(|(_, r)| r.clone()).collect();
+    let mut table = report::stage_table(&results);
+    table.title = format!(
+        "{} on {}: per-stage time (median ms) against {name}",
+        info.name, first.desc.name
+    );
+    table.columns.insert(0, name.clone());
+    for (row, v) in table.rows.iter_mut().zip(&values) {
+        row.insert(0, report::Cell::text(v));
+    }
+    bars.table(&table);
+    let stem = format!("{}-{}-sweep-{name}", first.desc.name, info.name);
+    report::write_tables(&table, &args.run.out, &stem)?;
+    report::sweep_plot_svg(
+        &points,
+        &args.run.out.join(format!("{stem}.svg")),
+        &format!(
+            "{} on {}: stage times against {name}",
+            info.name, first.desc.name
+        ),
+        &name,
+    )?;
+    let mut figures = vec![args.run.out.join(format!("{stem}.svg"))];
+    if first.quality.is_some() {
+        let svg = args.run.out.join(format!("{stem}-time-vs-error.svg"));
+        report::time_vs_error_svg(
+            &results,
+            &svg,
+            &format!(
+                "{} on {}: time versus error over {name}",
+                info.name, first.desc.name
+            ),
+        )?;
+        figures.push(svg);
+    }
+    let mut done = format!(
+        "wrote {} points and {stem}.md/.csv/.tex/.svg{} to {}",
+        points.len(),
+        if figures.len() > 1 {
+            ", -time-vs-error.svg"
+        } else {
+            ""
+        },
+        args.run.out.display()
+    );
+    if args.run.html {
+        let page = args.run.out.join(format!("{stem}.html"));
+        write_page(
+            &page,
+            table.title.clone(),
+            vec![table],
+            figures,
+            with_folder(&args.run.out, results),
+        )?;
+        done.push_str(&page_line(&page));
+    }
+    Ok(done)
+}
