@@ -239,6 +239,7 @@ fn fps(r: &RunResult) -> Option<f64> {
 /// Gathering: split, accumulate and combine (the filter is its own column).
 const GATHERING: [&str; 3] = [COMMON_STAGES[0], COMMON_STAGES[1], COMMON_STAGES[2]];
 
+/// The breakdown table: our runs' stages beside the slides' and the thesis' figures.
 fn breakdown(
     args: &ReproduceArgs,
     scene: &gibench_harness::scene::Scene,
@@ -273,131 +274,13 @@ fn breakdown(
     .map(String::from)
     .into();
     let triangles = scene.mesh.triangle_count();
-    let mut rows = Vec::new();
-    for r in runs {
-        let is_ism = r.technique == "ism";
-        let frame = r.frame.as_ref().map(|f| f.frame_ms.median);
-        rows.push(vec![
-            Cell::text("gibench"),
-            Cell::text(&r.technique),
-            Cell::text(format!("{} ({triangles})", r.scene)),
-            Cell::text(format!("{}x{}", r.resolution[0], r.resolution[1])),
-            report::vpl_count_cell(r),
-            Cell::text(format!("{0}²", s.map_size)),
-            if is_ism {
-                Cell::Num(Some(s.points_per_vpl as f64), 0)
-            } else {
-                Cell::text("triangles")
-            },
-            Cell::Ms(ms(r, STAGE_RSM)),
-            // keller-full traces its VPLs from the light on the CPU.
-            Cell::Ms(ms(r, STAGE_VPL_SAMPLING).or_else(|| ms(r, STAGE_VPL_GENERATION))),
-            Cell::Ms(maps_ms(r)),
-            Cell::Ms(ms(r, STAGE_POINT_SPLAT)),
-            Cell::Ms(ms(r, STAGE_PULL_PUSH)),
-            Cell::Ms(sum_ms(r, &GATHERING)),
-            Cell::Ms(ms(r, STAGE_FILTER)),
-            Cell::Ms(frame),
-            Cell::Num(fps(r), 1),
-            Cell::Num(
-                (!is_ism)
-                    .then(|| maps_ms(r).zip(maps_ms(ism)).map(|(a, b)| a / b))
-                    .flatten(),
-                2,
-            ),
-            Cell::Num(
-                (!is_ism)
-                    .then(|| fps(ism).zip(fps(r)).map(|(a, b)| a / b))
-                    .flatten(),
-                2,
-            ),
-        ]);
-    }
-    let b = &paper["breakdown"];
-    let slides = format!(
-        "Ritschel et al. 2008, course slides ({}, {})",
-        paper["hardware"].as_str().unwrap_or("?"),
-        paper["year"]
-    );
-    let n = |v: &serde_json::Value| v.as_f64();
-    let scene_cell = |name: &serde_json::Value, tris: &serde_json::Value| {
-        Cell::text(format!(
-            "{} ({}k)",
-            name.as_str().unwrap_or("?"),
-            tris.as_f64().unwrap_or(0.0) / 1000.0
-        ))
-    };
-    let (lo, hi) = (
-        n(&b["classic_over_ism"][0]).unwrap_or(f64::NAN),
-        n(&b["classic_over_ism"][1]).unwrap_or(f64::NAN),
-    );
-    let ism_ms = n(&b["ism_ms"]).unwrap_or(f64::NAN);
-    let slide_row = |technique: &str, maps: Cell, ratio: Cell, fps: Cell, speedup: Cell| {
-        vec![
-            Cell::text(&slides),
-            Cell::text(technique),
-            scene_cell(&b["scene"], &b["triangles"]),
-            Cell::text("not stated"),
-            Cell::Num(n(&b["vpls"]), 0),
-            Cell::text(format!("{}²", b["map_size"])),
-            Cell::Num(n(&b["points_per_vpl"]), 0),
-            Cell::Ms(None),
-            Cell::Ms(None),
-            maps,
-            Cell::Ms(None),
-            Cell::Ms(None),
-            Cell::Ms(None),
-            Cell::Ms(None),
-            Cell::Ms(None),
-            fps,
-            ratio,
-            speedup,
-        ]
-    };
-    rows.push(slide_row(
-        "ISM",
-        Cell::Ms(Some(ism_ms)),
-        Cell::Num(None, 1),
-        Cell::text(format!("> {}", b["fps_min"])),
-        Cell::Num(None, 1),
-    ));
-    rows.push(slide_row(
-        "classic maps, same VPLs",
-        Cell::text(format!("{:.0}–{:.0}", ism_ms * lo, ism_ms * hi)),
-        Cell::text(format!("{lo}–{hi}")),
-        Cell::Num(None, 1),
-        Cell::Num(None, 1),
-    ));
-    rows.push(slide_row(
-        "instant radiosity, classic maps",
-        Cell::Ms(None),
-        Cell::Num(None, 1),
-        Cell::Num(None, 1),
-        Cell::text(format!("~{}", b["speedup_over_ir_with_classic_maps"])),
-    ));
+    let mut rows: Vec<Vec<Cell>> = runs
+        .iter()
+        .map(|r| our_row(r, ism, &s, triangles))
+        .collect();
+    rows.extend(slides_rows(&paper));
+    rows.push(thesis_row(&paper));
     let t = &paper["thesis"];
-    let tm = &t["ms"];
-    let plus = |a: &str, b: &str| Cell::text(format!("{} + {}", tm[a], tm[b]));
-    rows.push(vec![
-        Cell::text("Linke, master's thesis (GTX 980 at base clock)"),
-        Cell::text("ISM (points collected per pixel)"),
-        scene_cell(&t["scene"], &t["triangles"]),
-        Cell::text(format!("{}x{}", t["resolution"][0], t["resolution"][1])),
-        Cell::Num(n(&t["vpls"]), 0),
-        Cell::text(format!("{}²", t["map_size"])),
-        Cell::Ms(None),
-        Cell::Ms(n(&tm["rsm"])),
-        Cell::text("several µs"),
-        Cell::Ms(n(&tm["ism"])),
-        plus("point_collection", "point_rendering"),
-        plus("pull", "push"),
-        Cell::Ms(n(&tm["gathering"])),
-        Cell::Ms(n(&tm["blur"])),
-        Cell::Ms(n(&tm["total"])),
-        Cell::Num(None, 1),
-        Cell::Num(None, 1),
-        Cell::Num(None, 1),
-    ]);
     let all: Vec<&RunResult> = runs.iter().collect();
     let frames = (ism.frames.measured, ism.frames.warmup);
     Ok(Table {
@@ -441,6 +324,145 @@ fn breakdown(
             device_note(&all),
         ],
     })
+}
+
+/// A row of ours: run `r` beside the `ism` run, at sizes `s` on a scene of `triangles`.
+fn our_row(r: &RunResult, ism: &RunResult, s: &Sizes, triangles: usize) -> Vec<Cell> {
+    let is_ism = r.technique == "ism";
+    let frame = r.frame.as_ref().map(|f| f.frame_ms.median);
+    vec![
+        Cell::text("gibench"),
+        Cell::text(&r.technique),
+        Cell::text(format!("{} ({triangles})", r.scene)),
+        Cell::text(format!("{}x{}", r.resolution[0], r.resolution[1])),
+        report::vpl_count_cell(r),
+        Cell::text(format!("{0}²", s.map_size)),
+        if is_ism {
+            Cell::Num(Some(s.points_per_vpl as f64), 0)
+        } else {
+            Cell::text("triangles")
+        },
+        Cell::Ms(ms(r, STAGE_RSM)),
+        // keller-full traces its VPLs from the light on the CPU.
+        Cell::Ms(ms(r, STAGE_VPL_SAMPLING).or_else(|| ms(r, STAGE_VPL_GENERATION))),
+        Cell::Ms(maps_ms(r)),
+        Cell::Ms(ms(r, STAGE_POINT_SPLAT)),
+        Cell::Ms(ms(r, STAGE_PULL_PUSH)),
+        Cell::Ms(sum_ms(r, &GATHERING)),
+        Cell::Ms(ms(r, STAGE_FILTER)),
+        Cell::Ms(frame),
+        Cell::Num(fps(r), 1),
+        Cell::Num(
+            (!is_ism)
+                .then(|| maps_ms(r).zip(maps_ms(ism)).map(|(a, b)| a / b))
+                .flatten(),
+            2,
+        ),
+        Cell::Num(
+            (!is_ism)
+                .then(|| fps(ism).zip(fps(r)).map(|(a, b)| a / b))
+                .flatten(),
+            2,
+        ),
+    ]
+}
+
+/// A scene's name and triangle count (in thousands) as the paper gives them.
+fn paper_scene_cell(name: &serde_json::Value, tris: &serde_json::Value) -> Cell {
+    Cell::text(format!(
+        "{} ({}k)",
+        name.as_str().unwrap_or("?"),
+        tris.as_f64().unwrap_or(0.0) / 1000.0
+    ))
+}
+
+/// The rows of the course slides: ISM, classic maps on the same VPLs, instant radiosity.
+fn slides_rows(paper: &serde_json::Value) -> Vec<Vec<Cell>> {
+    let mut rows = Vec::new();
+    let b = &paper["breakdown"];
+    let slides = format!(
+        "Ritschel et al. 2008, course slides ({}, {})",
+        paper["hardware"].as_str().unwrap_or("?"),
+        paper["year"]
+    );
+    let n = |v: &serde_json::Value| v.as_f64();
+    let (lo, hi) = (
+        n(&b["classic_over_ism"][0]).unwrap_or(f64::NAN),
+        n(&b["classic_over_ism"][1]).unwrap_or(f64::NAN),
+    );
+    let ism_ms = n(&b["ism_ms"]).unwrap_or(f64::NAN);
+    let slide_row = |technique: &str, maps: Cell, ratio: Cell, fps: Cell, speedup: Cell| {
+        vec![
+            Cell::text(&slides),
+            Cell::text(technique),
+            paper_scene_cell(&b["scene"], &b["triangles"]),
+            Cell::text("not stated"),
+            Cell::Num(n(&b["vpls"]), 0),
+            Cell::text(format!("{}²", b["map_size"])),
+            Cell::Num(n(&b["points_per_vpl"]), 0),
+            Cell::Ms(None),
+            Cell::Ms(None),
+            maps,
+            Cell::Ms(None),
+            Cell::Ms(None),
+            Cell::Ms(None),
+            Cell::Ms(None),
+            Cell::Ms(None),
+            fps,
+            ratio,
+            speedup,
+        ]
+    };
+    rows.push(slide_row(
+        "ISM",
+        Cell::Ms(Some(ism_ms)),
+        Cell::Num(None, 1),
+        Cell::text(format!("> {}", b["fps_min"])),
+        Cell::Num(None, 1),
+    ));
+    rows.push(slide_row(
+        "classic maps, same VPLs",
+        Cell::text(format!("{:.0}–{:.0}", ism_ms * lo, ism_ms * hi)),
+        Cell::text(format!("{lo}–{hi}")),
+        Cell::Num(None, 1),
+        Cell::Num(None, 1),
+    ));
+    rows.push(slide_row(
+        "instant radiosity, classic maps",
+        Cell::Ms(None),
+        Cell::Num(None, 1),
+        Cell::Num(None, 1),
+        Cell::text(format!("~{}", b["speedup_over_ir_with_classic_maps"])),
+    ));
+    rows
+}
+
+/// The row of Linke's master's thesis (its per-stage times).
+fn thesis_row(paper: &serde_json::Value) -> Vec<Cell> {
+    let n = |v: &serde_json::Value| v.as_f64();
+    let t = &paper["thesis"];
+    let tm = &t["ms"];
+    let plus = |a: &str, b: &str| Cell::text(format!("{} + {}", tm[a], tm[b]));
+    vec![
+        Cell::text("Linke, master's thesis (GTX 980 at base clock)"),
+        Cell::text("ISM (points collected per pixel)"),
+        paper_scene_cell(&t["scene"], &t["triangles"]),
+        Cell::text(format!("{}x{}", t["resolution"][0], t["resolution"][1])),
+        Cell::Num(n(&t["vpls"]), 0),
+        Cell::text(format!("{}²", t["map_size"])),
+        Cell::Ms(None),
+        Cell::Ms(n(&tm["rsm"])),
+        Cell::text("several µs"),
+        Cell::Ms(n(&tm["ism"])),
+        plus("point_collection", "point_rendering"),
+        plus("pull", "push"),
+        Cell::Ms(n(&tm["gathering"])),
+        Cell::Ms(n(&tm["blur"])),
+        Cell::Ms(n(&tm["total"])),
+        Cell::Num(None, 1),
+        Cell::Num(None, 1),
+        Cell::Num(None, 1),
+    ]
 }
 
 /// N × M of "NxM".

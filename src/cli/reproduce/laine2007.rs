@@ -506,36 +506,7 @@ fn management(args: &ReproduceArgs) -> Result<Table> {
         .into_iter()
         .flat_map(|kind| [256u32, 1024].map(|vpls| (kind, vpls)))
         .collect();
-    let mut measured: Vec<ManagementPasses> = configs.iter().map(|_| Default::default()).collect();
-    for _ in 0..MANAGEMENT_PASSES {
-        for (&(kind, vpls), acc) in configs.iter().zip(&mut measured) {
-            let clock = clock_with_light(&scene, kind);
-            let mut m = gibench_laine::Manager::new(vpls, 4, 8);
-            // Wall and CPU time (every thread of the process: the rays run across cores) of
-            // one step; then (untimed) the VPLs lighting the frame.
-            let mut step = |f: u32| {
-                let light = clock.frame(f).light;
-                let (s, wall, cpu) =
-                    gibench_harness::calibrate::timed(|| m.step(&scene, &bvh, light));
-                if f > 0 {
-                    acc.used.push(m.vpls().len() as f64);
-                    acc.rebuilt += s.rebuilt as u32;
-                    acc.repaired += s.repaired as u64;
-                    for (part, t) in acc.parts.iter_mut().zip(s.times.parts()) {
-                        part.push(t.as_secs_f64() * 1e3);
-                    }
-                }
-                (wall * 1e3, cpu.map(|c| c * 1e3))
-            };
-            let (fill, fill_cpu) = step(0);
-            let (times, cpu): (Vec<f64>, Vec<Option<f64>>) = (1..=frames).map(&mut step).unzip();
-            acc.pass_medians.push(Stats::of(&times).median);
-            acc.fill.push(fill);
-            acc.fill_cpu.push(fill_cpu);
-            acc.wall.extend(times);
-            acc.cpu.extend(cpu);
-        }
-    }
+    let measured = measure_management(&scene, &bvh, &configs, frames);
     for (&(kind, vpls), acc) in configs.iter().zip(&measured) {
         let used = Stats::of(&acc.used);
         let s = Stats::of(&acc.wall);
@@ -641,6 +612,49 @@ fn management(args: &ReproduceArgs) -> Result<Table> {
             format!("Paper: {} — a range over its test scenes, median only.", paper["source"].as_str().unwrap_or("")),
         ],
     })
+}
+
+/// Steps a fresh `laine` manager through the animation of `scene` once per configuration
+/// (light kind, VPLs) and pass, [`MANAGEMENT_PASSES`] passes taking turns; returns each
+/// configuration's measurements.
+fn measure_management(
+    scene: &gibench_harness::scene::Scene,
+    bvh: &gibench_harness::bvh::SceneBvh,
+    configs: &[(gibench_harness::scene::descriptor::LightKind, u32)],
+    frames: u32,
+) -> Vec<ManagementPasses> {
+    use gibench_harness::stats::Stats;
+    let mut measured: Vec<ManagementPasses> = configs.iter().map(|_| Default::default()).collect();
+    for _ in 0..MANAGEMENT_PASSES {
+        for (&(kind, vpls), acc) in configs.iter().zip(&mut measured) {
+            let clock = clock_with_light(scene, kind);
+            let mut m = gibench_laine::Manager::new(vpls, 4, 8);
+            // Wall and CPU time (every thread of the process: the rays run across cores) of
+            // one step; then (untimed) the VPLs lighting the frame.
+            let mut step = |f: u32| {
+                let light = clock.frame(f).light;
+                let (s, wall, cpu) =
+                    gibench_harness::calibrate::timed(|| m.step(scene, bvh, light));
+                if f > 0 {
+                    acc.used.push(m.vpls().len() as f64);
+                    acc.rebuilt += s.rebuilt as u32;
+                    acc.repaired += s.repaired as u64;
+                    for (part, t) in acc.parts.iter_mut().zip(s.times.parts()) {
+                        part.push(t.as_secs_f64() * 1e3);
+                    }
+                }
+                (wall * 1e3, cpu.map(|c| c * 1e3))
+            };
+            let (fill, fill_cpu) = step(0);
+            let (times, cpu): (Vec<f64>, Vec<Option<f64>>) = (1..=frames).map(&mut step).unzip();
+            acc.pass_medians.push(Stats::of(&times).median);
+            acc.fill.push(fill);
+            acc.fill_cpu.push(fill_cpu);
+            acc.wall.extend(times);
+            acc.cpu.extend(cpu);
+        }
+    }
+    measured
 }
 
 /// Dispersion of `laine`'s sampling points over the animation (Laine §4.3: the radius of the
