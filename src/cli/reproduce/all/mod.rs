@@ -15,6 +15,10 @@
 //! the output folder (or in the committed `results/`) by the work it does now (frames ×
 //! pixels; frames × VPLs for CPU-only targets); it says which adapter and mode those times were
 //! measured on. A target never timed before has no estimate, and the printout says so.
+//!
+//! This file runs the command (one target, or all of them) and prints the plan; [`targets`]
+//! lists the targets, [`planned`] checks and runs one, [`overall`] is the shared progress bar
+//! and [`manifest`] the record of what ran.
 
 mod manifest;
 mod overall;

@@ -7,10 +7,10 @@ use gibench_harness::gpu::GpuContext;
 use gibench_harness::report;
 use gibench_harness::{Error, Result};
 
-use super::super::job::Job;
-use super::super::ReproduceArgs;
 use super::targets::{Kind, Target};
 use crate::cli::progress::Bars;
+use crate::cli::reproduce::job::Job;
+use crate::cli::reproduce::ReproduceArgs;
 
 /// A target checked and ready to run into `out`.
 pub(super) struct Planned {
