@@ -4,6 +4,8 @@
 //!
 //! Needs: no optional GPU features, WebGL2-level limits.
 
+mod params;
+
 use gibench_harness::technique::{
     prepare_nothing, Conformance, FrameContext, Params, PrepareContext, Prepared, Technique,
     TechniqueInfo,
@@ -11,11 +13,13 @@ use gibench_harness::technique::{
 use gibench_harness::wgpu;
 use gibench_harness::Result;
 
+use params::PARAMS;
+
 /// Registry entry.
 pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "direct",
     description: "direct light only (shadow-mapped primary light); indirect irradiance is zero",
-    params: &[],
+    params: &[PARAMS],
     required_features: wgpu::Features::empty(),
     required_limits: wgpu::Limits::downlevel_webgl2_defaults,
     reference: gibench_harness::technique::one_bounce,

@@ -47,17 +47,21 @@
 //!
 //! Needs: compute shaders and storage buffers (Vulkan, GL ES 3.1); no optional features.
 
+mod params;
 pub mod sh;
 pub mod slab;
 pub mod volume;
 
-use gibench_harness::technique::{
-    prepare_nothing, Conformance, FrameContext, ParamKind, ParamSpec, Params, PrepareContext,
-    Prepared, Technique, TechniqueInfo,
-};
-use gibench_harness::{wgpu, Error, Result};
+pub use params::GaitatzesParams;
 
-use volume::{Grid, Mode, Propagation, Reconstruction, Transport, Volumes, Voxelizer};
+use gibench_harness::technique::{
+    prepare_nothing, Conformance, FrameContext, Params, PrepareContext, Prepared, Technique,
+    TechniqueInfo,
+};
+use gibench_harness::{wgpu, Result};
+
+use params::PARAMS;
+use volume::{Grid, Propagation, Reconstruction, Volumes, Voxelizer};
 
 /// Stage: voxelization, combine and injection.
 pub const STAGE_VOXELIZATION: &str = "voxelization";
@@ -65,39 +69,6 @@ pub const STAGE_VOXELIZATION: &str = "voxelization";
 pub const STAGE_PROPAGATION: &str = "propagation";
 /// Stage: the per-pixel reconstruction.
 pub const STAGE_RECONSTRUCTION: &str = "reconstruction";
-
-const PARAMS: &[ParamSpec] = &[
-    ParamSpec {
-        name: "grid",
-        kind: ParamKind::Int { min: 8, max: 128 },
-        default: "32",
-        doc: "cells per axis of the voxel grid (the paper: 32; 64 an option)",
-    },
-    ParamSpec {
-        name: "iterations",
-        kind: ParamKind::Int { min: 0, max: 1024 },
-        default: "12",
-        doc: "propagation iterations per frame (the paper: 11-12 outdoors, 64 for two bounces in the room); light advances at most one cell per iteration",
-    },
-    ParamSpec {
-        name: "mode",
-        kind: ParamKind::Choice(&["occluded", "lpv"]),
-        default: "occluded",
-        doc: "occluded: the paper's propagation through void cells with reflections at occupied ones (multiple bounces); lpv: plain light propagation volumes (no occlusion, one bounce)",
-    },
-    ParamSpec {
-        name: "transport",
-        kind: ParamKind::Choice(&Transport::NAMES),
-        default: "cosine",
-        doc: "what a void cell passes on through a face: cosine (the paper's reading, as in light propagation volumes: a clamped-cosine lobe along the face's axis; diffuses, most light between two walls returns to its source), carry (ours: the flux with the sender's own angular distribution; light keeps its direction and all of it reaches the facing wall, in beams too narrow) or pyramid (ours: the flux with the distribution of the sender's light within the face's pyramid; less returns than with cosine and it still spreads)",
-    },
-    ParamSpec {
-        name: "albedo",
-        kind: ParamKind::Choice(&["constant", "stored"]),
-        default: "constant",
-        doc: "albedo of secondary bounces: the paper's constant 0.5, or the voxel's stored albedo",
-    },
-];
 
 /// Registry entry.
 pub const INFO: TechniqueInfo = TechniqueInfo {
@@ -122,32 +93,6 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     prepare: prepare_nothing,
     create,
 };
-
-/// The parameters, read once.
-#[derive(Clone, Copy, Debug)]
-pub struct GaitatzesParams {
-    pub grid: u32,
-    pub iterations: u32,
-    pub mode: Mode,
-    pub stored_albedo: bool,
-    pub transport: Transport,
-}
-
-impl GaitatzesParams {
-    pub fn from_params(params: &Params) -> Result<GaitatzesParams> {
-        Ok(GaitatzesParams {
-            grid: params.int("grid") as u32,
-            iterations: params.int("iterations") as u32,
-            mode: match params.choice("mode") {
-                "lpv" => Mode::Lpv,
-                "occluded" => Mode::Occluded,
-                other => return Err(Error::param("mode", format!("unknown mode '{other}'"))),
-            },
-            stored_albedo: params.choice("albedo") == "stored",
-            transport: Transport::parse(params.choice("transport"))?,
-        })
-    }
-}
 
 /// `gaitatzes`.
 pub struct Gaitatzes {

@@ -27,55 +27,26 @@
 //!
 //! Needs: compute shaders and storage buffers (GL ES 3.1 / Vulkan), no optional features.
 
-use gibench_harness::anim::LightPose;
-use gibench_harness::bvh::SceneBvh;
-use gibench_harness::ir::gather::{GatherParams, VplGather, GATHER_PARAMS};
+mod params;
+mod ring;
+
+pub use params::KellerParams;
+pub use ring::PathRing;
+
+use gibench_harness::ir::gather::{VplGather, GATHER_PARAMS};
 use gibench_harness::ir::raster::AtlasClear;
 use gibench_harness::passes::DrawSet;
 use gibench_harness::quality::IndirectComponent;
-use gibench_harness::scene::Scene;
 use gibench_harness::technique::{
-    Conformance, FrameContext, ParamKind, ParamSpec, Params, PrepareContext, Prepared, Technique,
-    TechniqueInfo,
+    Conformance, FrameContext, Params, PrepareContext, Prepared, Technique, TechniqueInfo,
 };
-use gibench_harness::vpl::{self, Vpl, VplSettings};
+use gibench_harness::vpl::{self, Vpl};
 use gibench_harness::{wgpu, Error, Result};
+
+use params::{FULL_OWN, INCREMENTAL_OWN};
 
 /// Stage: tracing light paths and placing VPLs on the CPU.
 pub const STAGE_VPL_GENERATION: &str = "vpl-generation";
-
-const BOUNCES: ParamSpec = ParamSpec {
-    name: "bounces",
-    kind: ParamKind::Int { min: 1, max: 8 },
-    default: "1",
-    doc: "path vertices per light path (1 = single bounce as in Laine; more use Keller's fractional absorption)",
-};
-
-const FULL_OWN: &[ParamSpec] = &[
-    ParamSpec {
-        name: "vpls",
-        kind: ParamKind::Int { min: 1, max: 4096 },
-        default: "64",
-        doc: "VPLs lighting each frame: light paths are traced until there are this many (Laine's comparison: 256)",
-    },
-    BOUNCES,
-];
-
-const INCREMENTAL_OWN: &[ParamSpec] = &[
-    ParamSpec {
-        name: "vpls",
-        kind: ParamKind::Int { min: 1, max: 4096 },
-        default: "64",
-        doc: "VPLs lighting each frame: the ring keeps the N light paths that give this many at the first frame",
-    },
-    ParamSpec {
-        name: "budget",
-        kind: ParamKind::Int { min: 1, max: 4096 },
-        default: "4",
-        doc: "oldest paths replaced by new ones each frame",
-    },
-    BOUNCES,
-];
 
 /// Conformance on the Cornell boxes against the one-bounce reference (64 VPLs, 4x4 tiles):
 /// measured relative L1 0.30–0.72 and mean ratio 0.96–1.05 over the spot, area, omni and sun
@@ -120,33 +91,6 @@ pub const INCREMENTAL: TechniqueInfo = TechniqueInfo {
     prepare,
     create: create_incremental,
 };
-
-/// The parameters of both Keller techniques, read once.
-#[derive(Clone, Copy, Debug)]
-pub struct KellerParams {
-    /// VPLs lighting each frame.
-    pub vpls: u32,
-    pub bounces: u32,
-    /// Paths replaced per frame (incremental).
-    pub budget: u32,
-    pub gather: GatherParams,
-}
-
-impl KellerParams {
-    pub fn from_params(params: &Params) -> Result<KellerParams> {
-        let vpls = params.int("vpls") as u32;
-        Ok(KellerParams {
-            vpls,
-            bounces: params.int("bounces") as u32,
-            budget: if params.has("budget") {
-                params.int("budget") as u32
-            } else {
-                vpls
-            },
-            gather: GatherParams::from_params(params)?,
-        })
-    }
-}
 
 /// What both Keller techniques prepare once per scene: Keller's ρ̄ (the mean of the channels of
 /// the scene's area-weighted average reflectance, one pass over the static mesh).
@@ -213,85 +157,6 @@ impl Technique for KellerFull {
 
     fn output(&self) -> &wgpu::TextureView {
         self.gather.output()
-    }
-}
-
-/// The ring of `keller-incremental`: N path slots, each holding the VPLs of one light path; the
-/// path with Halton index h lives in slot h mod N. Refilled oldest first with consecutive
-/// Halton indices, the ring always holds N consecutive indices, one per residue mod N, so
-/// Keller's fractional absorption ([`vpl::generate`]: ⌊ρ̄^(j−1) N⌋ paths reach vertex j,
-/// weighted by N over that count) gives it exactly `keller-full`'s counts and weights whatever
-/// the per-frame budget. The VPL of slot p's vertex b lives in shadow-map slot p · bounces + b.
-pub struct PathRing {
-    paths: u32,
-    bounces: u32,
-    average_reflectance: f32,
-    ring: Vec<Vec<Vpl>>,
-    /// Halton index of the next path (its slot is `next_path mod paths`: the oldest).
-    next_path: u64,
-}
-
-impl PathRing {
-    /// An empty ring of `paths` light paths of up to `bounces` vertices.
-    pub fn new(paths: u32, bounces: u32, average_reflectance: f32) -> PathRing {
-        PathRing {
-            paths: paths.max(1),
-            bounces: bounces.max(1),
-            average_reflectance,
-            ring: vec![Vec::new(); paths.max(1) as usize],
-            next_path: 0,
-        }
-    }
-
-    /// N.
-    pub fn paths(&self) -> u32 {
-        self.paths
-    }
-
-    /// Replaces the oldest `count` paths (at most N) by new ones traced from `light`; returns
-    /// the new VPLs with their shadow-map slots.
-    pub fn advance(
-        &mut self,
-        scene: &Scene,
-        bvh: &SceneBvh,
-        light: &LightPose,
-        count: u32,
-    ) -> Vec<(u32, Vpl)> {
-        let count = count.min(self.paths);
-        let settings = VplSettings {
-            paths: count,
-            bounces: self.bounces,
-            first_path: self.next_path,
-            normalisation_paths: self.paths,
-            average_reflectance: Some(self.average_reflectance),
-        };
-        let batch = vpl::generate(scene, bvh, light, &settings);
-        let mut new_vpls = Vec::new();
-        for k in 0..count as u64 {
-            let h = self.next_path + k;
-            let p = (h % self.paths as u64) as u32;
-            let path: Vec<Vpl> = batch.iter().filter(|v| v.path == h).copied().collect();
-            for (b, v) in path.iter().enumerate() {
-                new_vpls.push((p * self.bounces + b as u32, *v));
-            }
-            self.ring[p as usize] = path;
-        }
-        self.next_path += count as u64;
-        new_vpls
-    }
-
-    /// Every VPL in the ring with its shadow-map slot.
-    pub fn vpls(&self) -> Vec<(u32, Vpl)> {
-        let bounces = self.bounces;
-        self.ring
-            .iter()
-            .enumerate()
-            .flat_map(|(p, path)| {
-                path.iter()
-                    .enumerate()
-                    .map(move |(b, v)| (p as u32 * bounces + b as u32, *v))
-            })
-            .collect()
     }
 }
 
