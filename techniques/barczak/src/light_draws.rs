@@ -124,186 +124,17 @@ impl LightDraws {
                 format!("expected 1..={MAX_LIGHTS_PER_DRAW} (got {k})"),
             ));
         }
-        let device = &gpu.device;
-        let tiles = leaves.tiles.len() as u64;
-        // The most any level plans without merging: every leaf, every light, split in two groups
-        // (VD: one more partial draw per leaf at most).
-        let max_draws = (tiles * (lights.div_ceil(k) as u64 + 1)).max(1);
-        let max_indices = (leaves.vertex_count() as u64 * lights as u64).max(1);
-        let limit = gpu.device.limits().max_buffer_size;
-        let need = (max_indices * 4).max(max_draws * RECORD_STRIDE);
-        if need > limit {
-            return Err(Error::Invalid(format!(
-                "barczak's light draws would need a {} MB buffer ({} leaves, {} of their vertices, {lights} light samples), more than this device's largest ({} MB); use fewer samples (vpls) or a scene with fewer patches (max-charts)",
-                need >> 20,
-                tiles,
-                leaves.vertex_count(),
-                limit >> 20
-            )));
-        }
-        let indices = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("barczak element indices"),
-            size: max_indices * 4,
-            usage: wgpu::BufferUsages::INDEX | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let records = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("barczak draw lights"),
-            size: max_draws * RECORD_STRIDE,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let raster = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("barczak light draws raster"),
-            size: 2 * RECORD_STRIDE,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let full = RasterData {
-            counts: [1, 0, 0, 0],
-            ndc: [0.0; 4],
-        };
-        let low = lowres.map_or(full, |l| {
-            let [x, y] = l.ndc_offset();
-            RasterData {
-                counts: [l.factor, l.factor / 2, 0, 0],
-                ndc: [x, y, 0.0, 0.0],
-            }
-        });
-        gpu.queue
-            .write_buffer(&raster, 0, bytemuck::bytes_of(&full));
-        gpu.queue
-            .write_buffer(&raster, RECORD_STRIDE, bytemuck::bytes_of(&low));
-        let frag = wgpu::ShaderStages::FRAGMENT;
-        let store_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("barczak lights"),
-            entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: frag,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Storage { read_only: true },
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
-                    visibility: frag,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Storage { read_only: true },
-                        has_dynamic_offset: true,
-                        min_binding_size: wgpu::BufferSize::new(
-                            std::mem::size_of::<DrawLights>() as u64
-                        ),
-                    },
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 2,
-                    visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Storage { read_only: true },
-                        has_dynamic_offset: true,
-                        min_binding_size: wgpu::BufferSize::new(
-                            std::mem::size_of::<RasterData>() as u64
-                        ),
-                    },
-                    count: None,
-                },
-            ],
-        });
-        let store_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("barczak lights"),
-            layout: &store_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: store.buffer().as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                        buffer: &records,
-                        offset: 0,
-                        size: wgpu::BufferSize::new(std::mem::size_of::<DrawLights>() as u64),
-                    }),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                        buffer: &raster,
-                        offset: 0,
-                        size: wgpu::BufferSize::new(std::mem::size_of::<RasterData>() as u64),
-                    }),
-                },
-            ],
-        });
-        let source = format!(
-            "{}\n{}\n{}",
-            VplStore::wgsl(2, 0, false),
-            ShadowAtlas::wgsl(3),
-            include_str!("shaders/light_draws.wgsl")
-        );
-        let module = shader_module(device, "barczak light draws", &source);
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("barczak light draws"),
-            bind_group_layouts: &[
-                Some(&uniforms.view_layout),
-                Some(&gbuffer.read_layout),
-                Some(&store_layout),
-                Some(atlas.layout()),
-            ],
-            immediate_size: 0,
-        });
-        let pipeline = |entry: &str, operation, depth| {
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some("barczak light draws"),
-                layout: Some(&layout),
-                vertex: wgpu::VertexState {
-                    module: &module,
-                    entry_point: Some("vs_leaf"),
-                    compilation_options: Default::default(),
-                    buffers: &[Some(Leaves::layout())],
-                },
-                primitive: wgpu::PrimitiveState::default(),
-                depth_stencil: depth,
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module: &module,
-                    entry_point: Some(entry),
-                    compilation_options: Default::default(),
-                    targets: &[Some(accumulate(operation))],
-                }),
-                multiview_mask: None,
-                cache: None,
-            })
-        };
-        use wgpu::BlendOperation::{Add, ReverseSubtract};
-        let edges = || Some(mask_depth(false, wgpu::CompareFunction::Greater));
-        let pipelines = [
-            [
-                pipeline("fs_subtract", ReverseSubtract, None),
-                pipeline("fs_add", Add, None),
-            ],
-            // The low image holds what the composite then subtracts or adds.
-            [
-                pipeline("fs_subtract", Add, None),
-                pipeline("fs_add", Add, None),
-            ],
-            [
-                pipeline("fs_subtract", ReverseSubtract, edges()),
-                pipeline("fs_add", Add, edges()),
-            ],
-        ];
+        let (indices, records, max_draws) = draw_buffers(gpu, &leaves, lights, k)?;
+        let raster = raster_buffer(gpu, lowres);
+        let (store_layout, store_group) = store_bind_group(&gpu.device, store, &records, &raster);
+        let pipelines = pipelines(&gpu.device, uniforms, gbuffer, &store_layout, atlas);
         gpu.check_errors()?;
         Ok(LightDraws {
             k,
             leaves,
             indices,
             records,
-            max_draws: max_draws as u32,
+            max_draws,
             store_group,
             gbuffer_group: gbuffer.read_group.clone(),
             pipelines,
@@ -504,4 +335,217 @@ impl LightDraws {
         }
         self.draws.len() as u32
     }
+}
+
+/// The element index buffer and the per-draw light records, sized once for the most any level
+/// plans for `lights` lights over `leaves`, `k` per draw; and that many draws. Refused when
+/// the larger would not fit the device's largest buffer.
+fn draw_buffers(
+    gpu: &GpuContext,
+    leaves: &Leaves,
+    lights: u32,
+    k: u32,
+) -> Result<(wgpu::Buffer, wgpu::Buffer, u32)> {
+    let device = &gpu.device;
+    let tiles = leaves.tiles.len() as u64;
+    // The most any level plans without merging: every leaf, every light, split in two groups
+    // (VD: one more partial draw per leaf at most).
+    let max_draws = (tiles * (lights.div_ceil(k) as u64 + 1)).max(1);
+    let max_indices = (leaves.vertex_count() as u64 * lights as u64).max(1);
+    let limit = gpu.device.limits().max_buffer_size;
+    let need = (max_indices * 4).max(max_draws * RECORD_STRIDE);
+    if need > limit {
+        return Err(Error::Invalid(format!(
+            "barczak's light draws would need a {} MB buffer ({} leaves, {} of their vertices, {lights} light samples), more than this device's largest ({} MB); use fewer samples (vpls) or a scene with fewer patches (max-charts)",
+            need >> 20,
+            tiles,
+            leaves.vertex_count(),
+            limit >> 20
+        )));
+    }
+    let indices = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("barczak element indices"),
+        size: max_indices * 4,
+        usage: wgpu::BufferUsages::INDEX | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let records = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("barczak draw lights"),
+        size: max_draws * RECORD_STRIDE,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    Ok((indices, records, max_draws as u32))
+}
+
+/// The two raster entries, a record apart: full resolution, then the low-resolution pass's
+/// (factor and projection shift; full resolution again without one).
+fn raster_buffer(gpu: &GpuContext, lowres: Option<&LowRes>) -> wgpu::Buffer {
+    let raster = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("barczak light draws raster"),
+        size: 2 * RECORD_STRIDE,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let full = RasterData {
+        counts: [1, 0, 0, 0],
+        ndc: [0.0; 4],
+    };
+    let low = lowres.map_or(full, |l| {
+        let [x, y] = l.ndc_offset();
+        RasterData {
+            counts: [l.factor, l.factor / 2, 0, 0],
+            ndc: [x, y, 0.0, 0.0],
+        }
+    });
+    gpu.queue
+        .write_buffer(&raster, 0, bytemuck::bytes_of(&full));
+    gpu.queue
+        .write_buffer(&raster, RECORD_STRIDE, bytemuck::bytes_of(&low));
+    raster
+}
+
+/// Group 2 of the light draws: the store's lights, the draw's light record and its raster
+/// entry (the last two at dynamic offsets).
+fn store_bind_group(
+    device: &wgpu::Device,
+    store: &VplStore,
+    records: &wgpu::Buffer,
+    raster: &wgpu::Buffer,
+) -> (wgpu::BindGroupLayout, wgpu::BindGroup) {
+    let frag = wgpu::ShaderStages::FRAGMENT;
+    let store_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("barczak lights"),
+        entries: &[
+            wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: frag,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Storage { read_only: true },
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            },
+            wgpu::BindGroupLayoutEntry {
+                binding: 1,
+                visibility: frag,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Storage { read_only: true },
+                    has_dynamic_offset: true,
+                    min_binding_size: wgpu::BufferSize::new(
+                        std::mem::size_of::<DrawLights>() as u64
+                    ),
+                },
+                count: None,
+            },
+            wgpu::BindGroupLayoutEntry {
+                binding: 2,
+                visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Storage { read_only: true },
+                    has_dynamic_offset: true,
+                    min_binding_size: wgpu::BufferSize::new(
+                        std::mem::size_of::<RasterData>() as u64
+                    ),
+                },
+                count: None,
+            },
+        ],
+    });
+    let store_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("barczak lights"),
+        layout: &store_layout,
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: store.buffer().as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer: records,
+                    offset: 0,
+                    size: wgpu::BufferSize::new(std::mem::size_of::<DrawLights>() as u64),
+                }),
+            },
+            wgpu::BindGroupEntry {
+                binding: 2,
+                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                    buffer: raster,
+                    offset: 0,
+                    size: wgpu::BufferSize::new(std::mem::size_of::<RasterData>() as u64),
+                }),
+            },
+        ],
+    });
+    (store_layout, store_group)
+}
+
+/// The light draws' pipelines per [`Raster`] (full resolution, low resolution, edges), each
+/// subtracting and adding.
+fn pipelines(
+    device: &wgpu::Device,
+    uniforms: &FrameUniforms,
+    gbuffer: &GBuffer,
+    store_layout: &wgpu::BindGroupLayout,
+    atlas: &ShadowAtlas,
+) -> [[wgpu::RenderPipeline; 2]; 3] {
+    let source = format!(
+        "{}\n{}\n{}",
+        VplStore::wgsl(2, 0, false),
+        ShadowAtlas::wgsl(3),
+        include_str!("shaders/light_draws.wgsl")
+    );
+    let module = shader_module(device, "barczak light draws", &source);
+    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("barczak light draws"),
+        bind_group_layouts: &[
+            Some(&uniforms.view_layout),
+            Some(&gbuffer.read_layout),
+            Some(store_layout),
+            Some(atlas.layout()),
+        ],
+        immediate_size: 0,
+    });
+    let pipeline = |entry: &str, operation, depth| {
+        device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("barczak light draws"),
+            layout: Some(&layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_leaf"),
+                compilation_options: Default::default(),
+                buffers: &[Some(Leaves::layout())],
+            },
+            primitive: wgpu::PrimitiveState::default(),
+            depth_stencil: depth,
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                targets: &[Some(accumulate(operation))],
+            }),
+            multiview_mask: None,
+            cache: None,
+        })
+    };
+    use wgpu::BlendOperation::{Add, ReverseSubtract};
+    let edges = || Some(mask_depth(false, wgpu::CompareFunction::Greater));
+    [
+        [
+            pipeline("fs_subtract", ReverseSubtract, None),
+            pipeline("fs_add", Add, None),
+        ],
+        // The low image holds what the composite then subtracts or adds.
+        [
+            pipeline("fs_subtract", Add, None),
+            pipeline("fs_add", Add, None),
+        ],
+        [
+            pipeline("fs_subtract", ReverseSubtract, edges()),
+            pipeline("fs_add", Add, edges()),
+        ],
+    ]
 }

@@ -265,156 +265,10 @@ impl Voxelizer {
         volumes: &Volumes,
     ) -> Result<Voxelizer> {
         let device = &gpu.device;
-        let [w, h] = grid.atlas_size();
-        let mut textures = Vec::new();
-        let mut targets = Vec::new();
-        for axis in ["x", "y", "z"] {
-            let make = |what: &str| {
-                device.create_texture(&wgpu::TextureDescriptor {
-                    label: Some(&format!("voxel atlas {axis} {what}")),
-                    size: wgpu::Extent3d {
-                        width: w,
-                        height: h,
-                        depth_or_array_layers: 1,
-                    },
-                    mip_level_count: 1,
-                    sample_count: 1,
-                    dimension: wgpu::TextureDimension::D2,
-                    format: ATLAS_FORMAT,
-                    usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-                        | wgpu::TextureUsages::TEXTURE_BINDING,
-                    view_formats: &[],
-                })
-            };
-            let t = [make("radiosity"), make("normal"), make("albedo")];
-            targets.push(t.each_ref().map(|t| t.create_view(&Default::default())));
-            textures.extend(t);
-        }
-        // One world → clip matrix per (axis, slice), written once.
-        let slices = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("voxel slices"),
-            size: 3 * grid.n as u64 * SLICE_STRIDE,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let mut bytes = vec![0u8; slices.size() as usize];
-        for axis in 0..3 {
-            for s in 0..grid.n {
-                let m = grid.slice_matrix(axis, s).to_cols_array();
-                let o = (axis as u64 * grid.n as u64 + s as u64) * SLICE_STRIDE;
-                bytes[o as usize..o as usize + 64].copy_from_slice(bytemuck::cast_slice(&m));
-            }
-        }
-        gpu.queue.write_buffer(&slices, 0, &bytes);
-        let slice_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("voxel slice"),
-            entries: &[uniform_entry(0, wgpu::ShaderStages::VERTEX, true)],
-        });
-        let slice_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("voxel slice"),
-            layout: &slice_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                    buffer: &slices,
-                    offset: 0,
-                    size: wgpu::BufferSize::new(64),
-                }),
-            }],
-        });
-        let source = format!(
-            "{}\n{}",
-            DirectLight::wgsl(3),
-            include_str!("shaders/voxelize.wgsl")
-        );
-        let module = shader_module(device, "voxelize", &source);
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("voxelize"),
-            bind_group_layouts: &[
-                Some(&slice_layout),
-                Some(&uniforms.object_layout),
-                Some(&scene.material_layout),
-                Some(&direct.light_layout),
-            ],
-            immediate_size: 0,
-        });
-        let add = wgpu::BlendComponent {
-            src_factor: wgpu::BlendFactor::One,
-            dst_factor: wgpu::BlendFactor::One,
-            operation: wgpu::BlendOperation::Add,
-        };
-        let target = Some(wgpu::ColorTargetState {
-            format: ATLAS_FORMAT,
-            blend: Some(wgpu::BlendState {
-                color: add,
-                alpha: add,
-            }),
-            write_mask: wgpu::ColorWrites::ALL,
-        });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("voxelize"),
-            layout: Some(&layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_voxel"),
-                compilation_options: Default::default(),
-                buffers: &[Some(Vertex::LAYOUT)],
-            },
-            primitive: wgpu::PrimitiveState {
-                cull_mode: None,
-                ..Default::default()
-            },
-            depth_stencil: None,
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_voxel"),
-                compilation_options: Default::default(),
-                targets: &[target.clone(), target.clone(), target],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
-        let c = wgpu::ShaderStages::COMPUTE;
-        let unfilterable = wgpu::TextureSampleType::Float { filterable: false };
-        let mut entries: Vec<wgpu::BindGroupLayoutEntry> = (0..9)
-            .map(|b| texture_entry(b, c, unfilterable, wgpu::TextureViewDimension::D2))
-            .collect();
-        entries.extend([
-            storage_entry(9, false),
-            storage_entry(10, false),
-            storage_entry(11, false),
-        ]);
-        let combine_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("voxel combine"),
-            entries: &entries,
-        });
-        let mut group_entries: Vec<wgpu::BindGroupEntry> = targets
-            .iter()
-            .flatten()
-            .enumerate()
-            .map(|(i, v)| wgpu::BindGroupEntry {
-                binding: i as u32,
-                resource: wgpu::BindingResource::TextureView(v),
-            })
-            .collect();
-        group_entries.extend([
-            entry(9, &volumes.voxels),
-            entry(10, &volumes.propagation[0]),
-            entry(11, &volumes.accumulation),
-        ]);
-        let combine_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("voxel combine"),
-            layout: &combine_layout,
-            entries: &group_entries,
-        });
-        let combine = compute_pipeline(
-            device,
-            "voxel combine",
-            &format!("{}\n{}", grid.wgsl(), include_str!("shaders/combine.wgsl")),
-            &[&combine_layout],
-            "combine",
-        );
+        let (textures, targets) = atlas_targets(device, grid);
+        let (slices, slice_layout, slice_group) = slice_matrices(gpu, grid);
+        let pipeline = voxelize_pipeline(device, &slice_layout, scene, uniforms, direct);
+        let (combine, combine_group) = combine_pass(device, grid, &targets, volumes);
         gpu.check_errors()?;
         Ok(Voxelizer {
             n: grid.n,
@@ -484,6 +338,196 @@ impl Voxelizer {
         let g = n.div_ceil(4);
         pass.dispatch_workgroups(g, g, g);
     }
+}
+
+/// The voxelization atlases, per axis radiosity, normal and albedo (`grid`'s slices side by
+/// side), and their views.
+fn atlas_targets(
+    device: &wgpu::Device,
+    grid: &Grid,
+) -> (Vec<wgpu::Texture>, Vec<[wgpu::TextureView; 3]>) {
+    let [w, h] = grid.atlas_size();
+    let mut textures = Vec::new();
+    let mut targets = Vec::new();
+    for axis in ["x", "y", "z"] {
+        let make = |what: &str| {
+            device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(&format!("voxel atlas {axis} {what}")),
+                size: wgpu::Extent3d {
+                    width: w,
+                    height: h,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: ATLAS_FORMAT,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                    | wgpu::TextureUsages::TEXTURE_BINDING,
+                view_formats: &[],
+            })
+        };
+        let t = [make("radiosity"), make("normal"), make("albedo")];
+        targets.push(t.each_ref().map(|t| t.create_view(&Default::default())));
+        textures.extend(t);
+    }
+    (textures, targets)
+}
+
+/// One world → clip matrix per (axis, slice), written once, and the bind group that picks
+/// one of them at a dynamic offset.
+fn slice_matrices(
+    gpu: &GpuContext,
+    grid: &Grid,
+) -> (wgpu::Buffer, wgpu::BindGroupLayout, wgpu::BindGroup) {
+    let device = &gpu.device;
+    let slices = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("voxel slices"),
+        size: 3 * grid.n as u64 * SLICE_STRIDE,
+        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let mut bytes = vec![0u8; slices.size() as usize];
+    for axis in 0..3 {
+        for s in 0..grid.n {
+            let m = grid.slice_matrix(axis, s).to_cols_array();
+            let o = (axis as u64 * grid.n as u64 + s as u64) * SLICE_STRIDE;
+            bytes[o as usize..o as usize + 64].copy_from_slice(bytemuck::cast_slice(&m));
+        }
+    }
+    gpu.queue.write_buffer(&slices, 0, &bytes);
+    let slice_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("voxel slice"),
+        entries: &[uniform_entry(0, wgpu::ShaderStages::VERTEX, true)],
+    });
+    let slice_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("voxel slice"),
+        layout: &slice_layout,
+        entries: &[wgpu::BindGroupEntry {
+            binding: 0,
+            resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                buffer: &slices,
+                offset: 0,
+                size: wgpu::BufferSize::new(64),
+            }),
+        }],
+    });
+    (slices, slice_layout, slice_group)
+}
+
+/// The slice pass: every triangle scan-converted into a slice's three targets, blended by
+/// addition.
+fn voxelize_pipeline(
+    device: &wgpu::Device,
+    slice_layout: &wgpu::BindGroupLayout,
+    scene: &GpuScene,
+    uniforms: &FrameUniforms,
+    direct: &DirectLight,
+) -> wgpu::RenderPipeline {
+    let source = format!(
+        "{}\n{}",
+        DirectLight::wgsl(3),
+        include_str!("shaders/voxelize.wgsl")
+    );
+    let module = shader_module(device, "voxelize", &source);
+    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("voxelize"),
+        bind_group_layouts: &[
+            Some(slice_layout),
+            Some(&uniforms.object_layout),
+            Some(&scene.material_layout),
+            Some(&direct.light_layout),
+        ],
+        immediate_size: 0,
+    });
+    let add = wgpu::BlendComponent {
+        src_factor: wgpu::BlendFactor::One,
+        dst_factor: wgpu::BlendFactor::One,
+        operation: wgpu::BlendOperation::Add,
+    };
+    let target = Some(wgpu::ColorTargetState {
+        format: ATLAS_FORMAT,
+        blend: Some(wgpu::BlendState {
+            color: add,
+            alpha: add,
+        }),
+        write_mask: wgpu::ColorWrites::ALL,
+    });
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("voxelize"),
+        layout: Some(&layout),
+        vertex: wgpu::VertexState {
+            module: &module,
+            entry_point: Some("vs_voxel"),
+            compilation_options: Default::default(),
+            buffers: &[Some(Vertex::LAYOUT)],
+        },
+        primitive: wgpu::PrimitiveState {
+            cull_mode: None,
+            ..Default::default()
+        },
+        depth_stencil: None,
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module: &module,
+            entry_point: Some("fs_voxel"),
+            compilation_options: Default::default(),
+            targets: &[target.clone(), target.clone(), target],
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
+/// The combine and injection pass: the three axes' atlases (`targets`) read, the voxels and
+/// the first propagation and accumulation volumes written.
+fn combine_pass(
+    device: &wgpu::Device,
+    grid: &Grid,
+    targets: &[[wgpu::TextureView; 3]],
+    volumes: &Volumes,
+) -> (wgpu::ComputePipeline, wgpu::BindGroup) {
+    let c = wgpu::ShaderStages::COMPUTE;
+    let unfilterable = wgpu::TextureSampleType::Float { filterable: false };
+    let mut entries: Vec<wgpu::BindGroupLayoutEntry> = (0..9)
+        .map(|b| texture_entry(b, c, unfilterable, wgpu::TextureViewDimension::D2))
+        .collect();
+    entries.extend([
+        storage_entry(9, false),
+        storage_entry(10, false),
+        storage_entry(11, false),
+    ]);
+    let combine_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("voxel combine"),
+        entries: &entries,
+    });
+    let mut group_entries: Vec<wgpu::BindGroupEntry> = targets
+        .iter()
+        .flatten()
+        .enumerate()
+        .map(|(i, v)| wgpu::BindGroupEntry {
+            binding: i as u32,
+            resource: wgpu::BindingResource::TextureView(v),
+        })
+        .collect();
+    group_entries.extend([
+        entry(9, &volumes.voxels),
+        entry(10, &volumes.propagation[0]),
+        entry(11, &volumes.accumulation),
+    ]);
+    let combine_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("voxel combine"),
+        layout: &combine_layout,
+        entries: &group_entries,
+    });
+    let combine = compute_pipeline(
+        device,
+        "voxel combine",
+        &format!("{}\n{}", grid.wgsl(), include_str!("shaders/combine.wgsl")),
+        &[&combine_layout],
+        "combine",
+    );
+    (combine, combine_group)
 }
 
 /// The propagation iterations (see the module docs).
