@@ -192,11 +192,7 @@ fn the_blocker_index_leaves_every_state_unchanged() {
         db.move_object(8, |p| p + Vec3::new(-0.2, 0.05, 0.3));
         check(&db, &format!("room after move {step}"));
     }
-    let scene = gibench_harness::scene::Scene::load_named(
-        "cornell-gltf",
-        &gibench_harness::assets::AssetPaths::standard(None),
-    )
-    .unwrap();
+    let scene = gibench_test_support::load("cornell-gltf");
     let bvh = gibench_harness::bvh::SceneBvh::new(&scene.mesh);
     let frame = gibench_harness::anim::FrameClock::new(&scene.descriptor).frame(0);
     let settings = gibench_barczak::samples::SampleSettings {

@@ -12,7 +12,6 @@ use gibench_barczak::lightmap::contribution;
 use gibench_barczak::lightmap_pass::{Leaves, LightMapPass};
 use gibench_barczak::samples::SampleSettings;
 use gibench_barczak::visibility::LightState;
-use gibench_harness::assets::AssetPaths;
 use gibench_harness::glam::Vec3;
 use gibench_harness::ir::accumulate::{Accumulation, IrradianceClamp};
 use gibench_harness::ir::atlas::{AtlasFormat, AtlasSettings, MapKind, ShadowAtlas};
@@ -20,7 +19,6 @@ use gibench_harness::ir::interleave::{FilterSettings, Interleave};
 use gibench_harness::ir::raster::{AtlasClear, AtlasRasteriser};
 use gibench_harness::ir::store::VplStore;
 use gibench_harness::passes::{render_target, DrawSet, HDR_FORMAT};
-use gibench_harness::scene::Scene;
 
 mod support;
 
@@ -29,8 +27,8 @@ const H: u32 = 72;
 
 #[test]
 fn light_maps_minus_occluded_partials_equal_the_brute_force_gather() {
-    let scene = Scene::load_named("barczak-pillars", &AssetPaths::standard(None)).unwrap();
-    support::each_backend(&scene, [W, H], |backend, gpu, harness| {
+    let scene = gibench_test_support::load("barczak-pillars");
+    gibench_test_support::each_backend("barczak", &scene, [W, H], 64, |backend, gpu, harness| {
         let frame = harness.clock.frame(0);
         harness.uniforms.write(&gpu.queue, &frame);
         let settings = SampleSettings {

@@ -4,10 +4,8 @@
 
 use gibench_barczak::lightmap_pass::{Leaves, LightMapPass};
 use gibench_barczak::samples::SampleSettings;
-use gibench_harness::assets::AssetPaths;
 use gibench_harness::glam::Vec3;
 use gibench_harness::passes::{render_target, HDR_FORMAT};
-use gibench_harness::scene::Scene;
 
 mod support;
 
@@ -17,8 +15,8 @@ const RES: u32 = 4;
 
 #[test]
 fn light_map_pass_draws_the_cpu_light_maps() {
-    let scene = Scene::load_named("barczak-pillars", &AssetPaths::standard(None)).unwrap();
-    support::each_backend(&scene, [W, H], |backend, gpu, harness| {
+    let scene = gibench_test_support::load("barczak-pillars");
+    gibench_test_support::each_backend("barczak", &scene, [W, H], 64, |backend, gpu, harness| {
         let frame = harness.clock.frame(0);
         harness.uniforms.write(&gpu.queue, &frame);
         let settings = SampleSettings {

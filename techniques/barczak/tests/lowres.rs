@@ -14,8 +14,6 @@
 
 use gibench_barczak::renderer::{FrameCounts, Optimisation, Renderer, RendererSettings};
 use gibench_barczak::samples::SampleSettings;
-use gibench_harness::assets::AssetPaths;
-use gibench_harness::scene::Scene;
 
 mod support;
 
@@ -44,8 +42,8 @@ fn settings(level: Optimisation) -> RendererSettings {
 
 #[test]
 fn the_low_resolution_pass_interpolates_off_edges_and_redraws_them() {
-    let scene = Scene::load_named("barczak-pillars", &AssetPaths::standard(None)).unwrap();
-    support::each_backend(&scene, [W, H], |backend, gpu, harness| {
+    let scene = gibench_test_support::load("barczak-pillars");
+    gibench_test_support::each_backend("barczak", &scene, [W, H], 64, |backend, gpu, harness| {
         let frame = harness.clock.frame(0);
         let render = |level| -> (Renderer, Vec<[f32; 3]>, FrameCounts) {
             let mut r = Renderer::new(

@@ -8,9 +8,7 @@ use gibench_harness::glam::{Mat3, Vec3};
 use gibench_harness::scene::Mesh;
 use gibench_harness::vpl::{fibonacci_sphere, Vpl};
 
-#[path = "../../../harness/tests/support/mod.rs"]
-mod support;
-use support::quad;
+use gibench_test_support::quad;
 
 #[test]
 fn basis_is_orthonormal() {

@@ -5,11 +5,9 @@
 use gibench_barczak::prt::{self, COEFFS};
 use gibench_barczak::prt_pass::PrtPass;
 use gibench_barczak::samples::SampleSettings;
-use gibench_harness::assets::AssetPaths;
 use gibench_harness::bvh::SceneBvh;
 use gibench_harness::glam::{Mat3, Vec3};
 use gibench_harness::passes::{render_target, HDR_FORMAT};
-use gibench_harness::scene::Scene;
 use gibench_harness::wgpu;
 
 mod support;
@@ -33,10 +31,10 @@ fn barycentric(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> (Vec3, f32) {
 
 #[test]
 fn prt_draw_interpolates_the_cpu_vertex_irradiance() {
-    let scene = Scene::load_named("barczak-pillars", &AssetPaths::standard(None)).unwrap();
+    let scene = gibench_test_support::load("barczak-pillars");
     let mesh = &scene.movers[0].mesh;
     let transfer = prt::transfer(mesh, &SceneBvh::new(mesh), 512, 1e-4);
-    support::each_backend(&scene, [W, H], |backend, gpu, harness| {
+    gibench_test_support::each_backend("barczak", &scene, [W, H], 64, |backend, gpu, harness| {
         let frame = harness.clock.frame(40);
         harness.uniforms.write(&gpu.queue, &frame);
         let settings = SampleSettings {

@@ -5,8 +5,6 @@
 
 use gibench_barczak::renderer::{Optimisation, Renderer, RendererSettings};
 use gibench_barczak::samples::SampleSettings;
-use gibench_harness::assets::AssetPaths;
-use gibench_harness::scene::Scene;
 
 mod support;
 
@@ -30,8 +28,8 @@ const SETTINGS: RendererSettings = RendererSettings {
 
 #[test]
 fn updated_frames_equal_frames_prepared_from_scratch() {
-    let scene = Scene::load_named("barczak-pillars", &AssetPaths::standard(None)).unwrap();
-    support::each_backend(&scene, [96, 72], |backend, gpu, harness| {
+    let scene = gibench_test_support::load("barczak-pillars");
+    gibench_test_support::each_backend("barczak", &scene, [96, 72], 64, |backend, gpu, harness| {
         let render = |r: &mut Renderer, f: u32| support::render_frame(gpu, harness, r, f);
         let start = harness.clock.frame(0);
         let mut running = Renderer::new(
@@ -92,8 +90,8 @@ fn updated_frames_equal_frames_prepared_from_scratch() {
 /// numbering, an occluder missed) leaves a shadow out of its map and changes pixels.
 #[test]
 fn face_culling_skips_faces_and_changes_no_pixel() {
-    let scene = Scene::load_named("barczak-table", &AssetPaths::standard(None)).unwrap();
-    support::each_backend(&scene, [96, 72], |backend, gpu, harness| {
+    let scene = gibench_test_support::load("barczak-table");
+    gibench_test_support::each_backend("barczak", &scene, [96, 72], 64, |backend, gpu, harness| {
         let start = harness.clock.frame(0);
         let new = |face_cull| {
             let settings = RendererSettings {

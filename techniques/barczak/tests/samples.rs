@@ -8,9 +8,7 @@ use gibench_harness::glam::Vec3;
 use gibench_harness::scene::descriptor::LightKind;
 use gibench_harness::scene::Scene;
 
-#[path = "../../../harness/tests/support/mod.rs"]
-mod support;
-use support::{closed_box_mesh, material, scene};
+use gibench_test_support::{closed_box_mesh, material, scene};
 
 const ALBEDO: Vec3 = Vec3::new(0.5, 0.6, 0.7);
 const BOX: Vec3 = Vec3::new(4.0, 3.0, 5.0);

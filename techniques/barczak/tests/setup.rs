@@ -8,10 +8,8 @@ use gibench_barczak::samples::SampleSettings;
 use gibench_barczak::setup::{prepare, CHART_LEVELS, MAX_CHARTS};
 use gibench_barczak::visibility::LightState;
 use gibench_harness::anim::FrameClock;
-use gibench_harness::assets::AssetPaths;
 use gibench_harness::bvh::SceneBvh;
 use gibench_harness::glam::Vec3;
-use gibench_harness::scene::Scene;
 
 const RES: u32 = 3;
 
@@ -27,7 +25,7 @@ fn light_maps_of_the_cornell_box_agree_with_ray_casts() {
 }
 
 fn light_maps_agree_with_ray_casts(name: &str, direct: u32) {
-    let scene = Scene::load_named(name, &AssetPaths::standard(None)).unwrap();
+    let scene = gibench_test_support::load(name);
     let bvh = SceneBvh::new(&scene.mesh);
     let frame = FrameClock::new(&scene.descriptor).frame(0);
     let settings = SampleSettings {
@@ -107,7 +105,7 @@ fn light_maps_agree_with_ray_casts(name: &str, direct: u32) {
 /// more charts than allowed is an error naming the scene and the counts.
 #[test]
 fn scenes_without_patches_get_charts_up_to_a_limit() {
-    let scene = Scene::load_named("cornell-gltf", &AssetPaths::standard(None)).unwrap();
+    let scene = gibench_test_support::load("cornell-gltf");
     assert!(scene.patches.is_empty());
     let patches = scene.receiver_patches(2, 1000).unwrap();
     assert_eq!(patches.len(), 18);

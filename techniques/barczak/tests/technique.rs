@@ -2,33 +2,16 @@
 //! reference's direct light of the area light (soft shadows) on the Cornell box; bad parameters
 //! are refused by name before any preparation.
 
-use gibench_harness::assets::AssetPaths;
-use gibench_harness::glam::Vec3;
 use gibench_harness::gpu::{GpuContext, GpuOptions};
 use gibench_harness::profiler::{ProfileMode, Profiler};
 use gibench_harness::reference::{render_reference, ReferenceSettings};
-use gibench_harness::runner::{Harness, RunConfig, TimingMode};
-use gibench_harness::scene::Scene;
+use gibench_harness::runner::{Harness, RunConfig};
+use gibench_test_support::kv;
 
 const SIZE: [u32; 2] = [96, 72];
 
 fn config(resolution: [u32; 2]) -> RunConfig {
-    RunConfig {
-        resolution,
-        frames: 1,
-        warmup: 0,
-        first_frame: 0,
-        timing: TimingMode::Stages,
-        seed: 1,
-        shadow_size: 256,
-    }
-}
-
-fn kv(pairs: &[(&str, &str)]) -> Vec<(String, String)> {
-    pairs
-        .iter()
-        .map(|(k, v)| (k.to_string(), v.to_string()))
-        .collect()
+    gibench_test_support::run_config(resolution, 256)
 }
 
 /// 256 points on the Cornell box's area light against the reference's direct irradiance: the
@@ -38,7 +21,7 @@ fn kv(pairs: &[(&str, &str)]) -> Vec<(String, String)> {
 #[test]
 fn direct_samples_match_the_reference_direct_light() {
     let info = &gibench_barczak::INFO;
-    let scene = Scene::load_named("cornell-area", &AssetPaths::standard(None)).unwrap();
+    let scene = gibench_test_support::load("cornell-area");
     let gpu = GpuContext::new(&GpuOptions::default()).unwrap();
     let config = config(SIZE);
     let h = Harness::new(&gpu, &scene, &config).unwrap();
@@ -52,11 +35,7 @@ fn direct_samples_match_the_reference_direct_light() {
     h.render_frame(t.as_mut(), &compose, &mut profiler, &frame, false)
         .unwrap();
     profiler.finish(&gpu).unwrap();
-    let out: Vec<Vec3> = gibench_harness::image_io::read_rgb_f32(&gpu, t.output().texture())
-        .unwrap()
-        .into_iter()
-        .map(Vec3::from)
-        .collect();
+    let out = gibench_test_support::read_rgb(&gpu, t.output().texture());
     let reference = render_reference(
         &scene,
         &frame,
@@ -88,7 +67,7 @@ fn bad_parameters_are_refused_by_name() {
     let info = &gibench_barczak::INFO;
     let gpu = GpuContext::new(&GpuOptions::default()).unwrap();
     let err = |scene: &str, resolution: [u32; 2], pairs: &[(&str, &str)]| -> String {
-        let scene = Scene::load_named(scene, &AssetPaths::standard(None)).unwrap();
+        let scene = gibench_test_support::load(scene);
         let config = config(resolution);
         let h = Harness::new(&gpu, &scene, &config).unwrap();
         let params = info.parse_params(&kv(pairs)).unwrap();
@@ -105,7 +84,7 @@ fn bad_parameters_are_refused_by_name() {
     let e = err("cornell-area", SIZE, &[("edge-step", "1")]);
     assert!(e.contains("edge-step") && e.contains("factor 2"), "{e}");
     // VD has no low-resolution pass: any resolution.
-    let scene = Scene::load_named("cornell-area", &AssetPaths::standard(None)).unwrap();
+    let scene = gibench_test_support::load("cornell-area");
     let config = config([97, 72]);
     let h = Harness::new(&gpu, &scene, &config).unwrap();
     let params = info.parse_params(&kv(&[("level", "vd")])).unwrap();

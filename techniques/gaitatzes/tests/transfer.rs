@@ -13,7 +13,7 @@
 
 use gibench_gaitatzes::slab::{measure, model, Irradiance, Slabs};
 use gibench_gaitatzes::volume::Transport;
-use gibench_harness::gpu::{backend_context, backends_for};
+use gibench_test_support::gpus;
 
 const N: u32 = 32;
 /// The two-plane scene's grid: its walls are 16 cells apart and 64 iterations long, and light
@@ -52,8 +52,7 @@ fn check(backend: &str, what: &str, got: Irradiance, want: Irradiance, tolerance
 /// (0.84, 0.75, 0.63).
 #[test]
 fn a_lit_layer_gives_the_facing_layer_the_modelled_irradiance() {
-    for backend in backends_for("transfer") {
-        let gpu = backend_context(backend);
+    for (backend, gpu) in gpus("transfer") {
         for transport in [Transport::Cosine, Transport::Carry, Transport::Pyramid] {
             for apart in [2, 3, 5] {
                 let s = Slabs {
@@ -111,8 +110,7 @@ fn a_lit_layer_gives_the_facing_layer_the_modelled_irradiance() {
 /// `transport=carry` meets the reference: the ceiling within 15 %, the floor below 0.01.
 #[test]
 fn lit_floor_and_black_ceiling_match_the_model() {
-    for backend in backends_for("transfer") {
-        let gpu = backend_context(backend);
+    for (backend, gpu) in gpus("transfer") {
         for transport in [Transport::Cosine, Transport::Carry, Transport::Pyramid] {
             let s = Slabs {
                 apart: 16,

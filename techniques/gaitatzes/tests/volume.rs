@@ -9,28 +9,9 @@ use gibench_gaitatzes::volume::{
 };
 use gibench_harness::glam::{Vec2, Vec3};
 use gibench_harness::gpu::GpuContext;
-use gibench_harness::gpu::{backend_context, backends_for};
-use gibench_harness::runner::{Harness, RunConfig, TimingMode};
-use gibench_harness::scene::{Material, Mesh, Scene};
-use gibench_harness::wgpu;
-
-fn read(gpu: &GpuContext, buffer: &wgpu::Buffer) -> Vec<f32> {
-    let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("test readback"),
-        size: buffer.size(),
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    let mut enc = gpu.device.create_command_encoder(&Default::default());
-    enc.copy_buffer_to_buffer(buffer, 0, &staging, 0, buffer.size());
-    gpu.queue.submit([enc.finish()]);
-    let slice = staging.slice(..);
-    slice.map_async(wgpu::MapMode::Read, |_| {});
-    gpu.flush().unwrap();
-    let v = bytemuck::cast_slice(&slice.get_mapped_range().unwrap()).to_vec();
-    staging.unmap();
-    v
-}
+use gibench_harness::runner::Harness;
+use gibench_harness::scene::{Material, Mesh};
+use gibench_test_support::{gpus, read_f32, run_config, scene_from_json};
 
 const N: u32 = 16;
 
@@ -94,11 +75,11 @@ fn propagate(
         let mut enc = gpu.device.create_command_encoder(&Default::default());
         propagation.encode(&mut enc, 1);
         gpu.queue.submit([enc.finish()]);
-        field = read(gpu, &volumes.propagation[1]);
+        field = read_f32(gpu, &volumes.propagation[1]);
         fields.push(field.clone());
         let _ = k;
     }
-    (fields, read(gpu, &volumes.accumulation))
+    (fields, read_f32(gpu, &volumes.accumulation))
 }
 
 /// An isotropic lit voxel in the middle of an empty grid: after every iteration the field is
@@ -110,8 +91,7 @@ fn propagate(
 #[test]
 fn one_lit_voxel_propagates_symmetrically_and_loses_no_energy() {
     let c = N / 2;
-    for backend in backends_for("volume") {
-        let gpu = backend_context(backend);
+    for (backend, gpu) in gpus("volume") {
         let empty = vec![0f32; N.pow(3) as usize * CELL];
         let iso = [1.0, 0.0, 0.0, 0.0];
         let (fields, _) = propagate(&gpu, Mode::Occluded, &empty, (c, c, c), iso, 6);
@@ -226,8 +206,7 @@ fn an_occluding_wall_blocks_propagation() {
         }
         e
     };
-    for backend in backends_for("volume") {
-        let gpu = backend_context(backend);
+    for (backend, gpu) in gpus("volume") {
         let iso = [1.0, 0.0, 0.0, 0.0];
         let source = 3.0 * (4.0 * std::f64::consts::PI).sqrt();
         let run = |wall| propagate(&gpu, Mode::Occluded, &wall_voxels(wall), (5, 8, 8), iso, 12);
@@ -291,38 +270,9 @@ fn voxelize_triangle(a: Vec3, b: Vec3, c: Vec3) {
                    "path": { "keys": [ { "time": 0, "position": [5, 5, 5] } ] } },
         "settings": { "filter_distance": 1 }
     }"#;
-    let descriptor = gibench_harness::scene::descriptor::SceneDescriptor::from_json(
-        std::path::Path::new("triangle.json"),
-        json,
-    )
-    .unwrap();
-    let scene = Scene {
-        descriptor,
-        extent: gibench_harness::scene::SceneExtent::of(&mesh),
-        mesh,
-        shadow_mesh: None,
-        materials: vec![Material {
-            name: "grey".into(),
-            base_color: Vec3::splat(0.5),
-            texture: None,
-            average_color: Vec3::splat(0.5),
-        }],
-        textures: Vec::new(),
-        movers: Vec::new(),
-        gltf_lights: Vec::new(),
-        patches: Vec::new(),
-    };
-    for backend in backends_for("volume") {
-        let gpu = backend_context(backend);
-        let config = RunConfig {
-            resolution: [32, 24],
-            frames: 1,
-            warmup: 0,
-            first_frame: 0,
-            timing: TimingMode::Stages,
-            seed: 1,
-            shadow_size: 64,
-        };
+    let scene = scene_from_json(json, mesh, vec![Material::plain("grey", Vec3::splat(0.5))]);
+    for (backend, gpu) in gpus("volume") {
+        let config = run_config([32, 24], 64);
         let harness = Harness::new(&gpu, &scene, &config).unwrap();
         harness.uniforms.write(&gpu.queue, &harness.clock.frame(0));
         let g = Grid::around(&scene.extent, 32, Mode::Occluded, false, Transport::Cosine);
@@ -344,7 +294,7 @@ fn voxelize_triangle(a: Vec3, b: Vec3, c: Vec3) {
             &harness.direct,
         );
         gpu.queue.submit([enc.finish()]);
-        let voxels = read(&gpu, &volumes.voxels);
+        let voxels = read_f32(&gpu, &volumes.voxels);
         let cells = g.n as i32;
         let occupied = |c: [i32; 3]| -> bool {
             c.iter().all(|v| (0..cells).contains(v))

@@ -3,13 +3,13 @@
 //! N / ⌊ρ̄^(j−1) N⌋ by the actual count), and `keller-full` traces until it has its VPL count.
 
 use gibench_harness::anim::{FrameClock, LightPose};
-use gibench_harness::assets::AssetPaths;
 use gibench_harness::bvh::SceneBvh;
-use gibench_harness::glam::{Vec2, Vec3};
+use gibench_harness::glam::Vec3;
 use gibench_harness::scene::descriptor::{LightKind, SceneDescriptor};
-use gibench_harness::scene::{Material, Mesh, Scene, SceneExtent};
+use gibench_harness::scene::{Material, Mesh, Scene};
 use gibench_harness::vpl::{self, Vpl, VplSettings};
 use gibench_keller::PathRing;
+use gibench_test_support::{load, quad, scene_with};
 
 /// Flux per bounce (1-based; index 0 unused), red channel.
 fn per_bounce(vpls: &[Vpl], bounces: u32) -> Vec<f64> {
@@ -21,7 +21,7 @@ fn per_bounce(vpls: &[Vpl], bounces: u32) -> Vec<f64> {
 }
 
 fn cornell() -> (Scene, SceneBvh, LightPose) {
-    let scene = Scene::load_named("cornell", &AssetPaths::standard(None)).unwrap();
+    let scene = load("cornell");
     let bvh = SceneBvh::new(&scene.mesh);
     let light = FrameClock::new(&scene.descriptor).frame(0).light;
     (scene, bvh, light)
@@ -108,37 +108,15 @@ fn closed_box_bounce_flux_is_exact_at_n_64() {
         ),
     ];
     for (corners, n) in faces {
-        let base = mesh.positions.len() as u32;
-        for (p, uv) in corners
-            .iter()
-            .zip([Vec2::ZERO, Vec2::X, Vec2::ONE, Vec2::Y])
-        {
-            mesh.positions.push(*p);
-            mesh.normals.push(n);
-            mesh.uvs.push(uv);
-            mesh.materials.push(0);
-        }
-        mesh.indices
-            .extend([0, 1, 2, 0, 2, 3].into_iter().map(|i| base + i));
+        quad(&mut mesh, corners, n, 0);
     }
     let mut descriptor = SceneDescriptor::resolve("cornell").unwrap();
     descriptor.light.kind = LightKind::Omni;
-    let scene = Scene {
+    let scene = scene_with(
         descriptor,
-        extent: SceneExtent::of(&mesh),
         mesh,
-        shadow_mesh: None,
-        materials: vec![Material {
-            name: "grey".into(),
-            base_color: Vec3::splat(rho),
-            texture: None,
-            average_color: Vec3::splat(rho),
-        }],
-        textures: Vec::new(),
-        movers: Vec::new(),
-        gltf_lights: Vec::new(),
-        patches: Vec::new(),
-    };
+        vec![Material::plain("grey", Vec3::splat(rho))],
+    );
     let bvh = SceneBvh::new(&scene.mesh);
     let light = LightPose {
         kind: LightKind::Omni,

@@ -6,7 +6,7 @@
 use gibench_barczak::database::{Receiver, ReceiverShape, VisibilityDatabase};
 use gibench_barczak::visibility::{Blocker, PatchTree, PointLight, Shape};
 use gibench_harness::gpu::GpuContext;
-use gibench_harness::runner::{Harness, RunConfig, TimingMode};
+use gibench_harness::runner::Harness;
 use gibench_harness::scene::Scene;
 use glam::Vec3;
 
@@ -138,11 +138,8 @@ pub fn lights() -> Vec<PointLight> {
         position: Vec3::new(3.1, 2.7, 2.9),
         normal: None,
     }];
-    let mut k = 1u32;
-    let mut next = || {
-        k = k.wrapping_mul(1_103_515_245).wrapping_add(12345);
-        (k >> 8) as f32 / (1u32 << 24) as f32
-    };
+    let mut rng = gibench_test_support::Lcg::new(1);
+    let mut next = || rng.next_f32();
     for i in 0..48 {
         let (a, b) = (0.2 + 5.6 * next(), 0.2 + 5.6 * next());
         let (position, normal) = match i % 4 {
@@ -204,29 +201,6 @@ pub fn bilinear(texels: &[Vec3], res: u32, s: f32, t: f32) -> Vec3 {
     at(i0, j0)
         .lerp(at(i1, j0), fx)
         .lerp(at(i0, j1).lerp(at(i1, j1), fx), fy)
-}
-
-/// Runs `body` on every portable backend present (Vulkan, GL) with a harness for `scene` at
-/// `size` pixels.
-pub fn each_backend(
-    scene: &Scene,
-    size: [u32; 2],
-    mut body: impl FnMut(&str, &GpuContext, &Harness),
-) {
-    for backend in gibench_harness::gpu::backends_for("barczak") {
-        let gpu = gibench_harness::gpu::backend_context(backend);
-        let config = RunConfig {
-            resolution: size,
-            frames: 1,
-            warmup: 0,
-            first_frame: 0,
-            timing: TimingMode::Stages,
-            seed: 1,
-            shadow_size: 64,
-        };
-        let harness = Harness::new(&gpu, scene, &config).unwrap();
-        body(backend, &gpu, &harness);
-    }
 }
 
 /// Frame `f` rendered by `r` after the harness's G-buffer (the harness's uniforms written for
