@@ -1,0 +1,75 @@
+//! The time-versus-error points of runs with quality data and their Pareto front.
+
+use super::runs::stage_ms;
+use crate::results::RunResult;
+
+/// "technique" plus the parameters whose values differ between runs of that technique in
+/// `all` (e.g. "laine clamp=3"), to tell sweep points apart.
+pub fn distinct_label(all: &[RunResult], r: &RunResult) -> String {
+    let same: Vec<&RunResult> = all
+        .iter()
+        .filter(|o| o.technique == r.technique && o.scene == r.scene)
+        .collect();
+    let mut label = r.technique.clone();
+    for (k, v) in &r.parameters {
+        if same.iter().any(|o| o.parameters.get(k) != Some(v)) {
+            label.push_str(&format!(
+                " {k}={}",
+                v.as_str()
+                    .map(String::from)
+                    .unwrap_or_else(|| v.to_string())
+            ));
+        }
+    }
+    if all.iter().any(|o| o.scene != r.scene) {
+        label.push_str(&format!(" @ {}", r.scene));
+    }
+    label
+}
+
+/// A run's time per frame for the time-versus-error plot: the median of whole frames where
+/// they were timed, else the sum of the per-stage medians.
+pub fn frame_time_ms(r: &RunResult) -> Option<f64> {
+    r.frame
+        .as_ref()
+        .map(|f| f.frame_ms.median)
+        .or_else(|| r.stages.iter().map(stage_ms).sum())
+        .filter(|t| t.is_finite())
+}
+
+/// The points of the time-versus-error plot: (label, frame ms, mean relative MSE against the
+/// reference), runs without quality left out.
+pub fn time_error_points(results: &[RunResult]) -> Vec<(String, f64, f64)> {
+    results
+        .iter()
+        .filter_map(|r| {
+            let q = r.quality.as_ref()?;
+            let t = frame_time_ms(r)?;
+            q.rel_mse
+                .mean
+                .is_finite()
+                .then(|| (distinct_label(results, r), t, q.rel_mse.mean))
+        })
+        .collect()
+}
+
+/// Indices of the Pareto front of (time, error) points: those no other point beats in both
+/// (at most equal in one and lower in the other), ordered by time.
+pub fn pareto_front(points: &[(String, f64, f64)]) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..points.len()).collect();
+    order.sort_by(|&a, &b| {
+        points[a]
+            .1
+            .total_cmp(&points[b].1)
+            .then(points[a].2.total_cmp(&points[b].2))
+    });
+    let mut front = Vec::new();
+    let mut best = f64::INFINITY;
+    for i in order {
+        if points[i].2 < best {
+            best = points[i].2;
+            front.push(i);
+        }
+    }
+    front
+}

@@ -1,0 +1,527 @@
+//! Tests of the tables, their renderings, the plots and the Pareto front.
+
+use std::collections::BTreeMap;
+
+use super::latex::latex_escape;
+use super::*;
+use crate::results::{
+    DeviceInfo, FrameRange, FrameResult, RunResult, StageKind, StageResult, SCHEMA_VERSION,
+};
+use crate::stats::Stats;
+use crate::Error;
+
+/// The front keeps exactly the points nothing beats in both time and error.
+#[test]
+fn pareto_front_keeps_the_unbeaten_points() {
+    let p = |t: f64, e: f64| (String::new(), t, e);
+    let points = vec![
+        p(10.0, 0.5),
+        p(5.0, 0.9),
+        p(20.0, 0.1),
+        p(12.0, 0.6),
+        p(5.0, 1.0),
+    ];
+    // (12, 0.6) is beaten by (10, 0.5); (5, 1.0) by (5, 0.9).
+    assert_eq!(pareto_front(&points), vec![1, 0, 2]);
+}
+
+/// Stats of 100 frames with the given median.
+fn stats(median: f64) -> Stats {
+    Stats {
+        count: 100,
+        mean: median * 1.01,
+        median,
+        p5: median * 0.9,
+        p95: median * 1.2,
+        p99: median * 1.4,
+        min: median * 0.8,
+        max: median * 1.5,
+    }
+}
+
+fn stage(name: &str, kind: StageKind, gpu: Option<f64>, wall: Option<f64>) -> StageResult {
+    StageResult {
+        name: name.into(),
+        kind,
+        gpu_ms: gpu.map(stats),
+        wall_ms: wall.map(stats),
+        cpu_ms: None,
+    }
+}
+
+fn run(scene: &str, technique: &str, stages: Vec<StageResult>, frame_median: f64) -> RunResult {
+    RunResult {
+        schema_version: SCHEMA_VERSION,
+        gibench_version: "0.1.0".into(),
+        git_commit: "abc1234".into(),
+        timestamp: 1_700_000_000,
+        scene: scene.into(),
+        technique: technique.into(),
+        parameters: BTreeMap::from([("vpls".to_string(), serde_json::json!(256))]),
+        settings: BTreeMap::from([("shadow_map_size".to_string(), serde_json::json!(1024))]),
+        resolution: [1280, 720],
+        frames: FrameRange {
+            warmup: 10,
+            measured: 100,
+            first: 10,
+        },
+        seed: 7,
+        timing_mode: "both".into(),
+        device: DeviceInfo {
+            adapter: "Test GPU".into(),
+            backend: "Vulkan".into(),
+            device_type: "DiscreteGpu".into(),
+            driver: "testdrv".into(),
+            driver_info: "1.2.3".into(),
+            timestamp_queries: true,
+            timestamp_period_ns: 1.0,
+        },
+        stages,
+        frame: Some(FrameResult {
+            frame_ms: stats(frame_median),
+            fps: 1000.0 / (frame_median * 1.01),
+            frames_in_flight: 2,
+            samples_ms: vec![frame_median],
+        }),
+        counters: BTreeMap::from([("shadow maps".to_string(), stats(1.0))]),
+        prepare_ms: None,
+        first_frame_ms: None,
+        quality: None,
+        images: vec!["frame.png".into()],
+        warnings: Vec::new(),
+        calibration_ms: None,
+        peak_memory_mb: None,
+    }
+}
+
+/// Run A: three GPU stages (GPU timestamps a little above the wall times), the last one
+/// without GPU timestamps (wall time 0.75 ms).
+/// Run B: a name with a comma and quotes, a scene with `_` and `%`, an extra CPU stage.
+fn two_runs() -> Vec<RunResult> {
+    let a = run(
+        "sponza",
+        "direct",
+        vec![
+            stage("g-buffer", StageKind::Gpu, Some(0.6), Some(0.5)),
+            stage("shadow map", StageKind::Gpu, Some(1.5), Some(1.234)),
+            stage("compose", StageKind::Gpu, None, Some(0.75)),
+        ],
+        3.0,
+    );
+    let b = run(
+        "cornell_box 100%",
+        "ism, \"imperfect\"",
+        vec![
+            stage("g-buffer", StageKind::Gpu, Some(0.3), Some(0.25)),
+            stage("vpl trace", StageKind::Cpu, None, Some(2.0)),
+            stage("compose", StageKind::Gpu, Some(0.1), Some(0.05)),
+        ],
+        4.5,
+    );
+    vec![a, b]
+}
+
+/// Runs from two devices pooled into one table get a device column naming each row's;
+/// runs from one device do not.
+#[test]
+fn pooled_devices_get_a_device_column() {
+    let mut runs = two_runs();
+    assert!(!stage_table(&runs).columns.contains(&"device".to_string()));
+    runs[1].device.adapter = "NVIDIA H200".into();
+    let t = stage_table(&runs);
+    assert_eq!(t.columns[0], "device");
+    let cell = |r: usize| match &t.rows[r][0] {
+        Cell::Text(s) => s.clone(),
+        other => panic!("{other:?}"),
+    };
+    assert!(cell(1).starts_with("NVIDIA H200") && !cell(0).starts_with("NVIDIA"));
+}
+
+#[test]
+fn stage_union_keeps_execution_order() {
+    let t = stage_table(&two_runs());
+    let expected = [
+        "scene",
+        "technique",
+        "resolution",
+        "g-buffer",
+        "shadow map",
+        "vpl trace",
+        "compose",
+        "Σ stages",
+        "frame (median ms)",
+        "FPS",
+    ];
+    assert_eq!(t.columns, expected);
+    assert_eq!(t.rows.len(), 2);
+}
+
+#[test]
+fn markdown_has_header_separator_and_one_row_per_result() {
+    let md = stage_table(&two_runs()).to_markdown();
+    let lines: Vec<&str> = md.lines().filter(|l| l.starts_with('|')).collect();
+    assert_eq!(lines.len(), 4, "header, separator, two rows:\n{md}");
+    assert!(
+        lines[0].contains("| g-buffer | shadow map | vpl trace | compose | Σ stages |"),
+        "{md}"
+    );
+    assert_eq!(
+        lines[1],
+        "| --- | --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"
+    );
+    // Run A: medians 0.50, 1.23 (1.234), no vpl trace, 0.75 (wall); sum 2.484; frame 3.00.
+    assert_eq!(
+        lines[2],
+        "| sponza | direct | 1280x720 | 0.50 | 1.23 | – | 0.75 | 2.48 | 3.00 | 330.0 |"
+    );
+    // Run B: 0.05 ms shows three decimals.
+    assert!(
+        lines[3].contains("| 0.25 | – | 2.00 | 0.050 | 2.30 | 4.50 |"),
+        "{}",
+        lines[3]
+    );
+    assert!(md.starts_with("### "));
+    assert!(md.contains("\nTimes in milliseconds, median over 100 measured frames (10 warm-up frames dropped); GPU stages: CPU wall time with the queue flushed before and after"), "{md}");
+    assert!(
+        md.contains("Device: Test GPU (Vulkan, DiscreteGpu; driver testdrv 1.2.3)."),
+        "{md}"
+    );
+}
+
+#[test]
+fn tables_use_flushed_wall_time() {
+    let runs = two_runs();
+    let t = stage_table(&runs);
+    let compose = t.columns.iter().position(|c| c == "compose").unwrap();
+    assert_eq!(t.rows[0][compose], Cell::Ms(Some(0.75)));
+    // The flushed wall time wins over a GPU timestamp (Laine's per-task method).
+    let gbuffer = t.columns.iter().position(|c| c == "g-buffer").unwrap();
+    assert_eq!(t.rows[1][gbuffer], Cell::Ms(Some(0.25)));
+    // No stage lacks a wall time here: no fallback note.
+    assert!(!t.notes.iter().any(|n| n.contains("GPU timestamps only")));
+}
+
+#[test]
+fn differing_devices_are_each_listed() {
+    let mut runs = two_runs();
+    runs[1].device.adapter = "Other GPU".into();
+    runs[1].frames.measured = 50;
+    let notes = stage_table(&runs).notes.join("\n");
+    assert!(notes.contains("Devices: Test GPU (Vulkan, DiscreteGpu; driver testdrv 1.2.3) for direct @ sponza; Other GPU"), "{notes}");
+    assert!(
+        notes.contains(
+            "100 measured frames (10 warm-up frames dropped) for direct @ sponza; 50 measured"
+        ),
+        "{notes}"
+    );
+}
+
+/// A huge value (a results file may say 1e308 ms) is written with an exponent, not as a
+/// cell of 300 digits; ordinary values keep their decimals.
+#[test]
+fn huge_values_are_written_with_an_exponent() {
+    for cell in [Cell::Ms(Some(1e308)), Cell::Num(Some(-1e308), 1)] {
+        assert!(cell.display().len() <= 12, "{}", cell.display());
+        assert!(cell.csv().len() <= 12, "{}", cell.csv());
+        assert!(cell.display().contains("e308"), "{}", cell.display());
+    }
+    assert_eq!(Cell::Ms(Some(12.345)).display(), "12.35");
+    assert_eq!(Cell::Num(Some(123456.0), 1).display(), "123456.0");
+}
+
+/// A table wider than the terminal is folded into blocks no wider than it, each repeating
+/// scene, technique and resolution and listing only the rows with values in its columns;
+/// every value is still shown once; notes are wrapped. (Before, the default run printed
+/// one line of over 300 characters per technique.)
+#[test]
+fn wide_tables_fold_to_the_terminal_width() {
+    let mut t = Table {
+        title: "wide".into(),
+        columns: ["scene", "technique", "resolution"]
+            .map(String::from)
+            .into(),
+        rows: Vec::new(),
+        notes: vec![format!("{} end", "word ".repeat(60))],
+    };
+    t.columns
+        .extend((0..30).map(|k| format!("stage-number-{k}")));
+    for (name, range) in [("alpha", 0..16), ("beta", 16..30)] {
+        let mut row = vec![Cell::text("sibenik"), Cell::text(name), Cell::text("64x48")];
+        row.extend(
+            (0..30).map(|k| Cell::Ms(range.contains(&k).then_some(1000.0 + k as f64 + 0.25))),
+        );
+        t.rows.push(row);
+    }
+    let out = t.to_terminal();
+    assert!(
+        out.lines().all(|l| l.chars().count() <= TERMINAL_WIDTH),
+        "{out}"
+    );
+    for k in 0..30 {
+        let v = format!("{:.2}", 1000.0 + k as f64 + 0.25);
+        assert_eq!(out.matches(&v).count(), 1, "{v} in\n{out}");
+    }
+    // Every row a block lists has a value in that block (alpha's and beta's own stages
+    // are apart).
+    for block in out.split("\n\n").filter(|b| b.contains("stage-number")) {
+        let rows = block.lines().skip_while(|l| !l.starts_with("---")).skip(1);
+        for l in rows {
+            assert!(l.contains("10"), "a row without values: {l}");
+        }
+    }
+    assert!(out.contains("word end"));
+    // A narrow table is unchanged: one block, every row.
+    let narrow = two_runs();
+    let out = stage_table(&narrow[..1]).to_terminal();
+    assert!(out.lines().all(|l| l.chars().count() <= TERMINAL_WIDTH));
+}
+
+#[test]
+fn csv_quotes_commas_and_quotes() {
+    let csv = stage_table(&two_runs()).to_csv();
+    let records: Vec<&str> = csv.split("\r\n").collect();
+    assert_eq!(
+        records.len(),
+        4,
+        "header, two rows, trailing empty: {csv:?}"
+    );
+    assert_eq!(records[3], "");
+    assert!(records[0].starts_with("scene,technique,resolution,g-buffer,shadow map,"));
+    assert_eq!(
+        records[1],
+        "sponza,direct,1280x720,0.5000,1.2340,,0.7500,2.4840,3.0000,330.0"
+    );
+    assert!(
+        records[2].starts_with("cornell_box 100%,\"ism, \"\"imperfect\"\"\",1280x720,"),
+        "{}",
+        records[2]
+    );
+    assert!(!csv.contains("Times in milliseconds"), "no notes in CSV");
+}
+
+#[test]
+fn latex_escapes_specials() {
+    let tex = stage_table(&two_runs()).to_latex();
+    assert!(tex.contains("\\begin{tabular}{lllrrrrrrr}"), "{tex}");
+    assert!(tex.contains("\\toprule") && tex.contains("\\midrule") && tex.contains("\\bottomrule"));
+    assert!(
+        tex.contains("cornell\\_box 100\\% & ism, \"imperfect\" & 1280x720"),
+        "{tex}"
+    );
+    assert!(tex.contains("$\\Sigma$ stages"), "{tex}");
+    assert!(tex.contains("{\\footnotesize\n"), "{tex}");
+    assert_eq!(
+        latex_escape("a&b%c$d#e_f{g}h~i^j\\k"),
+        "a\\&b\\%c\\$d\\#e\\_f\\{g\\}h\\textasciitilde{}i\\textasciicircum{}j\\textbackslash{}k"
+    );
+    // Missing values are en dashes.
+    assert!(tex.contains("& -- &"), "{tex}");
+}
+
+#[test]
+fn terminal_columns_align() {
+    let out = stage_table(&two_runs()).to_terminal();
+    let lines: Vec<&str> = out.lines().collect();
+    assert!(lines[0].starts_with("Per-stage"));
+    let header = lines[1];
+    let dashes = lines[2];
+    assert!(dashes.starts_with("------"));
+    // Right-aligned numeric columns: every data row ends where the header ends.
+    let width = |s: &str| s.chars().count();
+    assert_eq!(width(lines[3]), width(header), "{out}");
+    assert_eq!(width(lines[4]), width(header), "{out}");
+    assert_eq!(width(dashes), width(header), "{out}");
+    assert!(out.contains("\nDevice: Test GPU"));
+}
+
+#[test]
+fn detailed_table_has_one_row_per_stage_and_frame() {
+    let runs = two_runs();
+    let t = stage_table_detailed(&runs[0]);
+    assert_eq!(t.columns.len(), 14);
+    assert_eq!(t.columns[2], "GPU median");
+    assert_eq!(t.columns[13], "wall max");
+    assert_eq!(t.rows.len(), 4);
+    assert_eq!(t.rows[1][0], Cell::text("shadow map"));
+    assert_eq!(t.rows[1][2].display(), "1.50");
+    assert_eq!(t.rows[1][8].display(), "1.23");
+    assert_eq!(t.rows[2][2], Cell::Ms(None));
+    assert_eq!(t.rows[3][0], Cell::text("frame"));
+    assert_eq!(t.rows[3][8].display(), "3.00");
+    assert!(t.title.starts_with("direct @ sponza (1280x720)"));
+    assert!(t.to_markdown().contains("| compose | GPU | – | – |"));
+}
+
+#[test]
+fn write_tables_writes_three_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let table = stage_table(&two_runs());
+    let paths = write_tables(&table, &dir.path().join("tables"), "stages").unwrap();
+    let names: Vec<String> = paths
+        .iter()
+        .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(names, ["stages.md", "stages.csv", "stages.tex"]);
+    assert_eq!(
+        std::fs::read_to_string(&paths[0]).unwrap(),
+        table.to_markdown()
+    );
+    assert_eq!(std::fs::read_to_string(&paths[1]).unwrap(), table.to_csv());
+    assert_eq!(
+        std::fs::read_to_string(&paths[2]).unwrap(),
+        table.to_latex()
+    );
+    assert!(write_tables(&table, dir.path(), "").is_err());
+}
+
+/// The text content of every `<text>` element.
+fn svg_texts(svg: &str) -> Vec<String> {
+    svg.split("<text")
+        .skip(1)
+        .map(|t| {
+            t[t.find('>').unwrap() + 1..t.find("</text>").unwrap()]
+                .trim()
+                .to_string()
+        })
+        .collect()
+}
+
+#[test]
+fn stacked_bar_svg_has_bars_labels_and_legend() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("bars.svg");
+    stacked_bar_svg(&two_runs(), &path, "Stage times").unwrap();
+    let svg = std::fs::read_to_string(&path).unwrap();
+    assert!(
+        svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"),
+        "{svg}"
+    );
+    let texts = svg_texts(&svg);
+    for name in [
+        "g-buffer",
+        "shadow map",
+        "vpl trace",
+        "compose",
+        "Stage times",
+        "milliseconds (median)",
+        "direct @ sponza",
+    ] {
+        assert!(
+            texts.iter().any(|t| t == name),
+            "no <text> '{name}' in {texts:?}"
+        );
+    }
+    // The quotes of run B's name are escaped, not raw.
+    assert!(
+        texts
+            .iter()
+            .any(|t| t.contains("ism, &quot;imperfect&quot; @ cornell_box 100%")),
+        "{texts:?}"
+    );
+    assert!(texts.iter().any(|t| t == "2.48 ms"), "{texts:?}");
+    // Six segments (three stages per run) in the stage colours plus the legend swatches.
+    let blue = format!("fill=\"#{:02X}{:02X}{:02X}\"", 78, 121, 167);
+    assert_eq!(
+        svg.matches(&blue).count(),
+        3,
+        "two g-buffer segments and a legend swatch"
+    );
+}
+
+#[test]
+fn zero_and_missing_stage_times_do_not_panic() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut runs = two_runs();
+    runs[0].stages[0].gpu_ms = Some(stats(0.0));
+    runs[0].stages[1].gpu_ms = None;
+    runs[0].stages[1].wall_ms = None;
+    let mut zero = runs[0].clone();
+    for s in &mut zero.stages {
+        s.gpu_ms = Some(stats(0.0));
+    }
+    zero.frame = None;
+    let mut none = runs[1].clone();
+    none.stages.clear();
+    runs.extend([zero, none]);
+    stacked_bar_svg(&runs, &dir.path().join("bars.svg"), "zeros").unwrap();
+    stacked_bar_svg(&runs[2..], &dir.path().join("bars0.svg"), "all zero").unwrap();
+    let points: Vec<(String, RunResult)> = runs
+        .iter()
+        .enumerate()
+        .map(|(i, r)| (i.to_string(), r.clone()))
+        .collect();
+    sweep_plot_svg(&points, &dir.path().join("sweep.svg"), "zeros", "n").unwrap();
+    sweep_plot_svg(
+        &points[2..],
+        &dir.path().join("sweep0.svg"),
+        "all zero",
+        "n",
+    )
+    .unwrap();
+    let t = stage_table(&runs);
+    assert_eq!(
+        t.rows[3].iter().filter(|c| **c == Cell::Ms(None)).count(),
+        5,
+        "{:?}",
+        t.rows[3]
+    );
+    let _ = (t.to_markdown(), t.to_csv(), t.to_latex(), t.to_terminal());
+}
+
+#[test]
+fn sweep_plot_svg_has_stage_lines_and_total() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("sweep.svg");
+    let runs = two_runs();
+    let points: Vec<(String, RunResult)> = ["64", "256", "1024"]
+        .iter()
+        .zip([runs[0].clone(), runs[1].clone(), runs[0].clone()])
+        .map(|(x, r)| (x.to_string(), r))
+        .collect();
+    sweep_plot_svg(&points, &path, "VPL count sweep", "VPLs").unwrap();
+    let svg = std::fs::read_to_string(&path).unwrap();
+    assert!(svg.starts_with("<svg"));
+    let texts = svg_texts(&svg);
+    for name in [
+        "g-buffer",
+        "shadow map",
+        "vpl trace",
+        "compose",
+        "total (Σ stages)",
+        "VPLs",
+        "64",
+        "256",
+        "1024",
+    ] {
+        assert!(
+            texts.iter().any(|t| t == name),
+            "no <text> '{name}' in {texts:?}"
+        );
+    }
+    assert!(svg.contains("<polyline"), "lines are drawn");
+}
+
+#[test]
+fn empty_input_is_an_error_not_a_panic() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("empty.svg");
+    assert!(matches!(
+        stacked_bar_svg(&[], &path, "empty"),
+        Err(Error::Invalid(_))
+    ));
+    assert!(matches!(
+        sweep_plot_svg(&[], &path, "empty", "x"),
+        Err(Error::Invalid(_))
+    ));
+    assert!(!path.exists());
+    let t = stage_table(&[]);
+    assert!(t.rows.is_empty());
+    assert_eq!(
+        t.to_markdown()
+            .lines()
+            .filter(|l| l.starts_with('|'))
+            .count(),
+        2
+    );
+    let _ = (t.to_csv(), t.to_latex(), t.to_terminal());
+}
