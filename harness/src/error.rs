@@ -58,48 +58,9 @@ impl Error {
     }
 }
 
-/// Writes `bytes` to `path` atomically: a temporary file in the same directory, then a rename,
-/// so a reader never sees a half-written file and a failed run leaves nothing behind. While an
-/// [`crate::output::OutputSet`] is open on a folder holding `path`, the file is staged there and
-/// appears at `path` when the set is published.
-pub fn write_atomic(path: &std::path::Path, bytes: &[u8]) -> Result<()> {
-    match crate::output::staged_path(path)? {
-        Some(staged) => write_atomic_direct(&staged, bytes),
-        None => write_atomic_direct(path, bytes),
-    }
-}
-
-/// [`write_atomic`] straight to `path`, never staged (the reference cache). The temporary file is
-/// named `.gibench-tmp-PID-…`, so one a killed process leaves can be found and removed
-/// ([`crate::output::remove_stale_temporaries`]).
-pub fn write_atomic_direct(path: &std::path::Path, bytes: &[u8]) -> Result<()> {
-    use std::io::Write;
-    let dir = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(std::path::Path::new("."));
-    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
-    let mut tmp = tempfile::Builder::new()
-        .prefix(&format!(
-            "{}{}-",
-            crate::output::TEMP_PREFIX,
-            std::process::id()
-        ))
-        .tempfile_in(dir)
-        .map_err(|e| Error::io(dir, e))?;
-    tmp.write_all(bytes).map_err(|e| Error::io(path, e))?;
-    tmp.as_file().sync_all().map_err(|e| Error::io(path, e))?;
-    // Temporary files are created private; results are meant to be read by anyone.
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        tmp.as_file()
-            .set_permissions(std::fs::Permissions::from_mode(0o644))
-            .map_err(|e| Error::io(path, e))?;
-    }
-    tmp.persist(path).map_err(|e| Error::io(path, e.error))?;
-    Ok(())
-}
+/// The atomic writes live with the output sets that stage them; re-exported here for the
+/// callers that name them by this path.
+pub use crate::output::{write_atomic, write_atomic_direct};
 
 /// Parses JSON `bytes` as `T`. A failure says where: the path of the field that failed
 /// (`light.path.keys[1].position`) before serde's message (which gives the line and column).

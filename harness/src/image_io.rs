@@ -108,7 +108,7 @@ pub fn write_png(path: &Path, size: [u32; 2], rgba8: &[u8]) -> Result<()> {
         image::ImageFormat::Png,
     )
     .map_err(|e| Error::bad_file(path, format!("PNG encoding failed: {e}")))?;
-    crate::error::write_atomic(path, &bytes)
+    crate::output::write_atomic(path, &bytes)
 }
 
 /// Writes RGB floats as a 32-bit float OpenEXR file.
@@ -134,7 +134,7 @@ pub fn write_exr(path: &Path, size: [u32; 2], rgb: &[[f32; 3]]) -> Result<()> {
         .non_parallel()
         .to_buffered(&mut bytes)
         .map_err(|e| Error::bad_file(path, format!("EXR encoding failed: {e}")))?;
-    crate::error::write_atomic(path, bytes.get_ref())
+    crate::output::write_atomic(path, bytes.get_ref())
 }
 
 #[cfg(test)]

@@ -9,7 +9,7 @@
 //!   refused, naming `--out`; the lock of a killed run is released by the operating system
 //!   when its process ends (a zombie too), and the next command finishes or undoes what that
 //!   run left (below);
-//! * while the set is open, every file written with [`crate::error::write_atomic`] under the
+//! * while the set is open, every file written with [`write_atomic`] under the
 //!   folder goes to a hidden staging folder (`.gibench-staging/`) instead;
 //! * [`OutputSet::publish`] lists the staged files in a journal (`.gibench-publish`), moves them
 //!   into place, then removes the journal, the staging folder and the lock. A run killed while
@@ -24,7 +24,7 @@
 //! publication is finished the same way), and **file patterns** of the folder itself
 //! ([`OutputSet::replace_files`]: `mesh-*.ply`), likewise.
 //!
-//! Files written with [`crate::error::write_atomic_direct`] (the reference cache, whose entries
+//! Files written with [`write_atomic_direct`] (the reference cache, whose entries
 //! are shared across runs and read back within one) bypass the set.
 //!
 //! One set per process at a time.
@@ -445,7 +445,7 @@ impl OutputSet {
             .chain(patterns.iter().map(|p| format!("{REPLACE_FILES}{p}")))
             .chain(staged.iter().map(|p| p.to_string_lossy().into_owned()))
             .collect();
-        crate::error::write_atomic_direct(&journal, list.join("\n").as_bytes())?;
+        write_atomic_direct(&journal, list.join("\n").as_bytes())?;
         move_staged(&self.dir)?;
         self.published = true;
         self.close();
@@ -706,6 +706,45 @@ pub fn remove_stale_temporaries(dir: &Path) {
 /// Prefix of every temporary file gibench writes (then `PID-`).
 pub(crate) const TEMP_PREFIX: &str = ".gibench-tmp-";
 
+/// Writes `bytes` to `path` atomically: a temporary file in the same directory, then a rename,
+/// so a reader never sees a half-written file and a failed run leaves nothing behind. While an
+/// [`OutputSet`] is open on a folder holding `path`, the file is staged there and
+/// appears at `path` when the set is published.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    match staged_path(path)? {
+        Some(staged) => write_atomic_direct(&staged, bytes),
+        None => write_atomic_direct(path, bytes),
+    }
+}
+
+/// [`write_atomic`] straight to `path`, never staged (the reference cache). The temporary file is
+/// named `.gibench-tmp-PID-…`, so one a killed process leaves can be found and removed
+/// ([`remove_stale_temporaries`]).
+pub fn write_atomic_direct(path: &Path, bytes: &[u8]) -> Result<()> {
+    use std::io::Write;
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+    let mut tmp = tempfile::Builder::new()
+        .prefix(&format!("{}{}-", TEMP_PREFIX, std::process::id()))
+        .tempfile_in(dir)
+        .map_err(|e| Error::io(dir, e))?;
+    tmp.write_all(bytes).map_err(|e| Error::io(path, e))?;
+    tmp.as_file().sync_all().map_err(|e| Error::io(path, e))?;
+    // Temporary files are created private; results are meant to be read by anyone.
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        tmp.as_file()
+            .set_permissions(std::fs::Permissions::from_mode(0o644))
+            .map_err(|e| Error::io(path, e))?;
+    }
+    tmp.persist(path).map_err(|e| Error::io(path, e.error))?;
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -820,7 +859,7 @@ mod tests {
         std::fs::remove_file(out.join("tiles")).unwrap();
         let set = OutputSet::begin("out", &out).unwrap();
         std::os::unix::fs::symlink(&outside, out.join("tiles")).unwrap();
-        let e = crate::error::write_atomic(&out.join("tiles/new.txt"), b"x")
+        let e = write_atomic(&out.join("tiles/new.txt"), b"x")
             .unwrap_err()
             .to_string();
         assert!(e.contains("symbolic link"), "{e}");

@@ -19,46 +19,8 @@ use crate::reference::{self, ReferenceImages, ReferenceSettings};
 use crate::scene::Scene;
 use crate::{Error, Result};
 
-/// Which reference component a technique's indirect irradiance is compared with.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum IndirectComponent {
-    /// Exactly one bounce (Laine, Keller with one bounce, ISM).
-    OneBounce,
-    /// All bounces up to the reference's bounce count.
-    MultiBounce,
-    /// The primary light's direct irradiance (for a technique's direct light samples: Barczak's
-    /// `set=direct`).
-    Direct,
-}
-
-impl IndirectComponent {
-    pub fn parse(s: &str) -> Result<IndirectComponent> {
-        match s {
-            "one-bounce" => Ok(IndirectComponent::OneBounce),
-            "multi-bounce" => Ok(IndirectComponent::MultiBounce),
-            "direct" => Ok(IndirectComponent::Direct),
-            _ => Err(Error::param(
-                "quality-reference",
-                format!("expected one-bounce, multi-bounce or direct (got '{s}')"),
-            )),
-        }
-    }
-    pub fn name(self) -> &'static str {
-        match self {
-            IndirectComponent::OneBounce => "one-bounce",
-            IndirectComponent::MultiBounce => "multi-bounce",
-            IndirectComponent::Direct => "direct",
-        }
-    }
-    /// The component's image.
-    pub fn of(self, r: &ReferenceImages) -> &[Vec3] {
-        match self {
-            IndirectComponent::OneBounce => &r.one_bounce,
-            IndirectComponent::MultiBounce => &r.multi_bounce,
-            IndirectComponent::Direct => &r.direct,
-        }
-    }
-}
+/// Re-exported: the component lives with the reference images it picks from.
+pub use crate::reference::IndirectComponent;
 
 /// Settings of the quality measurement.
 #[derive(Clone, Debug)]
@@ -273,7 +235,7 @@ impl ReferenceCache {
         }
         let (r, setup) = reference::render_reference_timed(scene, frame, resolution, settings);
         if let (Some(p), Some(dir)) = (&path, &self.dir) {
-            crate::error::write_atomic_direct(p, &encode(&r))?;
+            crate::output::write_atomic_direct(p, &encode(&r))?;
             trim(dir, MAX_CACHE_BYTES, p);
         }
         Ok((r, Some(setup)))

@@ -73,6 +73,7 @@ use crate::anim::{FrameState, LightPose};
 use crate::bvh::SceneBvh;
 use crate::scene::descriptor::LightKind;
 use crate::scene::{Mesh, Scene, Texture};
+use crate::{Error, Result};
 
 /// Version of the reference's results: bumped whenever the same inputs would give different
 /// images (part of the reference cache key). 2: the indirect paths' directions from a polynomial
@@ -106,6 +107,47 @@ impl Default for ReferenceSettings {
             spp: 256,
             bounces: 8,
             seed: 0,
+        }
+    }
+}
+
+/// Which reference component a technique's indirect irradiance is compared with.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum IndirectComponent {
+    /// Exactly one bounce (Laine, Keller with one bounce, ISM).
+    OneBounce,
+    /// All bounces up to the reference's bounce count.
+    MultiBounce,
+    /// The primary light's direct irradiance (for a technique's direct light samples: Barczak's
+    /// `set=direct`).
+    Direct,
+}
+
+impl IndirectComponent {
+    pub fn parse(s: &str) -> Result<IndirectComponent> {
+        match s {
+            "one-bounce" => Ok(IndirectComponent::OneBounce),
+            "multi-bounce" => Ok(IndirectComponent::MultiBounce),
+            "direct" => Ok(IndirectComponent::Direct),
+            _ => Err(Error::param(
+                "quality-reference",
+                format!("expected one-bounce, multi-bounce or direct (got '{s}')"),
+            )),
+        }
+    }
+    pub fn name(self) -> &'static str {
+        match self {
+            IndirectComponent::OneBounce => "one-bounce",
+            IndirectComponent::MultiBounce => "multi-bounce",
+            IndirectComponent::Direct => "direct",
+        }
+    }
+    /// The component's image.
+    pub fn of(self, r: &ReferenceImages) -> &[Vec3] {
+        match self {
+            IndirectComponent::OneBounce => &r.one_bounce,
+            IndirectComponent::MultiBounce => &r.multi_bounce,
+            IndirectComponent::Direct => &r.direct,
         }
     }
 }

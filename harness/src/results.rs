@@ -142,7 +142,7 @@ impl RunResult {
     pub fn write(&self, path: &Path) -> Result<()> {
         let json =
             serde_json::to_vec_pretty(self).map_err(|e| Error::bad_file(path, e.to_string()))?;
-        crate::error::write_atomic(path, &json)
+        crate::output::write_atomic(path, &json)
     }
 
     /// Reads and checks a results file.

@@ -14,7 +14,7 @@ use crate::bvh::SceneBvh;
 use crate::gpu::GpuContext;
 use crate::passes::{DirectLight, FrameUniforms, GBuffer, GpuScene};
 use crate::profiler::Profiler;
-use crate::quality::IndirectComponent;
+use crate::reference::IndirectComponent;
 use crate::scene::Scene;
 use crate::{Error, Result};
 

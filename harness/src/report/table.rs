@@ -109,7 +109,7 @@ pub fn write_tables(table: &Table, dir: &Path, stem: &str) -> Result<Vec<PathBuf
     let mut paths = Vec::with_capacity(outputs.len());
     for (ext, text) in outputs {
         let path = dir.join(format!("{stem}.{ext}"));
-        crate::error::write_atomic(&path, text.as_bytes())?;
+        crate::output::write_atomic(&path, text.as_bytes())?;
         paths.push(path);
     }
     Ok(paths)

@@ -101,7 +101,7 @@ fn write_svg(
         draw(root)
             .map_err(|e| Error::Invalid(format!("{}: plotting failed: {e}", path.display())))?;
     }
-    crate::error::write_atomic(path, svg.as_bytes())
+    crate::output::write_atomic(path, svg.as_bytes())
 }
 
 /// A legend entry: the name, its colour and how its swatch is drawn.
