@@ -114,6 +114,14 @@ enum Axis {
     Y,
 }
 
+/// A categorical axis ([`Categories`]): which axis, its slot count and the label of the slot
+/// centred on a value.
+struct CategoryAxis<'a> {
+    axis: Axis,
+    slots: usize,
+    label: &'a dyn Fn(&f64) -> String,
+}
+
 /// What sets one chart apart from the others; [`chart_svg`] draws everything they share.
 struct ChartFrame<'a> {
     /// The caption above the chart.
@@ -126,9 +134,8 @@ struct ChartFrame<'a> {
     x_desc: &'a str,
     /// The y axis' name, if it has one.
     y_desc: Option<&'a str>,
-    /// A categorical axis ([`Categories`]): which one, its slot count and the label of the slot
-    /// centred on a value. Its grid lines are left out.
-    categories: Option<(Axis, usize, &'a dyn Fn(&f64) -> String)>,
+    /// A categorical axis, if any; its grid lines are left out.
+    categories: Option<CategoryAxis<'a>>,
     /// The heading of the legend column.
     legend_title: &'a str,
 }
@@ -163,12 +170,24 @@ where
             .y_label_area_size(frame.label_areas.1)
             .build_cartesian_2d(x, y)?;
         let mut mesh = chart.configure_mesh();
-        match frame.categories {
-            Some((Axis::X, n, labels)) => {
-                mesh.disable_x_mesh().x_labels(n).x_label_formatter(labels);
+        match &frame.categories {
+            Some(CategoryAxis {
+                axis: Axis::X,
+                slots,
+                label,
+            }) => {
+                mesh.disable_x_mesh()
+                    .x_labels(*slots)
+                    .x_label_formatter(*label);
             }
-            Some((Axis::Y, n, labels)) => {
-                mesh.disable_y_mesh().y_labels(n).y_label_formatter(labels);
+            Some(CategoryAxis {
+                axis: Axis::Y,
+                slots,
+                label,
+            }) => {
+                mesh.disable_y_mesh()
+                    .y_labels(*slots)
+                    .y_label_formatter(*label);
             }
             None => {}
         }

@@ -6,7 +6,7 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use super::{axis_max, category, chart_svg, label_width, stage_color, Axis, Categories};
-use super::{ChartFrame, Mark, FONT, LEGEND_W};
+use super::{CategoryAxis, ChartFrame, Mark, FONT, LEGEND_W};
 use crate::report::runs::{run_label, stage_ms, stage_names};
 use crate::report::Cell;
 use crate::results::RunResult;
@@ -46,7 +46,11 @@ pub fn stacked_bar_svg(results: &[RunResult], path: &Path, title: &str) -> Resul
         label_areas: (50, label_area),
         x_desc: "milliseconds (median)",
         y_desc: None,
-        categories: Some((Axis::Y, n, &label_of)),
+        categories: Some(CategoryAxis {
+            axis: Axis::Y,
+            slots: n,
+            label: &label_of,
+        }),
         legend_title: "stages",
     };
     chart_svg(path, &frame, 0.0..xmax, Categories(n), |chart| {

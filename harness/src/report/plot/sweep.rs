@@ -5,8 +5,8 @@ use std::path::Path;
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
-use super::{axis_max, category, chart_svg, stage_color, Axis, Categories, ChartFrame, Mark};
-use super::{PlotResult, LEGEND_W};
+use super::{axis_max, category, chart_svg, stage_color, Axis, Categories, CategoryAxis};
+use super::{ChartFrame, Mark, PlotResult, LEGEND_W};
 use crate::report::runs::{stage_ms, stage_names, stage_sum};
 use crate::results::RunResult;
 use crate::{Error, Result};
@@ -64,7 +64,11 @@ pub fn sweep_plot_svg(
         label_areas: (60, 70),
         x_desc: x_name,
         y_desc: Some("milliseconds (median)"),
-        categories: Some((Axis::X, m, &label_of)),
+        categories: Some(CategoryAxis {
+            axis: Axis::X,
+            slots: m,
+            label: &label_of,
+        }),
         legend_title: "stages",
     };
     chart_svg(path, &frame, Categories(m), 0.0..ymax, |chart| {
