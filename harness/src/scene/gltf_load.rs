@@ -67,7 +67,88 @@ pub fn load_gltf_with_offsets(
     let (doc, buffers, images) = import_checked(path)?;
     let bad = |message: String| Error::bad_file(path, message);
 
-    // Materials and the images they use as base colour.
+    let (mut materials, textures) = load_materials(path, &doc, &images, texture_offset)?;
+    let file_material_count = materials.len();
+    let mut default_material: Option<u32> = None;
+
+    let mut mesh = Mesh::default();
+    let mut lights = Vec::new();
+    let mut visited = vec![false; doc.nodes().len()];
+    let mut stack: Vec<(gltf::Node, Mat4)> = scene_roots(&doc)
+        .into_iter()
+        .rev()
+        .map(|n| (n, Mat4::IDENTITY))
+        .collect();
+    while let Some((node, parent)) = stack.pop() {
+        if std::mem::replace(&mut visited[node.index()], true) {
+            return Err(bad(format!(
+                "node {} appears twice in the scene's hierarchy",
+                node.index()
+            )));
+        }
+        let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
+        if !world.is_finite() {
+            return Err(bad(format!(
+                "node {}: transform is not finite",
+                node.index()
+            )));
+        }
+        for child in node.children().collect::<Vec<_>>().into_iter().rev() {
+            stack.push((child, world));
+        }
+
+        if let Some(light) = node.light() {
+            lights.push(punctual_light(&node, &light, world));
+        }
+
+        let Some(gmesh) = node.mesh() else { continue };
+        let placement = Placement::of(world);
+        for prim in gmesh.primitives() {
+            if prim.mode() != gltf::mesh::Mode::Triangles {
+                continue;
+            }
+            let material = match prim.material().index() {
+                Some(i) => material_offset + i as u32,
+                None => *default_material.get_or_insert_with(|| {
+                    materials.push(Material {
+                        name: "default".into(),
+                        base_color: Vec3::splat(DEFAULT_ALBEDO),
+                        texture: None,
+                        average_color: Vec3::splat(DEFAULT_ALBEDO),
+                    });
+                    material_offset + file_material_count as u32
+                }),
+            };
+            let what = || format!("mesh {} primitive {}", gmesh.index(), prim.index());
+            let Some(data) = read_primitive(path, &prim, &buffers, &what)? else {
+                continue;
+            };
+            append_primitive(path, &mut mesh, data, &placement, material, &what)?;
+        }
+    }
+
+    if mesh.triangle_count() == 0 {
+        return Err(bad(
+            "contains no triangles (only triangle-list primitives are read)".into(),
+        ));
+    }
+    Ok(LoadedGltf {
+        mesh,
+        materials,
+        textures,
+        lights,
+    })
+}
+
+/// The file's materials, in order, and the images they use as base colour (decoded once each,
+/// in order of first use); a material's texture index is offset by `texture_offset`.
+fn load_materials(
+    path: &Path,
+    doc: &gltf::Document,
+    images: &[gltf::image::Data],
+    texture_offset: u32,
+) -> Result<(Vec<Material>, Vec<Texture>)> {
+    let bad = |message: String| Error::bad_file(path, message);
     let mut materials = Vec::new();
     let mut textures: Vec<Texture> = Vec::new();
     let mut image_slot: HashMap<usize, usize> = HashMap::new();
@@ -119,11 +200,13 @@ pub fn load_gltf_with_offsets(
             average_color,
         });
     }
-    let file_material_count = materials.len();
-    let mut default_material: Option<u32> = None;
+    Ok((materials, textures))
+}
 
-    // Roots of the scene to walk.
-    let roots: Vec<gltf::Node> = match doc.default_scene().or_else(|| doc.scenes().next()) {
+/// Roots of the scene to walk: the default scene's (else the first scene's) nodes, else every
+/// node that is no other node's child.
+fn scene_roots(doc: &gltf::Document) -> Vec<gltf::Node<'_>> {
+    match doc.default_scene().or_else(|| doc.scenes().next()) {
         Some(scene) => scene.nodes().collect(),
         None => {
             let mut is_child = vec![false; doc.nodes().len()];
@@ -134,63 +217,52 @@ pub fn load_gltf_with_offsets(
             }
             doc.nodes().filter(|n| !is_child[n.index()]).collect()
         }
+    }
+}
+
+/// The `KHR_lights_punctual` light `light` of `node`, placed by the node's `world` matrix.
+fn punctual_light(
+    node: &gltf::Node,
+    light: &gltf::khr_lights_punctual::Light,
+    world: Mat4,
+) -> PunctualLight {
+    let kind = match light.kind() {
+        gltf::khr_lights_punctual::Kind::Point => PunctualKind::Point,
+        gltf::khr_lights_punctual::Kind::Directional => PunctualKind::Directional,
+        gltf::khr_lights_punctual::Kind::Spot {
+            inner_cone_angle,
+            outer_cone_angle,
+        } => PunctualKind::Spot {
+            inner_cone_angle,
+            outer_cone_angle,
+        },
     };
+    PunctualLight {
+        name: light
+            .name()
+            .or(node.name())
+            .map(str::to_owned)
+            .unwrap_or_else(|| format!("light{}", light.index())),
+        kind,
+        position: world.transform_point3(Vec3::ZERO),
+        direction: world
+            .transform_vector3(Vec3::NEG_Z)
+            .normalize_or(Vec3::NEG_Z),
+        color: Vec3::from(light.color()),
+        intensity: light.intensity(),
+    }
+}
 
-    let mut mesh = Mesh::default();
-    let mut lights = Vec::new();
-    let mut visited = vec![false; doc.nodes().len()];
-    let mut stack: Vec<(gltf::Node, Mat4)> = roots
-        .into_iter()
-        .rev()
-        .map(|n| (n, Mat4::IDENTITY))
-        .collect();
-    while let Some((node, parent)) = stack.pop() {
-        if std::mem::replace(&mut visited[node.index()], true) {
-            return Err(bad(format!(
-                "node {} appears twice in the scene's hierarchy",
-                node.index()
-            )));
-        }
-        let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
-        if !world.is_finite() {
-            return Err(bad(format!(
-                "node {}: transform is not finite",
-                node.index()
-            )));
-        }
-        for child in node.children().collect::<Vec<_>>().into_iter().rev() {
-            stack.push((child, world));
-        }
+/// A node's world matrix with what its primitives need from it: the normal matrix (inverse
+/// transpose; zero for a singular matrix) and whether it mirrors (then windings are swapped).
+struct Placement {
+    world: Mat4,
+    normal_matrix: Mat3,
+    mirrored: bool,
+}
 
-        if let Some(light) = node.light() {
-            let kind = match light.kind() {
-                gltf::khr_lights_punctual::Kind::Point => PunctualKind::Point,
-                gltf::khr_lights_punctual::Kind::Directional => PunctualKind::Directional,
-                gltf::khr_lights_punctual::Kind::Spot {
-                    inner_cone_angle,
-                    outer_cone_angle,
-                } => PunctualKind::Spot {
-                    inner_cone_angle,
-                    outer_cone_angle,
-                },
-            };
-            lights.push(PunctualLight {
-                name: light
-                    .name()
-                    .or(node.name())
-                    .map(str::to_owned)
-                    .unwrap_or_else(|| format!("light{}", light.index())),
-                kind,
-                position: world.transform_point3(Vec3::ZERO),
-                direction: world
-                    .transform_vector3(Vec3::NEG_Z)
-                    .normalize_or(Vec3::NEG_Z),
-                color: Vec3::from(light.color()),
-                intensity: light.intensity(),
-            });
-        }
-
-        let Some(gmesh) = node.mesh() else { continue };
+impl Placement {
+    fn of(world: Mat4) -> Placement {
         let normal_matrix = {
             let m = Mat3::from_mat4(world);
             let det = m.determinant();
@@ -201,184 +273,205 @@ pub fn load_gltf_with_offsets(
             }
         };
         let mirrored = Mat3::from_mat4(world).determinant() < 0.0;
+        Placement {
+            world,
+            normal_matrix,
+            mirrored,
+        }
+    }
+}
 
-        for prim in gmesh.primitives() {
-            if prim.mode() != gltf::mesh::Mode::Triangles {
-                continue;
-            }
-            let what = || format!("mesh {} primitive {}", gmesh.index(), prim.index());
-            let material = match prim.material().index() {
-                Some(i) => material_offset + i as u32,
-                None => *default_material.get_or_insert_with(|| {
-                    materials.push(Material {
-                        name: "default".into(),
-                        base_color: Vec3::splat(DEFAULT_ALBEDO),
-                        texture: None,
-                        average_color: Vec3::splat(DEFAULT_ALBEDO),
-                    });
-                    material_offset + file_material_count as u32
-                }),
-            };
-            let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
-            // An accessor whose data lies outside its buffer makes the reader return None.
-            let position_accessor = prim.get(&gltf::Semantic::Positions);
-            if position_accessor.as_ref().is_some_and(|a| a.count() == 0) {
-                continue;
-            }
-            let positions: Vec<Vec3> = match (position_accessor, reader.read_positions()) {
-                (None, _) => continue,
-                (Some(_), None) => {
-                    return Err(bad(format!(
-                        "{}: POSITION data lies outside its buffer",
-                        what()
-                    )))
-                }
-                (Some(_), Some(it)) => it.map(Vec3::from).collect(),
-            };
-            if positions.iter().any(|p| !p.is_finite()) {
-                return Err(bad(format!("{}: non-finite vertex positions", what())));
-            }
-            let n = positions.len();
-            let normals: Option<Vec<Vec3>> = match prim.get(&gltf::Semantic::Normals) {
-                None => None,
-                Some(a) if a.count() != n => {
-                    return Err(bad(format!(
-                        "{}: {} normals for {n} positions",
-                        what(),
-                        a.count()
-                    )))
-                }
-                Some(_) => Some(
-                    reader
-                        .read_normals()
-                        .ok_or_else(|| {
-                            bad(format!("{}: NORMAL data lies outside its buffer", what()))
-                        })?
-                        .map(Vec3::from)
-                        .collect(),
-                ),
-            };
-            let uvs: Vec<Vec2> = match prim.get(&gltf::Semantic::TexCoords(0)) {
-                None => vec![Vec2::ZERO; n],
-                Some(a) if a.count() != n => {
-                    return Err(bad(format!(
-                        "{}: {} texture coordinates for {n} positions",
-                        what(),
-                        a.count()
-                    )))
-                }
-                Some(_) => reader
-                    .read_tex_coords(0)
-                    .ok_or_else(|| {
-                        bad(format!(
-                            "{}: TEXCOORD_0 data lies outside its buffer",
-                            what()
-                        ))
-                    })?
-                    .into_f32()
-                    .map(Vec2::from)
-                    .map(|uv| if uv.is_finite() { uv } else { Vec2::ZERO })
-                    .collect(),
-            };
-            let mut indices: Vec<u32> = match prim.indices() {
-                None => (0..n as u32).collect(),
-                Some(a) if a.count() == 0 => Vec::new(),
-                Some(_) => reader
-                    .read_indices()
-                    .ok_or_else(|| bad(format!("{}: index data lies outside its buffer", what())))?
-                    .into_u32()
-                    .collect(),
-            };
-            indices.truncate(indices.len() / 3 * 3);
-            if let Some(&i) = indices.iter().find(|&&i| i as usize >= n) {
-                return Err(bad(format!(
-                    "{}: index {i} is out of range ({n} vertices)",
-                    what()
-                )));
-            }
-            if indices.is_empty() {
-                continue;
-            }
-            if mirrored {
-                for tri in indices.chunks_exact_mut(3) {
-                    tri.swap(1, 2);
-                }
-            }
-            let world_positions: Vec<Vec3> = positions
-                .iter()
-                .map(|p| world.transform_point3(*p))
-                .collect();
-            if world_positions.iter().any(|p| !p.is_finite()) {
-                return Err(bad(format!(
-                    "{}: vertex positions overflow after the node transform",
-                    what()
-                )));
-            }
-            if mesh.positions.len() + indices.len() > u32::MAX as usize {
-                return Err(bad("too many vertices for 32-bit indices".into()));
-            }
+/// One triangle-list primitive's vertex data as stored (object space), indices checked and cut
+/// to whole triangles.
+struct PrimitiveData {
+    positions: Vec<Vec3>,
+    normals: Option<Vec<Vec3>>,
+    uvs: Vec<Vec2>,
+    indices: Vec<u32>,
+}
 
-            let base = mesh.positions.len() as u32;
-            match normals {
-                Some(normals) => {
-                    for v in 0..n {
-                        mesh.positions.push(world_positions[v]);
-                        mesh.uvs.push(uvs[v]);
-                        mesh.materials.push(material);
-                        mesh.normals
-                            .push((normal_matrix * normals[v]).normalize_or_zero());
-                    }
-                    mesh.indices.extend(indices.iter().map(|i| base + i));
-                    // Zero or degenerate normals fall back to the face normal of a triangle
-                    // using the vertex.
-                    for tri in indices.chunks_exact(3) {
-                        let face = face_normal(&world_positions, tri);
-                        for &i in tri {
-                            let slot = &mut mesh.normals[(base + i) as usize];
-                            if *slot == Vec3::ZERO {
-                                *slot = face;
-                            }
-                        }
-                    }
-                    for v in 0..n {
-                        let slot = &mut mesh.normals[base as usize + v];
-                        if *slot == Vec3::ZERO {
-                            *slot = Vec3::Y; // an unused vertex
-                        }
+/// Reads a primitive's positions, normals, texture coordinates and indices; `None` when it has
+/// no positions or no triangles. `what` names it in errors.
+fn read_primitive(
+    path: &Path,
+    prim: &gltf::Primitive,
+    buffers: &[gltf::buffer::Data],
+    what: &dyn Fn() -> String,
+) -> Result<Option<PrimitiveData>> {
+    let bad = |message: String| Error::bad_file(path, message);
+    let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
+    // An accessor whose data lies outside its buffer makes the reader return None.
+    let position_accessor = prim.get(&gltf::Semantic::Positions);
+    if position_accessor.as_ref().is_some_and(|a| a.count() == 0) {
+        return Ok(None);
+    }
+    let positions: Vec<Vec3> = match (position_accessor, reader.read_positions()) {
+        (None, _) => return Ok(None),
+        (Some(_), None) => {
+            return Err(bad(format!(
+                "{}: POSITION data lies outside its buffer",
+                what()
+            )))
+        }
+        (Some(_), Some(it)) => it.map(Vec3::from).collect(),
+    };
+    if positions.iter().any(|p| !p.is_finite()) {
+        return Err(bad(format!("{}: non-finite vertex positions", what())));
+    }
+    let n = positions.len();
+    let normals: Option<Vec<Vec3>> = match prim.get(&gltf::Semantic::Normals) {
+        None => None,
+        Some(a) if a.count() != n => {
+            return Err(bad(format!(
+                "{}: {} normals for {n} positions",
+                what(),
+                a.count()
+            )))
+        }
+        Some(_) => Some(
+            reader
+                .read_normals()
+                .ok_or_else(|| bad(format!("{}: NORMAL data lies outside its buffer", what())))?
+                .map(Vec3::from)
+                .collect(),
+        ),
+    };
+    let uvs: Vec<Vec2> = match prim.get(&gltf::Semantic::TexCoords(0)) {
+        None => vec![Vec2::ZERO; n],
+        Some(a) if a.count() != n => {
+            return Err(bad(format!(
+                "{}: {} texture coordinates for {n} positions",
+                what(),
+                a.count()
+            )))
+        }
+        Some(_) => reader
+            .read_tex_coords(0)
+            .ok_or_else(|| {
+                bad(format!(
+                    "{}: TEXCOORD_0 data lies outside its buffer",
+                    what()
+                ))
+            })?
+            .into_f32()
+            .map(Vec2::from)
+            .map(|uv| if uv.is_finite() { uv } else { Vec2::ZERO })
+            .collect(),
+    };
+    let mut indices: Vec<u32> = match prim.indices() {
+        None => (0..n as u32).collect(),
+        Some(a) if a.count() == 0 => Vec::new(),
+        Some(_) => reader
+            .read_indices()
+            .ok_or_else(|| bad(format!("{}: index data lies outside its buffer", what())))?
+            .into_u32()
+            .collect(),
+    };
+    indices.truncate(indices.len() / 3 * 3);
+    if let Some(&i) = indices.iter().find(|&&i| i as usize >= n) {
+        return Err(bad(format!(
+            "{}: index {i} is out of range ({n} vertices)",
+            what()
+        )));
+    }
+    if indices.is_empty() {
+        return Ok(None);
+    }
+    Ok(Some(PrimitiveData {
+        positions,
+        normals,
+        uvs,
+        indices,
+    }))
+}
+
+/// Appends a primitive to `mesh` in world space with material `material`: windings swapped
+/// where the placement mirrors, stored normals transformed (a zero or degenerate one replaced
+/// by a face normal of a triangle using the vertex), or flat normals on vertices of their own
+/// where it has none.
+fn append_primitive(
+    path: &Path,
+    mesh: &mut Mesh,
+    data: PrimitiveData,
+    placement: &Placement,
+    material: u32,
+    what: &dyn Fn() -> String,
+) -> Result<()> {
+    let bad = |message: String| Error::bad_file(path, message);
+    let PrimitiveData {
+        positions,
+        normals,
+        uvs,
+        mut indices,
+    } = data;
+    let n = positions.len();
+    let world = placement.world;
+    if placement.mirrored {
+        for tri in indices.chunks_exact_mut(3) {
+            tri.swap(1, 2);
+        }
+    }
+    let world_positions: Vec<Vec3> = positions
+        .iter()
+        .map(|p| world.transform_point3(*p))
+        .collect();
+    if world_positions.iter().any(|p| !p.is_finite()) {
+        return Err(bad(format!(
+            "{}: vertex positions overflow after the node transform",
+            what()
+        )));
+    }
+    if mesh.positions.len() + indices.len() > u32::MAX as usize {
+        return Err(bad("too many vertices for 32-bit indices".into()));
+    }
+
+    let base = mesh.positions.len() as u32;
+    match normals {
+        Some(normals) => {
+            for v in 0..n {
+                mesh.positions.push(world_positions[v]);
+                mesh.uvs.push(uvs[v]);
+                mesh.materials.push(material);
+                mesh.normals
+                    .push((placement.normal_matrix * normals[v]).normalize_or_zero());
+            }
+            mesh.indices.extend(indices.iter().map(|i| base + i));
+            // Zero or degenerate normals fall back to the face normal of a triangle
+            // using the vertex.
+            for tri in indices.chunks_exact(3) {
+                let face = face_normal(&world_positions, tri);
+                for &i in tri {
+                    let slot = &mut mesh.normals[(base + i) as usize];
+                    if *slot == Vec3::ZERO {
+                        *slot = face;
                     }
                 }
-                None => {
-                    // Flat normals: every triangle gets its own three vertices.
-                    for (k, tri) in indices.chunks_exact(3).enumerate() {
-                        let face = face_normal(&world_positions, tri);
-                        for &i in tri {
-                            mesh.positions.push(world_positions[i as usize]);
-                            mesh.uvs.push(uvs[i as usize]);
-                            mesh.materials.push(material);
-                            mesh.normals.push(face);
-                        }
-                        let b = base + 3 * k as u32;
-                        mesh.indices.extend_from_slice(&[b, b + 1, b + 2]);
-                    }
+            }
+            for v in 0..n {
+                let slot = &mut mesh.normals[base as usize + v];
+                if *slot == Vec3::ZERO {
+                    *slot = Vec3::Y; // an unused vertex
                 }
             }
         }
+        None => {
+            // Flat normals: every triangle gets its own three vertices.
+            for (k, tri) in indices.chunks_exact(3).enumerate() {
+                let face = face_normal(&world_positions, tri);
+                for &i in tri {
+                    mesh.positions.push(world_positions[i as usize]);
+                    mesh.uvs.push(uvs[i as usize]);
+                    mesh.materials.push(material);
+                    mesh.normals.push(face);
+                }
+                let b = base + 3 * k as u32;
+                mesh.indices.extend_from_slice(&[b, b + 1, b + 2]);
+            }
+        }
     }
-
-    if mesh.triangle_count() == 0 {
-        return Err(bad(
-            "contains no triangles (only triangle-list primitives are read)".into(),
-        ));
-    }
-    Ok(LoadedGltf {
-        mesh,
-        materials,
-        textures,
-        lights,
-    })
+    Ok(())
 }
 
-/// Unit normal of triangle `tri` (counter-clockwise front), `+Y` if it has no area.
 /// Largest glTF file, and largest file one of its URIs may name, that gibench reads (2 GiB).
 pub const MAX_GLTF_FILE_BYTES: u64 = 2 << 30;
 
@@ -502,6 +595,7 @@ fn percent_decode(s: &str) -> Option<String> {
     String::from_utf8(out).ok()
 }
 
+/// Unit normal of triangle `tri` (counter-clockwise front), `+Y` if it has no area.
 fn face_normal(positions: &[Vec3], tri: &[u32]) -> Vec3 {
     let [a, b, c] = [0, 1, 2].map(|k| positions[tri[k] as usize]);
     (b - a).cross(c - a).normalize_or(Vec3::Y)
