@@ -37,11 +37,24 @@ enum Facing {
     AwayFrom(Vec3),
 }
 
-/// (corners, material, facing) for every quad, corners in the published order.
-fn quads() -> Vec<([Vec3; 4], u32, Facing)> {
-    let v = |x: f32, y: f32, z: f32| Vec3::new(x, y, z);
-    let short_centre = v(186.0, 82.5, 168.5);
-    let tall_centre = v(368.5, 165.0, 351.5);
+/// A quad: its corners in the published order, its material and which way it faces.
+type Quad = ([Vec3; 4], u32, Facing);
+
+fn v(x: f32, y: f32, z: f32) -> Vec3 {
+    Vec3::new(x, y, z)
+}
+
+/// (corners, material, facing) for every quad, corners in the published order: the room, the
+/// short block, the tall block.
+fn quads() -> Vec<Quad> {
+    let mut quads = room();
+    quads.extend(short_block());
+    quads.extend(tall_block());
+    quads
+}
+
+/// Floor, luminaire patch, ceiling, back, right and left walls, all facing the inside.
+fn room() -> Vec<Quad> {
     vec![
         // Floor.
         (
@@ -109,7 +122,13 @@ fn quads() -> Vec<([Vec3; 4], u32, Facing)> {
             RED,
             Facing::Along(Vec3::NEG_X),
         ),
-        // Short block.
+    ]
+}
+
+/// The short block's top and four sides, facing away from its centre.
+fn short_block() -> Vec<Quad> {
+    let short_centre = v(186.0, 82.5, 168.5);
+    vec![
         (
             [
                 v(130.0, 165.0, 65.0),
@@ -160,7 +179,13 @@ fn quads() -> Vec<([Vec3; 4], u32, Facing)> {
             BOX,
             Facing::AwayFrom(short_centre),
         ),
-        // Tall block.
+    ]
+}
+
+/// The tall block's top and four sides, facing away from its centre.
+fn tall_block() -> Vec<Quad> {
+    let tall_centre = v(368.5, 165.0, 351.5);
+    vec![
         (
             [
                 v(423.0, 330.0, 247.0),
