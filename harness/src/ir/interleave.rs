@@ -117,93 +117,88 @@ fn buffer_entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_>
     }
 }
 
-impl Interleave {
-    /// Workgroup size (both axes) of every interleave pass; accumulate shaders use it too.
-    pub const WORKGROUP_SIZE: u32 = 8;
-    /// Largest number of tiles per axis.
-    pub const MAX_TILES: u32 = 64;
+/// Refuses a tile grid outside `1..=MAX_TILES` per side or with more tiles along an axis than
+/// the image has pixels, an output texture that is not the G-buffer's size, format and storage
+/// usage, and filter thresholds out of range.
+fn check_setup(
+    tiles: [u32; 2],
+    full: [u32; 2],
+    output: &wgpu::Texture,
+    filter: &FilterSettings,
+) -> Result<()> {
+    if tiles
+        .iter()
+        .any(|t| !(1..=Interleave::MAX_TILES).contains(t))
+    {
+        return Err(Error::param(
+            "tiles",
+            format!(
+                "{}x{} tiles: each side must be between 1 and {}",
+                tiles[0],
+                tiles[1],
+                Interleave::MAX_TILES
+            ),
+        ));
+    }
+    if tiles[0] > full[0] || tiles[1] > full[1] {
+        // Tiles without a pixel would take their VPLs' light away (or, filtered, spread
+        // others' into hot spots).
+        return Err(Error::param(
+            "tiles",
+            format!(
+                "{}x{} tiles on a {}x{} image: a tile grid cannot have more tiles along an axis than the image has pixels",
+                tiles[0], tiles[1], full[0], full[1]
+            ),
+        ));
+    }
+    let out_size = [output.width(), output.height()];
+    if out_size != full || output.depth_or_array_layers() != 1 {
+        return Err(Error::param(
+            "output",
+            format!(
+                "interleave output texture is {}x{}x{}; it must match the G-buffer, {}x{}",
+                out_size[0],
+                out_size[1],
+                output.depth_or_array_layers(),
+                full[0],
+                full[1]
+            ),
+        ));
+    }
+    if output.format() != HDR_FORMAT {
+        return Err(Error::param(
+            "output",
+            format!(
+                "interleave output texture is {:?}; it must be {HDR_FORMAT:?}",
+                output.format()
+            ),
+        ));
+    }
+    if !output
+        .usage()
+        .contains(wgpu::TextureUsages::STORAGE_BINDING)
+    {
+        return Err(Error::param(
+            "output",
+            "interleave output texture needs usage STORAGE_BINDING",
+        ));
+    }
+    check_filter(filter)?;
+    Ok(())
+}
 
-    /// Creates the buffers, pipelines and bind groups (nothing is created per frame).
-    ///
-    /// `output` is the technique's full-resolution indirect-irradiance texture: Rgba16Float, the
-    /// G-buffer's size, with usage STORAGE_BINDING (and typically TEXTURE_BINDING | COPY_SRC).
-    pub fn new(
-        gpu: &GpuContext,
-        gbuffer: &GBuffer,
-        tiles: (u32, u32),
-        filter: FilterSettings,
-        output: &wgpu::Texture,
-    ) -> Result<Interleave> {
-        let device = &gpu.device;
-        let tiles = [tiles.0, tiles.1];
-        if tiles.iter().any(|t| !(1..=Self::MAX_TILES).contains(t)) {
-            return Err(Error::param(
-                "tiles",
-                format!(
-                    "{}x{} tiles: each side must be between 1 and {}",
-                    tiles[0],
-                    tiles[1],
-                    Self::MAX_TILES
-                ),
-            ));
-        }
-        let full = gbuffer.size;
-        if tiles[0] > full[0] || tiles[1] > full[1] {
-            // Tiles without a pixel would take their VPLs' light away (or, filtered, spread
-            // others' into hot spots).
-            return Err(Error::param(
-                "tiles",
-                format!(
-                    "{}x{} tiles on a {}x{} image: a tile grid cannot have more tiles along an axis than the image has pixels",
-                    tiles[0], tiles[1], full[0], full[1]
-                ),
-            ));
-        }
-        let out_size = [output.width(), output.height()];
-        if out_size != full || output.depth_or_array_layers() != 1 {
-            return Err(Error::param(
-                "output",
-                format!(
-                    "interleave output texture is {}x{}x{}; it must match the G-buffer, {}x{}",
-                    out_size[0],
-                    out_size[1],
-                    output.depth_or_array_layers(),
-                    full[0],
-                    full[1]
-                ),
-            ));
-        }
-        if output.format() != HDR_FORMAT {
-            return Err(Error::param(
-                "output",
-                format!(
-                    "interleave output texture is {:?}; it must be {HDR_FORMAT:?}",
-                    output.format()
-                ),
-            ));
-        }
-        if !output
-            .usage()
-            .contains(wgpu::TextureUsages::STORAGE_BINDING)
-        {
-            return Err(Error::param(
-                "output",
-                "interleave output texture needs usage STORAGE_BINDING",
-            ));
-        }
-        check_filter(&filter)?;
-        let tile_size = [full[0].div_ceil(tiles[0]), full[1].div_ceil(tiles[1])];
-        let split_size = [tile_size[0] * tiles[0], tile_size[1] * tiles[1]];
+/// The interleave buffers: the uniform and the split, irradiance and combined storage.
+struct Buffers {
+    params: wgpu::Buffer,
+    split_position: wgpu::Buffer,
+    split_normal: wgpu::Buffer,
+    split_irradiance: wgpu::Buffer,
+    combined: wgpu::Buffer,
+}
 
-        let split_bytes = split_size[0] as u64 * split_size[1] as u64 * 16;
-        let full_bytes = full[0] as u64 * full[1] as u64 * 16;
-        let max = gpu.max_storage_buffer();
-        if split_bytes.max(full_bytes) > max {
-            return Err(Error::Gpu(format!(
-                "interleave buffers of {} bytes exceed the adapter's storage-buffer limit of {max}",
-                split_bytes.max(full_bytes)
-            )));
-        }
+impl Buffers {
+    /// Split buffers of `split_bytes`, the combined buffer of `full_bytes`, and the uniform.
+    fn new(device: &wgpu::Device, split_bytes: u64, full_bytes: u64) -> Buffers {
         let buffer = |label: &str, size: u64| {
             device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
@@ -224,91 +219,174 @@ impl Interleave {
             usage: PARAMS_USAGE,
             mapped_at_creation: false,
         });
+        Buffers {
+            params,
+            split_position,
+            split_normal,
+            split_irradiance,
+            combined,
+        }
+    }
+}
 
-        let compute = wgpu::ShaderStages::COMPUTE;
-        let split_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("interleave split (accumulate)"),
-            entries: &[
-                params_entry(0, compute),
-                storage_entry(1, true),
-                storage_entry(2, true),
-                storage_entry(3, false),
-            ],
-        });
-        let split_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("interleave split (accumulate)"),
-            layout: &split_layout,
-            entries: &[
-                buffer_entry(0, &params),
-                buffer_entry(1, &split_position),
-                buffer_entry(2, &split_normal),
-                buffer_entry(3, &split_irradiance),
-            ],
-        });
-        let pass_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("interleave passes"),
-            entries: &[
-                params_entry(0, compute),
-                storage_entry(1, false),
-                storage_entry(2, false),
-                storage_entry(3, true),
-                storage_entry(4, false),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 5,
-                    visibility: compute,
-                    ty: wgpu::BindingType::StorageTexture {
-                        access: wgpu::StorageTextureAccess::WriteOnly,
-                        format: HDR_FORMAT,
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                    },
-                    count: None,
-                },
-            ],
-        });
-        let output_view = output.create_view(&Default::default());
-        let pass_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("interleave passes"),
-            layout: &pass_layout,
-            entries: &[
-                buffer_entry(0, &params),
-                buffer_entry(1, &split_position),
-                buffer_entry(2, &split_normal),
-                buffer_entry(3, &split_irradiance),
-                buffer_entry(4, &combined),
-                wgpu::BindGroupEntry {
-                    binding: 5,
-                    resource: wgpu::BindingResource::TextureView(&output_view),
-                },
-            ],
-        });
-        let module = shader_module(
-            device,
-            "interleave",
-            &format!(
-                "{}\n{}",
-                include_str!("shaders/interleave.wgsl"),
-                include_str!("shaders/interleave_passes.wgsl")
-            ),
-        );
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("interleave"),
-            bind_group_layouts: &[Some(&pass_layout), Some(&gbuffer.read_layout)],
-            immediate_size: 0,
-        });
-        let pipeline = |label: &str, entry: &str| {
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(label),
-                layout: Some(&pipeline_layout),
-                module: &module,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        };
-        let split_pipeline = pipeline("interleave split", "split_main");
-        let combine_pipeline = pipeline("interleave combine", "combine_main");
-        let filter_pipeline = pipeline("interleave filter", "filter_main");
+/// Group 0 of a technique's accumulate shader: the uniform, the split position and normal
+/// (read) and the split irradiance (read_write).
+fn split_bind_group(
+    device: &wgpu::Device,
+    b: &Buffers,
+) -> (wgpu::BindGroupLayout, wgpu::BindGroup) {
+    let compute = wgpu::ShaderStages::COMPUTE;
+    let split_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("interleave split (accumulate)"),
+        entries: &[
+            params_entry(0, compute),
+            storage_entry(1, true),
+            storage_entry(2, true),
+            storage_entry(3, false),
+        ],
+    });
+    let split_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("interleave split (accumulate)"),
+        layout: &split_layout,
+        entries: &[
+            buffer_entry(0, &b.params),
+            buffer_entry(1, &b.split_position),
+            buffer_entry(2, &b.split_normal),
+            buffer_entry(3, &b.split_irradiance),
+        ],
+    });
+    (split_layout, split_group)
+}
 
+/// The split, combine and filter passes' group: every buffer and the output texture.
+fn pass_bind_group(
+    device: &wgpu::Device,
+    b: &Buffers,
+    output: &wgpu::Texture,
+) -> (wgpu::BindGroupLayout, wgpu::BindGroup) {
+    let compute = wgpu::ShaderStages::COMPUTE;
+    let pass_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("interleave passes"),
+        entries: &[
+            params_entry(0, compute),
+            storage_entry(1, false),
+            storage_entry(2, false),
+            storage_entry(3, true),
+            storage_entry(4, false),
+            wgpu::BindGroupLayoutEntry {
+                binding: 5,
+                visibility: compute,
+                ty: wgpu::BindingType::StorageTexture {
+                    access: wgpu::StorageTextureAccess::WriteOnly,
+                    format: HDR_FORMAT,
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                },
+                count: None,
+            },
+        ],
+    });
+    let output_view = output.create_view(&Default::default());
+    let pass_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("interleave passes"),
+        layout: &pass_layout,
+        entries: &[
+            buffer_entry(0, &b.params),
+            buffer_entry(1, &b.split_position),
+            buffer_entry(2, &b.split_normal),
+            buffer_entry(3, &b.split_irradiance),
+            buffer_entry(4, &b.combined),
+            wgpu::BindGroupEntry {
+                binding: 5,
+                resource: wgpu::BindingResource::TextureView(&output_view),
+            },
+        ],
+    });
+    (pass_layout, pass_group)
+}
+
+/// The split, combine and filter pipelines, in that order, over the pass group and the
+/// G-buffer's read group.
+fn pipelines(
+    device: &wgpu::Device,
+    pass_layout: &wgpu::BindGroupLayout,
+    gbuffer: &GBuffer,
+) -> [wgpu::ComputePipeline; 3] {
+    let module = shader_module(
+        device,
+        "interleave",
+        &format!(
+            "{}\n{}",
+            include_str!("shaders/interleave.wgsl"),
+            include_str!("shaders/interleave_passes.wgsl")
+        ),
+    );
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("interleave"),
+        bind_group_layouts: &[Some(pass_layout), Some(&gbuffer.read_layout)],
+        immediate_size: 0,
+    });
+    let pipeline = |label: &str, entry: &str| {
+        device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(label),
+            layout: Some(&pipeline_layout),
+            module: &module,
+            entry_point: Some(entry),
+            compilation_options: Default::default(),
+            cache: None,
+        })
+    };
+    let split_pipeline = pipeline("interleave split", "split_main");
+    let combine_pipeline = pipeline("interleave combine", "combine_main");
+    let filter_pipeline = pipeline("interleave filter", "filter_main");
+    [split_pipeline, combine_pipeline, filter_pipeline]
+}
+
+impl Interleave {
+    /// Workgroup size (both axes) of every interleave pass; accumulate shaders use it too.
+    pub const WORKGROUP_SIZE: u32 = 8;
+    /// Largest number of tiles per axis.
+    pub const MAX_TILES: u32 = 64;
+
+    /// Creates the buffers, pipelines and bind groups (nothing is created per frame).
+    ///
+    /// `output` is the technique's full-resolution indirect-irradiance texture: Rgba16Float, the
+    /// G-buffer's size, with usage STORAGE_BINDING (and typically TEXTURE_BINDING | COPY_SRC).
+    pub fn new(
+        gpu: &GpuContext,
+        gbuffer: &GBuffer,
+        tiles: (u32, u32),
+        filter: FilterSettings,
+        output: &wgpu::Texture,
+    ) -> Result<Interleave> {
+        let device = &gpu.device;
+        let tiles = [tiles.0, tiles.1];
+        let full = gbuffer.size;
+        check_setup(tiles, full, output, &filter)?;
+        let tile_size = [full[0].div_ceil(tiles[0]), full[1].div_ceil(tiles[1])];
+        let split_size = [tile_size[0] * tiles[0], tile_size[1] * tiles[1]];
+
+        let split_bytes = split_size[0] as u64 * split_size[1] as u64 * 16;
+        let full_bytes = full[0] as u64 * full[1] as u64 * 16;
+        let max = gpu.max_storage_buffer();
+        if split_bytes.max(full_bytes) > max {
+            return Err(Error::Gpu(format!(
+                "interleave buffers of {} bytes exceed the adapter's storage-buffer limit of {max}",
+                split_bytes.max(full_bytes)
+            )));
+        }
+        let buffers = Buffers::new(device, split_bytes, full_bytes);
+        let (split_layout, split_group) = split_bind_group(device, &buffers);
+        let (pass_layout, pass_group) = pass_bind_group(device, &buffers, output);
+        let [split_pipeline, combine_pipeline, filter_pipeline] =
+            pipelines(device, &pass_layout, gbuffer);
+
+        let Buffers {
+            params,
+            split_position,
+            split_normal,
+            split_irradiance,
+            combined,
+        } = buffers;
         let me = Interleave {
             full,
             tiles,
