@@ -75,6 +75,10 @@ pub struct CompareRow {
     pub cpu_ms: Option<[f64; 2]>,
 }
 
+/// Median of `v`: the middle value after sorting by `total_cmp`, the mean of the two middle
+/// values for an even count. Deliberately not [`crate::stats::Stats::of`]'s median, which
+/// interpolates (`a + (b - a) * 0.5` can round differently from `0.5 * (a + b)`, and an infinite
+/// neighbour turns an odd count's median into NaN): using it would change compare's numbers.
 fn median(v: &[f64]) -> f64 {
     let mut s = v.to_vec();
     s.sort_by(f64::total_cmp);
