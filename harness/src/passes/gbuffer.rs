@@ -60,7 +60,12 @@ pub fn scene_pipeline(
     vertex_entry: &str,
     fragment: Option<(&str, &[wgpu::TextureFormat])>,
 ) -> wgpu::RenderPipeline {
-    let module = shader_module(device, label, include_str!("shaders/geometry.wgsl"));
+    let source = format!(
+        "{}\n{}",
+        super::MESH_WGSL,
+        include_str!("shaders/geometry.wgsl")
+    );
+    let module = shader_module(device, label, &source);
     let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some(label),
         bind_group_layouts: &[

@@ -27,6 +27,12 @@ pub use scene_gpu::{
     CAMERA_SLOT, MAX_MATERIALS,
 };
 
+/// The scene's meshes as every rasterising pass draws them (`shaders/mesh.wgsl`): the object
+/// and material bindings (groups 1 and 2), the vertex layout, the vertex transform and a
+/// fragment's albedo. Prepended, after [`COMMON_WGSL`], by [`scene_pipeline`]'s shader and by any
+/// technique's own pass over the scene's meshes (Gaitatzes' voxelization).
+pub const MESH_WGSL: &str = include_str!("shaders/mesh.wgsl");
+
 /// WGSL declared once and prepended to every shader (View, Light, helpers).
 pub const COMMON_WGSL: &str = include_str!("shaders/common.wgsl");
 

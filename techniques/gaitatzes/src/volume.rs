@@ -425,7 +425,8 @@ fn voxelize_pipeline(
     direct: &DirectLight,
 ) -> wgpu::RenderPipeline {
     let source = format!(
-        "{}\n{}",
+        "{}\n{}\n{}",
+        gibench_harness::passes::MESH_WGSL,
         DirectLight::wgsl(3),
         include_str!("shaders/voxelize.wgsl")
     );

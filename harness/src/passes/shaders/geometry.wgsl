@@ -1,36 +1,10 @@
-// G-buffer and depth-only (shadow map) rendering of the scene's meshes.
+// G-buffer and depth-only (shadow map) rendering of the scene's meshes. Expects mesh.wgsl
+// prepended.
 
 @group(0) @binding(0) var<uniform> view: View;
-@group(1) @binding(0) var<uniform> object: Object;
-@group(2) @binding(0) var<uniform> materials: array<vec4<f32>, 1024>;
-@group(2) @binding(1) var textures: texture_2d_array<f32>;
-@group(2) @binding(2) var texture_sampler: sampler;
-
-struct VertexIn {
-    @location(0) position: vec3<f32>,
-    @location(1) normal: vec3<f32>,
-    @location(2) uv: vec2<f32>,
-    @location(3) material: u32,
-};
-
-struct VertexOut {
-    @builtin(position) clip: vec4<f32>,
-    @location(0) world: vec3<f32>,
-    @location(1) normal: vec3<f32>,
-    @location(2) uv: vec2<f32>,
-    @location(3) @interpolate(flat) material: u32,
-};
-
 @vertex
-fn vs_main(v: VertexIn) -> VertexOut {
-    var out: VertexOut;
-    let world = object.model * vec4<f32>(v.position, 1.0);
-    out.world = world.xyz;
-    out.clip = view.view_proj * world;
-    out.normal = (object.normal_matrix * vec4<f32>(v.normal, 0.0)).xyz;
-    out.uv = v.uv;
-    out.material = v.material;
-    return out;
+fn vs_main(v: VertexIn) -> MeshOut {
+    return mesh_vertex(v, view.view_proj);
 }
 
 @vertex
@@ -44,16 +18,13 @@ struct GBufferOut {
 };
 
 @fragment
-fn fs_gbuffer(in: VertexOut) -> GBufferOut {
+fn fs_gbuffer(in: MeshOut) -> GBufferOut {
     var n = normalize(in.normal);
     // Shade both sides: the normal faces the camera.
     if (dot(n, view.eye.xyz - in.world) < 0.0) {
         n = -n;
     }
-    let m = materials[in.material];
-    // Sampled unconditionally: implicit-derivative sampling must stay in uniform control flow.
-    let texel = textureSample(textures, texture_sampler, in.uv, max(i32(m.w), 0)).rgb;
-    let albedo = select(m.rgb, m.rgb * texel, m.w >= 0.0);
+    let albedo = mesh_albedo(in);
     var out: GBufferOut;
     out.normal = vec4<f32>(n, 1.0);
     out.albedo = vec4<f32>(albedo, 1.0);
