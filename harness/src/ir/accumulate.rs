@@ -24,7 +24,7 @@ use super::atlas::ShadowAtlas;
 use super::interleave::{Interleave, INTERLEAVE_WGSL};
 use super::store::VplStore;
 use crate::gpu::GpuContext;
-use crate::passes::{compute_pipeline, params_entry, PARAMS_USAGE};
+use crate::passes::{bind_buffer, compute_pipeline, params_entry, PARAMS_USAGE};
 use crate::Result;
 
 /// GPU layout of `AccumulateParams` in `accumulate.wgsl`.
@@ -108,16 +108,7 @@ impl Accumulation {
         let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("accumulate"),
             layout: &layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: store.buffer().as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: params.as_entire_binding(),
-                },
-            ],
+            entries: &[bind_buffer(0, store.buffer()), bind_buffer(1, &params)],
         });
         let source = format!(
             "{INTERLEAVE_WGSL}\n{}\n{}\n{}",

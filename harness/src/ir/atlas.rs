@@ -29,7 +29,7 @@ use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec2, Vec3};
 
 use crate::gpu::GpuContext;
-use crate::passes::{cube_face_matrix, params_entry, texture_entry, PARAMS_USAGE};
+use crate::passes::{bind_buffer, cube_face_matrix, params_entry, texture_entry, PARAMS_USAGE};
 use crate::scene::SceneExtent;
 use crate::{Error, Result};
 
@@ -265,10 +265,7 @@ impl ShadowAtlas {
             label: Some("vpl atlas"),
             layout: &layout,
             entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: params.as_entire_binding(),
-                },
+                bind_buffer(0, &params),
                 wgpu::BindGroupEntry {
                     binding: 1,
                     resource: wgpu::BindingResource::TextureView(&view),

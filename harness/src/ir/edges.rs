@@ -16,7 +16,9 @@
 use bytemuck::{Pod, Zeroable};
 
 use crate::gpu::GpuContext;
-use crate::passes::{compute_pipeline, params_entry, storage_entry, GBuffer, PARAMS_USAGE};
+use crate::passes::{
+    bind_buffer, compute_pipeline, params_entry, storage_entry, GBuffer, PARAMS_USAGE,
+};
 use crate::{Error, Result};
 
 /// What counts as an edge (see the module docs).
@@ -108,16 +110,7 @@ impl EdgeMask {
         let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("edge mask"),
             layout: &layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: params.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: mask.as_entire_binding(),
-                },
-            ],
+            entries: &[bind_buffer(0, &params), bind_buffer(1, &mask)],
         });
         let pipeline = compute_pipeline(
             device,

@@ -43,7 +43,10 @@ use bytemuck::{Pod, Zeroable};
 use crate::gpu::GpuContext;
 use crate::{Error, Result};
 
-use crate::passes::{params_entry, shader_module, GBuffer, HDR_FORMAT, PARAMS_USAGE};
+use crate::passes::{
+    bind_buffer, params_entry, shader_module, storage_entry, storage_texture_entry, GBuffer,
+    HDR_FORMAT, PARAMS_USAGE,
+};
 
 /// WGSL declarations a technique prepends to its accumulate shader (after `common.wgsl`, which
 /// [`crate::passes::shader_module`] adds): `struct InterleaveParams { full, tiles, tile_size, split:
@@ -107,15 +110,6 @@ pub struct Interleave {
 }
 
 const WG: u32 = Interleave::WORKGROUP_SIZE;
-
-use crate::passes::storage_entry;
-
-fn buffer_entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
-    wgpu::BindGroupEntry {
-        binding,
-        resource: buffer.as_entire_binding(),
-    }
-}
 
 /// Refuses a tile grid outside `1..=MAX_TILES` per side or with more tiles along an axis than
 /// the image has pixels, an output texture that is not the G-buffer's size, format and storage
@@ -249,10 +243,10 @@ fn split_bind_group(
         label: Some("interleave split (accumulate)"),
         layout: &split_layout,
         entries: &[
-            buffer_entry(0, &b.params),
-            buffer_entry(1, &b.split_position),
-            buffer_entry(2, &b.split_normal),
-            buffer_entry(3, &b.split_irradiance),
+            bind_buffer(0, &b.params),
+            bind_buffer(1, &b.split_position),
+            bind_buffer(2, &b.split_normal),
+            bind_buffer(3, &b.split_irradiance),
         ],
     });
     (split_layout, split_group)
@@ -273,16 +267,7 @@ fn pass_bind_group(
             storage_entry(2, false),
             storage_entry(3, true),
             storage_entry(4, false),
-            wgpu::BindGroupLayoutEntry {
-                binding: 5,
-                visibility: compute,
-                ty: wgpu::BindingType::StorageTexture {
-                    access: wgpu::StorageTextureAccess::WriteOnly,
-                    format: HDR_FORMAT,
-                    view_dimension: wgpu::TextureViewDimension::D2,
-                },
-                count: None,
-            },
+            storage_texture_entry(5, HDR_FORMAT),
         ],
     });
     let output_view = output.create_view(&Default::default());
@@ -290,11 +275,11 @@ fn pass_bind_group(
         label: Some("interleave passes"),
         layout: &pass_layout,
         entries: &[
-            buffer_entry(0, &b.params),
-            buffer_entry(1, &b.split_position),
-            buffer_entry(2, &b.split_normal),
-            buffer_entry(3, &b.split_irradiance),
-            buffer_entry(4, &b.combined),
+            bind_buffer(0, &b.params),
+            bind_buffer(1, &b.split_position),
+            bind_buffer(2, &b.split_normal),
+            bind_buffer(3, &b.split_irradiance),
+            bind_buffer(4, &b.combined),
             wgpu::BindGroupEntry {
                 binding: 5,
                 resource: wgpu::BindingResource::TextureView(&output_view),

@@ -22,7 +22,9 @@ use bytemuck::{Pod, Zeroable};
 use super::atlas::{AtlasFormat, ShadowAtlas};
 use super::splat::{texel_buffer_size, PointSplat};
 use crate::gpu::GpuContext;
-use crate::passes::{compute_pipeline, params_entry, storage_entry, PARAMS_USAGE};
+use crate::passes::{
+    bind_buffer, compute_pipeline, params_entry, storage_entry, storage_texture_entry, PARAMS_USAGE,
+};
 use crate::{Error, Result};
 
 /// GPU layout of `PullPushParams` in `pullpush.wgsl`.
@@ -100,16 +102,7 @@ impl PullPush {
             entries: &base,
         });
         let mut with_atlas = base.to_vec();
-        with_atlas.push(wgpu::BindGroupLayoutEntry {
-            binding: 3,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::StorageTexture {
-                access: wgpu::StorageTextureAccess::WriteOnly,
-                format: wgpu::TextureFormat::R32Float,
-                view_dimension: wgpu::TextureViewDimension::D2,
-            },
-            count: None,
-        });
+        with_atlas.push(storage_texture_entry(3, wgpu::TextureFormat::R32Float));
         let store_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("pull-push store"),
             entries: &with_atlas,
@@ -146,18 +139,9 @@ impl PullPush {
                 }),
             );
             let mut entries = vec![
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: params.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: splat.depth().as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: pyramid.as_entire_binding(),
-                },
+                bind_buffer(0, &params),
+                bind_buffer(1, splat.depth()),
+                bind_buffer(2, &pyramid),
             ];
             if kind == 2 {
                 entries.push(wgpu::BindGroupEntry {

@@ -30,8 +30,8 @@ use super::atlas::{MapKind, ShadowAtlas};
 use super::store::VplStore;
 use crate::gpu::GpuContext;
 use crate::passes::{
-    compute_pipeline, cube_face_matrix, shader_module, storage_entry, uniform_entry, DrawSet,
-    FrameUniforms, GpuScene, Vertex,
+    bind_buffer, compute_pipeline, cube_face_matrix, shader_module, storage_entry, uniform_entry,
+    DrawSet, FrameUniforms, GpuScene, Vertex,
 };
 use crate::vpl::{frame_from_normal, Vpl};
 use crate::{Error, Result};
@@ -414,14 +414,8 @@ impl AtlasRasteriser {
             label: Some("vpl views from the store"),
             layout: &layout,
             entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: store.buffer().as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: self.view_buffer.as_entire_binding(),
-                },
+                bind_buffer(0, store.buffer()),
+                bind_buffer(1, &self.view_buffer),
             ],
         });
         gpu.check_errors()?;

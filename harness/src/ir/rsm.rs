@@ -19,9 +19,9 @@
 use super::splat::texel_buffer_size;
 use crate::gpu::GpuContext;
 use crate::passes::{
-    begin_gbuffer_pass, compute_pipeline, draw_light_faces, params_entry, render_target,
-    scene_pipeline, storage_entry, texture_entry, uniform_entry, FrameUniforms, GpuScene,
-    ALBEDO_FORMAT, DEPTH_FORMAT, NORMAL_FORMAT, PARAMS_USAGE,
+    begin_gbuffer_pass, bind_buffer, compute_pipeline, draw_light_faces, params_entry,
+    render_target, scene_pipeline, storage_entry, texture_entry, uniform_entry, FrameUniforms,
+    GpuScene, ALBEDO_FORMAT, DEPTH_FORMAT, NORMAL_FORMAT, PARAMS_USAGE,
 };
 use crate::Result;
 
@@ -109,14 +109,8 @@ impl ReflectiveShadowMap {
             label: Some("rsm export"),
             layout: &layout,
             entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: params.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: uniforms.light_buffer.as_entire_binding(),
-                },
+                bind_buffer(0, &params),
+                bind_buffer(1, &uniforms.light_buffer),
                 wgpu::BindGroupEntry {
                     binding: 2,
                     resource: wgpu::BindingResource::TextureView(&depth_view),
@@ -129,18 +123,9 @@ impl ReflectiveShadowMap {
                     binding: 4,
                     resource: wgpu::BindingResource::TextureView(&albedo_view),
                 },
-                wgpu::BindGroupEntry {
-                    binding: 5,
-                    resource: buffers[0].as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 6,
-                    resource: buffers[1].as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 7,
-                    resource: buffers[2].as_entire_binding(),
-                },
+                bind_buffer(5, &buffers[0]),
+                bind_buffer(6, &buffers[1]),
+                bind_buffer(7, &buffers[2]),
             ],
         });
         let face_entries: Vec<wgpu::BindGroupLayoutEntry> =

@@ -21,7 +21,7 @@ use bytemuck::{Pod, Zeroable};
 use super::atlas::{MapKind, ShadowAtlas};
 use super::store::VplStore;
 use crate::gpu::GpuContext;
-use crate::passes::{compute_pipeline, params_entry, storage_entry, PARAMS_USAGE};
+use crate::passes::{bind_buffer, compute_pipeline, params_entry, storage_entry, PARAMS_USAGE};
 use crate::{Error, Result};
 
 /// GPU layout of `SplatParams` in `splat.wgsl`.
@@ -133,26 +133,11 @@ impl PointSplat {
             label: Some("splat"),
             layout: &layout,
             entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: store.buffer().as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: params.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: points.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: depth.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 4,
-                    resource: objects.as_entire_binding(),
-                },
+                bind_buffer(0, store.buffer()),
+                bind_buffer(1, &params),
+                bind_buffer(2, points),
+                bind_buffer(3, &depth),
+                bind_buffer(4, objects),
             ],
         });
         let source = format!(

@@ -134,17 +134,6 @@ impl VplStore {
 
     /// A bind-group-layout entry for the store, read-only or read-write, compute only.
     pub fn layout_entry(binding: u32, read_write: bool) -> wgpu::BindGroupLayoutEntry {
-        wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Storage {
-                    read_only: !read_write,
-                },
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
-            count: None,
-        }
+        crate::passes::storage_entry(binding, !read_write)
     }
 }

@@ -28,7 +28,7 @@ use bytemuck::{Pod, Zeroable};
 
 use super::store::VplStore;
 use crate::gpu::GpuContext;
-use crate::passes::{compute_pipeline, params_entry, storage_entry, PARAMS_USAGE};
+use crate::passes::{bind_buffer, compute_pipeline, params_entry, storage_entry, PARAMS_USAGE};
 use crate::{Error, Result};
 
 #[repr(C)]
@@ -161,10 +161,7 @@ impl VplSampler {
         let entries: Vec<wgpu::BindGroupEntry> = resources
             .iter()
             .enumerate()
-            .map(|(i, b)| wgpu::BindGroupEntry {
-                binding: i as u32,
-                resource: b.as_entire_binding(),
-            })
+            .map(|(i, b)| bind_buffer(i as u32, b))
             .collect();
         let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("vpl sample"),

@@ -9,7 +9,8 @@ use wgpu::util::DeviceExt;
 use crate::gpu::GpuContext;
 
 use super::{
-    draw_fullscreen, fullscreen_pipeline, params_entry, render_target, shader_module, texture_entry,
+    bind_buffer, draw_fullscreen, fullscreen_pipeline, params_entry, render_target, shader_module,
+    texture_entry,
 };
 use super::{GBuffer, HDR_FORMAT};
 
@@ -62,10 +63,7 @@ impl Compose {
                     binding: 1,
                     resource: wgpu::BindingResource::TextureView(indirect),
                 },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: params.as_entire_binding(),
-                },
+                bind_buffer(2, &params),
             ],
         });
         let module = shader_module(device, "compose", include_str!("shaders/compose.wgsl"));

@@ -18,7 +18,8 @@ use crate::scene::descriptor::LightKind;
 
 use super::gbuffer::{scene_pipeline, DEPTH_FORMAT};
 use super::{
-    draw_fullscreen, fullscreen_pipeline, params_entry, render_target, shader_module, texture_entry,
+    bind_buffer, draw_fullscreen, fullscreen_pipeline, params_entry, render_target, shader_module,
+    texture_entry,
 };
 use super::{FrameUniforms, GBuffer, GpuScene, HDR_FORMAT};
 
@@ -145,10 +146,7 @@ impl DirectLight {
             label: Some("light"),
             layout: &light_layout,
             entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: uniforms.light_buffer.as_entire_binding(),
-                },
+                bind_buffer(0, &uniforms.light_buffer),
                 wgpu::BindGroupEntry {
                     binding: 1,
                     resource: wgpu::BindingResource::TextureView(&atlas_view),

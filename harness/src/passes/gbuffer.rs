@@ -14,7 +14,8 @@ use crate::gpu::GpuContext;
 use crate::{Error, Result};
 
 use super::{
-    render_target, shader_module, texture_entry, uniform_entry, FrameUniforms, GpuScene, Vertex,
+    bind_buffer, render_target, shader_module, storage_entry, texture_entry, uniform_entry,
+    FrameUniforms, GpuScene, Vertex,
 };
 
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
@@ -220,16 +221,7 @@ impl GBuffer {
         );
         let storage_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("gbuffer export"),
-            entries: &[wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::COMPUTE,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Storage { read_only: false },
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                },
-                count: None,
-            }],
+            entries: &[storage_entry(0, false)],
         });
         let export_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("gbuffer export"),
@@ -303,10 +295,7 @@ impl GBuffer {
         let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("gbuffer export"),
             layout: &self.export_pipeline.get_bind_group_layout(1),
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: storage.as_entire_binding(),
-            }],
+            entries: &[bind_buffer(0, &storage)],
         });
         let mut enc = device.create_command_encoder(&Default::default());
         {

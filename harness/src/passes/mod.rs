@@ -10,12 +10,20 @@
 //! * [`DirectLight`]: the primary light's shadow map (cube, or the sun's orthographic map) and
 //!   direct irradiance with 16-tap PCF; [`DirectLight::wgsl`] gives any shader the same lookup.
 //! * [`Compose`]: outgoing radiance and its display encoding.
+//! * Bind-group entries: [`uniform_entry`], [`storage_entry`], [`params_entry`],
+//!   [`texture_entry`], [`storage_texture_entry`], [`sampler_entry`] and the like for layouts;
+//!   [`bind_buffer`] for a whole buffer in a bind group.
 
+mod bind;
 mod compose;
 mod direct;
 mod gbuffer;
 mod scene_gpu;
 
+pub use bind::{
+    bind_buffer, dynamic_storage_entry, params_entry, read_storage_entry, sampler_entry,
+    storage_entry, storage_texture_entry, texture_entry, uniform_entry, PARAMS_USAGE,
+};
 pub use compose::Compose;
 pub use direct::{draw_light_faces, needed_cube_faces, DirectLight, CUBE_FACES, DIRECT_LIGHT_WGSL};
 pub use gbuffer::{
@@ -71,82 +79,8 @@ pub fn compute_pipeline(
     })
 }
 
-/// A storage-buffer layout entry, read-only or read-write, compute only.
-pub fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
-}
-
 /// Format of every irradiance and radiance buffer (renderable on Vulkan and GL).
 pub const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
-
-/// A read-only storage-buffer layout entry for a pass's parameter block.
-///
-/// Parameters a shader branches or loops on are bound as read-only storage buffers, not
-/// uniforms: lavapipe (Mesa 22.3) inlines uniform values that control flow depends on and
-/// compiles a fresh shader variant for every draw or dispatch that reads them, never freeing it
-/// (about 0.7 MB per frame for the direct-light pass alone: memory grew without bound).
-pub fn params_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only: true },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
-}
-
-/// Buffer usages of a parameter block bound with [`params_entry`] and written by the queue.
-pub const PARAMS_USAGE: wgpu::BufferUsages =
-    wgpu::BufferUsages::STORAGE.union(wgpu::BufferUsages::COPY_DST);
-
-/// A uniform-buffer layout entry.
-pub fn uniform_entry(
-    binding: u32,
-    visibility: wgpu::ShaderStages,
-    dynamic: bool,
-) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Uniform,
-            has_dynamic_offset: dynamic,
-            min_binding_size: None,
-        },
-        count: None,
-    }
-}
-
-/// A sampled-texture layout entry.
-pub fn texture_entry(
-    binding: u32,
-    visibility: wgpu::ShaderStages,
-    sample_type: wgpu::TextureSampleType,
-    dim: wgpu::TextureViewDimension,
-) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility,
-        ty: wgpu::BindingType::Texture {
-            sample_type,
-            view_dimension: dim,
-            multisampled: false,
-        },
-        count: None,
-    }
-}
 
 /// The full-resolution indirect-irradiance texture a technique returns (HDR_FORMAT; sampled by
 /// compose, copied out for images and quality). `storage` adds STORAGE_BINDING for compute

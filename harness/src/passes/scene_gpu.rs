@@ -7,7 +7,7 @@ use crate::anim::{FrameState, LightPose};
 use crate::scene::{Mesh, Scene, SceneExtent, Texture};
 use crate::{Error, Result};
 
-use super::{texture_entry, uniform_entry};
+use super::{bind_buffer, sampler_entry, texture_entry, uniform_entry};
 
 /// Most materials a scene may have (they live in one uniform array).
 pub const MAX_MATERIALS: usize = 1024;
@@ -215,22 +215,14 @@ impl GpuScene {
                     wgpu::TextureSampleType::Float { filterable: true },
                     wgpu::TextureViewDimension::D2Array,
                 ),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 2,
-                    visibility: fs,
-                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                    count: None,
-                },
+                sampler_entry(2, fs, wgpu::SamplerBindingType::Filtering),
             ],
         });
         let material_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("materials"),
             layout: &material_layout,
             entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: material_buffer.as_entire_binding(),
-                },
+                bind_buffer(0, &material_buffer),
                 wgpu::BindGroupEntry {
                     binding: 1,
                     resource: wgpu::BindingResource::TextureView(&view),

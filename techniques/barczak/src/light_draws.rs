@@ -27,7 +27,10 @@ use bytemuck::{Pod, Zeroable};
 use gibench_harness::gpu::GpuContext;
 use gibench_harness::ir::atlas::ShadowAtlas;
 use gibench_harness::ir::store::VplStore;
-use gibench_harness::passes::{shader_module, FrameUniforms, GBuffer, CAMERA_SLOT};
+use gibench_harness::passes::{
+    bind_buffer, dynamic_storage_entry, read_storage_entry, shader_module, FrameUniforms, GBuffer,
+    CAMERA_SLOT,
+};
 use gibench_harness::{wgpu, Error, Result};
 
 use crate::database::VisibilityDatabase;
@@ -417,50 +420,20 @@ fn store_bind_group(
     let store_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("barczak lights"),
         entries: &[
-            wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: frag,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Storage { read_only: true },
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                },
-                count: None,
-            },
-            wgpu::BindGroupLayoutEntry {
-                binding: 1,
-                visibility: frag,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Storage { read_only: true },
-                    has_dynamic_offset: true,
-                    min_binding_size: wgpu::BufferSize::new(
-                        std::mem::size_of::<DrawLights>() as u64
-                    ),
-                },
-                count: None,
-            },
-            wgpu::BindGroupLayoutEntry {
-                binding: 2,
-                visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Storage { read_only: true },
-                    has_dynamic_offset: true,
-                    min_binding_size: wgpu::BufferSize::new(
-                        std::mem::size_of::<RasterData>() as u64
-                    ),
-                },
-                count: None,
-            },
+            read_storage_entry(0, frag),
+            dynamic_storage_entry(1, frag, std::mem::size_of::<DrawLights>() as u64),
+            dynamic_storage_entry(
+                2,
+                wgpu::ShaderStages::VERTEX_FRAGMENT,
+                std::mem::size_of::<RasterData>() as u64,
+            ),
         ],
     });
     let store_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("barczak lights"),
         layout: &store_layout,
         entries: &[
-            wgpu::BindGroupEntry {
-                binding: 0,
-                resource: store.buffer().as_entire_binding(),
-            },
+            bind_buffer(0, store.buffer()),
             wgpu::BindGroupEntry {
                 binding: 1,
                 resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {

@@ -12,7 +12,8 @@
 use bytemuck::{Pod, Zeroable};
 use gibench_harness::gpu::GpuContext;
 use gibench_harness::passes::{
-    params_entry, shader_module, FrameUniforms, GBuffer, CAMERA_SLOT, HDR_FORMAT,
+    bind_buffer, params_entry, read_storage_entry, shader_module, FrameUniforms, GBuffer,
+    CAMERA_SLOT, HDR_FORMAT,
 };
 use gibench_harness::scene::charts::polygon_area;
 use gibench_harness::{wgpu, Error, Result};
@@ -264,31 +265,13 @@ impl LightMapPass {
             label: Some("barczak light maps"),
             entries: &[
                 params_entry(0, wgpu::ShaderStages::FRAGMENT),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Storage { read_only: true },
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
+                read_storage_entry(1, wgpu::ShaderStages::FRAGMENT),
             ],
         });
         let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("barczak light maps"),
             layout: &layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: params.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: texels.as_entire_binding(),
-                },
-            ],
+            entries: &[bind_buffer(0, &params), bind_buffer(1, &texels)],
         });
         let module = shader_module(
             device,

@@ -8,7 +8,8 @@
 
 use gibench_harness::gpu::GpuContext;
 use gibench_harness::passes::{
-    shader_module, FrameUniforms, GBuffer, GpuScene, Vertex, CAMERA_SLOT, HDR_FORMAT,
+    bind_buffer, read_storage_entry, shader_module, FrameUniforms, GBuffer, GpuScene, Vertex,
+    CAMERA_SLOT, HDR_FORMAT,
 };
 use gibench_harness::{wgpu, Error, Result};
 use glam::Vec3;
@@ -42,19 +43,10 @@ impl PrtPass {
                 "barczak's PRT draw reads its transfer in the vertex shader; this adapter has too few storage buffers per stage".into(),
             ));
         }
-        let entry = |binding| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::VERTEX,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Storage { read_only: true },
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
-            count: None,
-        };
+        let vertex = wgpu::ShaderStages::VERTEX;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("barczak prt"),
-            entries: &[entry(0), entry(1)],
+            entries: &[read_storage_entry(0, vertex), read_storage_entry(1, vertex)],
         });
         let movers = transfers
             .iter()
@@ -76,16 +68,7 @@ impl PrtPass {
                 let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
                     label: Some("barczak prt"),
                     layout: &layout,
-                    entries: &[
-                        wgpu::BindGroupEntry {
-                            binding: 0,
-                            resource: transfer.as_entire_binding(),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 1,
-                            resource: lighting.as_entire_binding(),
-                        },
-                    ],
+                    entries: &[bind_buffer(0, &transfer), bind_buffer(1, &lighting)],
                 });
                 MoverData { lighting, group }
             })

@@ -16,8 +16,9 @@
 use gibench_harness::glam::{Mat4, Vec3, Vec4};
 use gibench_harness::gpu::GpuContext;
 use gibench_harness::passes::{
-    compute_pipeline, shader_module, storage_entry, texture_entry, uniform_entry, DirectLight,
-    DrawSet, FrameUniforms, GBuffer, GpuScene, Vertex, HDR_FORMAT,
+    bind_buffer, compute_pipeline, shader_module, storage_entry, storage_texture_entry,
+    texture_entry, uniform_entry, DirectLight, DrawSet, FrameUniforms, GBuffer, GpuScene, Vertex,
+    HDR_FORMAT,
 };
 use gibench_harness::scene::SceneExtent;
 use gibench_harness::{wgpu, Error, Result};
@@ -225,13 +226,6 @@ impl Volumes {
             propagation: [buffer("propagation a"), buffer("propagation b")],
             accumulation: buffer("accumulation"),
         })
-    }
-}
-
-fn entry(binding: u32, buffer: &wgpu::Buffer) -> wgpu::BindGroupEntry<'_> {
-    wgpu::BindGroupEntry {
-        binding,
-        resource: buffer.as_entire_binding(),
     }
 }
 
@@ -512,9 +506,9 @@ fn combine_pass(
         })
         .collect();
     group_entries.extend([
-        entry(9, &volumes.voxels),
-        entry(10, &volumes.propagation[0]),
-        entry(11, &volumes.accumulation),
+        bind_buffer(9, &volumes.voxels),
+        bind_buffer(10, &volumes.propagation[0]),
+        bind_buffer(11, &volumes.accumulation),
     ]);
     let combine_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("voxel combine"),
@@ -556,10 +550,10 @@ impl Propagation {
                 label: Some("propagation"),
                 layout: &layout,
                 entries: &[
-                    entry(0, &volumes.voxels),
-                    entry(1, &volumes.propagation[from]),
-                    entry(2, &volumes.propagation[1 - from]),
-                    entry(3, &volumes.accumulation),
+                    bind_buffer(0, &volumes.voxels),
+                    bind_buffer(1, &volumes.propagation[from]),
+                    bind_buffer(2, &volumes.propagation[1 - from]),
+                    bind_buffer(3, &volumes.accumulation),
                 ],
             })
         };
@@ -625,24 +619,15 @@ impl Reconstruction {
             entries: &[
                 storage_entry(0, true),
                 storage_entry(1, true),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 2,
-                    visibility: wgpu::ShaderStages::COMPUTE,
-                    ty: wgpu::BindingType::StorageTexture {
-                        access: wgpu::StorageTextureAccess::WriteOnly,
-                        format: HDR_FORMAT,
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                    },
-                    count: None,
-                },
+                storage_texture_entry(2, HDR_FORMAT),
             ],
         });
         let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("reconstruction"),
             layout: &layout,
             entries: &[
-                entry(0, &volumes.voxels),
-                entry(1, &volumes.accumulation),
+                bind_buffer(0, &volumes.voxels),
+                bind_buffer(1, &volumes.accumulation),
                 wgpu::BindGroupEntry {
                     binding: 2,
                     resource: wgpu::BindingResource::TextureView(output),
