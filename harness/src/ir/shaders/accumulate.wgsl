@@ -20,18 +20,13 @@ fn vpl_irradiance(v: GpuVpl, p: vec3<f32>, n: vec3<f32>, e_max: vec3<f32>, clamp
     if (all(v.flux.rgb == vec3<f32>(0.0))) {
         return vec3<f32>(0.0);
     }
-    let d = p - v.position.xyz;
-    let r2 = dot(d, d);
-    let dir = d * inverseSqrt(max(r2, 1e-30));
-    let cos_v = dot(v.normal.xyz, dir);
-    let cos_r = -dot(n, dir);
-    if (cos_v <= 0.0 || cos_r <= 0.0) {
+    let g = vpl_geometry(v, p, n);
+    if (g <= 0.0) {
         return vec3<f32>(0.0);
     }
     // Irradiance = base * g. The bound is compared as g against the largest g any channel
     // allows, so a tiny r2 cannot overflow into inf * 0.
     let base = v.flux.rgb * (vpl_visibility(v, p, n) / 3.14159265358979);
-    let g = cos_v * cos_r / max(r2, 1e-30);
     if (clamped) {
         var g_max = 3.4e38;
         for (var c = 0; c < 3; c++) {

@@ -18,3 +18,18 @@ struct VplStoreData {
     header: vec4<u32>,
     items: array<GpuVpl>,
 };
+
+// The unoccluded geometric term between VPL `v` and a receiver at `p` (unit normal `n`): the
+// cosine at the VPL times the cosine at the receiver over their squared distance; 0 when either
+// lies behind the other's surface. A VPL's irradiance there is flux / pi * this * visibility.
+fn vpl_geometry(v: GpuVpl, p: vec3<f32>, n: vec3<f32>) -> f32 {
+    let d = p - v.position.xyz;
+    let r2 = dot(d, d);
+    let dir = d * inverseSqrt(max(r2, 1e-30));
+    let cos_v = dot(v.normal.xyz, dir);
+    let cos_r = -dot(n, dir);
+    if (cos_v <= 0.0 || cos_r <= 0.0) {
+        return 0.0;
+    }
+    return cos_v * cos_r / max(r2, 1e-30);
+}

@@ -46,18 +46,11 @@ fn vs_leaf(@location(0) position: vec3<f32>, @location(2) normal: vec3<f32>) -> 
     return out;
 }
 
-// A light sample's irradiance at p (normal n) without visibility: flux/pi * cos at the light,
-// times cos at the receiver, over the squared distance (lightmap.rs `contribution`).
+// A light sample's irradiance at p (normal n) without visibility: flux/pi times the store's
+// geometric term, cos at the light times cos at the receiver over the squared distance
+// (lightmap.rs `contribution`).
 fn contribution(v: GpuVpl, p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
-    let d = v.position.xyz - p;
-    let r2 = dot(d, d);
-    if (r2 <= 0.0) {
-        return vec3<f32>(0.0);
-    }
-    let w = d * inverseSqrt(r2);
-    let receive = max(dot(n, w), 0.0);
-    let emit = max(-dot(v.normal.xyz, w), 0.0);
-    return v.flux.rgb / 3.14159265358979 * emit * receive / r2;
+    return v.flux.rgb / 3.14159265358979 * vpl_geometry(v, p, n);
 }
 
 const LOOKUP: u32 = 0x80000000u;
