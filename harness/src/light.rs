@@ -269,6 +269,32 @@ impl LightPose {
     }
 }
 
+/// The irradiance at `x` (unit normal `n`) from a point light at `position` of flux `flux`,
+/// without visibility: E = I · max(0, n·ω) / r², ω the unit direction from `x` to the light.
+/// A light on a surface of unit normal `normal` (a VPL, a light sample) emits I = Φ/π ·
+/// max(0, cos θ) about it, an omnidirectional one (`None`) I = Φ/4π. Zero at the light itself.
+/// The GPU's unoccluded term is `vpl_geometry` (`ir/shaders/vpl_store.wgsl`).
+pub fn point_irradiance(
+    position: Vec3,
+    normal: Option<Vec3>,
+    flux: Vec3,
+    x: Vec3,
+    n: Vec3,
+) -> Vec3 {
+    let d = position - x;
+    let r2 = d.length_squared();
+    if r2 <= 0.0 {
+        return Vec3::ZERO;
+    }
+    let w = d / r2.sqrt();
+    let receive = n.dot(w).max(0.0);
+    let intensity = match normal {
+        Some(ln) => flux / std::f32::consts::PI * (-ln.dot(w)).max(0.0),
+        None => flux / (4.0 * std::f32::consts::PI),
+    };
+    intensity * receive / r2
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

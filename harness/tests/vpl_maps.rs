@@ -12,6 +12,7 @@ use gibench_harness::ir::atlas::{AtlasFormat, AtlasSettings, MapKind, ShadowAtla
 use gibench_harness::ir::interleave::{FilterSettings, Interleave};
 use gibench_harness::ir::raster::{AtlasClear, AtlasRasteriser};
 use gibench_harness::ir::store::VplStore;
+use gibench_harness::light::point_irradiance;
 use gibench_harness::passes::DrawSet;
 use gibench_harness::runner::{Harness, RunConfig, TimingMode};
 use gibench_harness::scene::Scene;
@@ -202,11 +203,7 @@ fn one_vpl_in(
         .map(|i| {
             let p = g.positions[i]?;
             let n = g.normals[i];
-            let d = p - vpl.position;
-            let r2 = d.length_squared();
-            let dir = d / r2.sqrt();
-            let g_term = vpl.normal.dot(dir).max(0.0) * (-n.dot(dir)).max(0.0) / r2;
-            let unoccluded = vpl.flux.x / std::f32::consts::PI * g_term;
+            let unoccluded = point_irradiance(vpl.position, Some(vpl.normal), vpl.flux, p, n).x;
             let visible = !harness
                 .bvh
                 .occluded(vpl.position + vpl.normal * off, p + n * off, 1e-4);

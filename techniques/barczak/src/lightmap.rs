@@ -16,25 +16,16 @@
 //! A light's irradiance at x with normal n: a light sample with normal N emits Φ/π · cos θ
 //! (an omni light Φ/4π), so E = I(θ) · max(0, n·ω) / r², ω the unit direction to the light.
 
+use gibench_harness::light::point_irradiance;
 use glam::Vec3;
 
 use crate::database::{LightMapChange, ReceiverShape, VisibilityDatabase};
 use crate::visibility::{LightState, PatchTree, PointLight};
 
-/// The irradiance at `x` (normal `n`) from `light` of flux `flux`, without visibility.
+/// The irradiance at `x` (normal `n`) from `light` of flux `flux`, without visibility (the
+/// harness's [`point_irradiance`]).
 pub fn contribution(light: &PointLight, flux: Vec3, x: Vec3, n: Vec3) -> Vec3 {
-    let d = light.position - x;
-    let r2 = d.length_squared();
-    if r2 <= 0.0 {
-        return Vec3::ZERO;
-    }
-    let w = d / r2.sqrt();
-    let receive = n.dot(w).max(0.0);
-    let intensity = match light.normal {
-        Some(ln) => flux / std::f32::consts::PI * (-ln.dot(w)).max(0.0),
-        None => flux / (4.0 * std::f32::consts::PI),
-    };
-    intensity * receive / r2
+    point_irradiance(light.position, light.normal, flux, x, n)
 }
 
 /// The centre of texel (i, j) of a `res`² map on `node` of `tree` (i along the first edge).
