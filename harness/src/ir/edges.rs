@@ -17,7 +17,7 @@ use bytemuck::{Pod, Zeroable};
 
 use crate::gpu::GpuContext;
 use crate::passes::{
-    bind_buffer, compute_pipeline, params_entry, storage_entry, GBuffer, PARAMS_USAGE,
+    bind_buffer, compute_pipeline, params_buffer, params_entry, storage_entry, GBuffer,
 };
 use crate::{Error, Result};
 
@@ -86,19 +86,13 @@ impl EdgeMask {
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
-        let params = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("edge mask params"),
-            size: std::mem::size_of::<ParamsData>() as u64,
-            usage: PARAMS_USAGE,
-            mapped_at_creation: false,
-        });
-        gpu.queue.write_buffer(
-            &params,
-            0,
-            bytemuck::bytes_of(&ParamsData {
+        let params = params_buffer(
+            gpu,
+            "edge mask params",
+            &ParamsData {
                 counts: [settings.step, 0, 0, 0],
                 limits: [settings.normal_cos, settings.plane_distance, 0.0, 0.0],
-            }),
+            },
         );
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("edge mask"),

@@ -131,6 +131,23 @@ pub fn render_target(
     })
 }
 
+/// A parameter block for a binding made with [`params_entry`]: a buffer of `data`'s size with
+/// [`PARAMS_USAGE`], `data` queued into it.
+pub fn params_buffer<T: bytemuck::Pod>(
+    gpu: &crate::gpu::GpuContext,
+    label: &str,
+    data: &T,
+) -> wgpu::Buffer {
+    let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: std::mem::size_of::<T>() as u64,
+        usage: PARAMS_USAGE,
+        mapped_at_creation: false,
+    });
+    gpu.queue.write_buffer(&buffer, 0, bytemuck::bytes_of(data));
+    buffer
+}
+
 /// A fullscreen-triangle render pipeline (vertex `vs_main`, fragment `fs_main`).
 pub fn fullscreen_pipeline(
     device: &wgpu::Device,
@@ -155,9 +172,24 @@ pub fn fullscreen_pipeline(
             })
         })
         .collect();
+    fullscreen_pipeline_with(device, label, module, &layout, "fs_main", &targets, None)
+}
+
+/// A fullscreen-triangle render pipeline over `layout` (vertex `vs_main`): fragment `entry`
+/// writing `targets` as given (blending included; none for a depth-only pass), with an optional
+/// depth state.
+pub fn fullscreen_pipeline_with(
+    device: &wgpu::Device,
+    label: &str,
+    module: &wgpu::ShaderModule,
+    layout: &wgpu::PipelineLayout,
+    entry: &str,
+    targets: &[Option<wgpu::ColorTargetState>],
+    depth: Option<wgpu::DepthStencilState>,
+) -> wgpu::RenderPipeline {
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(label),
-        layout: Some(&layout),
+        layout: Some(layout),
         vertex: wgpu::VertexState {
             module,
             entry_point: Some("vs_main"),
@@ -165,13 +197,13 @@ pub fn fullscreen_pipeline(
             buffers: &[],
         },
         primitive: wgpu::PrimitiveState::default(),
-        depth_stencil: None,
+        depth_stencil: depth,
         multisample: wgpu::MultisampleState::default(),
         fragment: Some(wgpu::FragmentState {
             module,
-            entry_point: Some("fs_main"),
+            entry_point: Some(entry),
             compilation_options: Default::default(),
-            targets: &targets,
+            targets,
         }),
         multiview_mask: None,
         cache: None,

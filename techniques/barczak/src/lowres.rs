@@ -20,7 +20,8 @@ use bytemuck::{Pod, Zeroable};
 use gibench_harness::gpu::GpuContext;
 use gibench_harness::ir::edges::{EdgeMask, EdgeSettings};
 use gibench_harness::passes::{
-    params_entry, render_target, shader_module, texture_entry, GBuffer, HDR_FORMAT, PARAMS_USAGE,
+    fullscreen_pipeline_with, params_buffer, params_entry, render_target, shader_module,
+    texture_entry, GBuffer, HDR_FORMAT,
 };
 use gibench_harness::{wgpu, Error, Result};
 
@@ -81,19 +82,13 @@ impl LowRes {
         let low_view = low.create_view(&Default::default());
         let mask = render_target(device, "barczak edge depth", gbuffer.size, MASK_FORMAT);
         let mask_view = mask.create_view(&Default::default());
-        let params = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("barczak low resolution"),
-            size: std::mem::size_of::<Params>() as u64,
-            usage: PARAMS_USAGE,
-            mapped_at_creation: false,
-        });
-        gpu.queue.write_buffer(
-            &params,
-            0,
-            bytemuck::bytes_of(&Params {
+        let params = params_buffer(
+            gpu,
+            "barczak low resolution",
+            &Params {
                 counts: [factor, factor / 2, size[0], size[1]],
                 full: [w, h, 0, 0],
-            }),
+            },
         );
         let frag = wgpu::ShaderStages::FRAGMENT;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -139,40 +134,27 @@ impl LowRes {
         });
         let pipeline = |entry: &str,
                         depth: wgpu::DepthStencilState,
-                        target: Option<wgpu::ColorTargetState>| {
-            let targets = [target];
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some("barczak low resolution"),
-                layout: Some(&pipeline_layout),
-                vertex: wgpu::VertexState {
-                    module: &module,
-                    entry_point: Some("vs_main"),
-                    compilation_options: Default::default(),
-                    buffers: &[],
-                },
-                primitive: wgpu::PrimitiveState::default(),
-                depth_stencil: Some(depth),
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module: &module,
-                    entry_point: Some(entry),
-                    compilation_options: Default::default(),
-                    targets: if targets[0].is_some() { &targets } else { &[] },
-                }),
-                multiview_mask: None,
-                cache: None,
-            })
+                        targets: &[Option<wgpu::ColorTargetState>]| {
+            fullscreen_pipeline_with(
+                device,
+                "barczak low resolution",
+                &module,
+                &pipeline_layout,
+                entry,
+                targets,
+                Some(depth),
+            )
         };
         let mask_pipeline = pipeline(
             "fs_mask",
             mask_depth(true, wgpu::CompareFunction::Always),
-            None,
+            &[],
         );
         let composite = |operation| {
             pipeline(
                 "fs_composite",
                 mask_depth(false, wgpu::CompareFunction::Less),
-                Some(accumulate(operation)),
+                &[Some(accumulate(operation))],
             )
         };
         let composite_add = composite(wgpu::BlendOperation::Add);
