@@ -20,8 +20,8 @@ use bytemuck::{Pod, Zeroable};
 use gibench_harness::gpu::GpuContext;
 use gibench_harness::ir::edges::{EdgeMask, EdgeSettings};
 use gibench_harness::passes::{
-    fullscreen_pipeline_with, params_buffer, params_entry, render_target, shader_module,
-    texture_entry, GBuffer, HDR_FORMAT,
+    bind_buffer, fullscreen_pipeline_with, params_buffer, params_entry, render_target,
+    shader_module, texture_entry, GBuffer, HDR_FORMAT,
 };
 use gibench_harness::{wgpu, Error, Result};
 
@@ -108,14 +108,8 @@ impl LowRes {
             label: Some("barczak low resolution"),
             layout: &layout,
             entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: params.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: edges.mask().as_entire_binding(),
-                },
+                bind_buffer(0, &params),
+                bind_buffer(1, edges.mask()),
                 wgpu::BindGroupEntry {
                     binding: 2,
                     resource: wgpu::BindingResource::TextureView(&low_view),
