@@ -26,6 +26,7 @@ use serde::Serialize;
 
 use crate::report::{stage_ms, Cell, Table};
 use crate::results::RunResult;
+use crate::stats::median;
 use crate::{Error, Result};
 
 /// Repeats each side needs of every run it is compared on.
@@ -73,21 +74,6 @@ pub struct CompareRow {
     /// CPU stages: median thread CPU time, base and current.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub cpu_ms: Option<[f64; 2]>,
-}
-
-/// Median of `v`: the middle value after sorting by `total_cmp`, the mean of the two middle
-/// values for an even count. Deliberately not [`crate::stats::Stats::of`]'s median, which
-/// interpolates (`a + (b - a) * 0.5` can round differently from `0.5 * (a + b)`, and an infinite
-/// neighbour turns an odd count's median into NaN): using it would change compare's numbers.
-fn median(v: &[f64]) -> f64 {
-    let mut s = v.to_vec();
-    s.sort_by(f64::total_cmp);
-    let n = s.len();
-    if n % 2 == 1 {
-        s[n / 2]
-    } else {
-        0.5 * (s[n / 2 - 1] + s[n / 2])
-    }
 }
 
 /// The key runs are matched by.

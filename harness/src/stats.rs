@@ -53,12 +53,7 @@ impl Stats {
         let mut s: Vec<f64> = samples.to_vec();
         s.sort_by(|a, b| a.total_cmp(b));
         let n = s.len();
-        let pct = |p: f64| {
-            let x = p * (n - 1) as f64;
-            let i = x.floor() as usize;
-            let j = (i + 1).min(n - 1);
-            s[i] + (s[j] - s[i]) * (x - i as f64)
-        };
+        let pct = |p: f64| percentile(&s, p);
         Stats {
             count: n,
             mean: s.iter().sum::<f64>() / n as f64,
@@ -70,6 +65,28 @@ impl Stats {
             max: s[n - 1],
         }
     }
+}
+
+/// The `p` percentile (0 to 1) of `sorted` (ascending, not empty), interpolated linearly
+/// between the closest ranks; a rank hit exactly is that sample (so an infinite neighbour does
+/// not make it NaN).
+pub fn percentile(sorted: &[f64], p: f64) -> f64 {
+    let n = sorted.len();
+    let x = p * (n - 1) as f64;
+    let i = x.floor() as usize;
+    let j = (i + 1).min(n - 1);
+    let t = x - i as f64;
+    if t == 0.0 {
+        return sorted[i];
+    }
+    sorted[i] + (sorted[j] - sorted[i]) * t
+}
+
+/// The median of `samples` (any order, not empty): [`Stats::of`]'s median without the rest.
+pub fn median(samples: &[f64]) -> f64 {
+    let mut s = samples.to_vec();
+    s.sort_by(f64::total_cmp);
+    percentile(&s, 0.5)
 }
 
 #[cfg(test)]
@@ -101,5 +118,14 @@ mod tests {
         assert!((s.p95 - 4.8).abs() < 1e-12);
         assert!((s.p99 - 4.96).abs() < 1e-12);
         assert_eq!(Stats::of(&[]).count, 0);
+    }
+
+    /// The median `compare` uses: the middle sample of an odd count even beside an infinity
+    /// (a stage that timed out), the midpoint of the two middle samples of an even count.
+    #[test]
+    fn median_takes_the_middle_sample_and_ignores_an_infinite_neighbour() {
+        assert_eq!(median(&[f64::INFINITY, 2.0, 1.0]), 2.0);
+        assert_eq!(Stats::of(&[f64::INFINITY, 2.0, 1.0]).median, 2.0);
+        assert_eq!(median(&[4.0, 1.0, 3.0, 2.0]), 2.5);
     }
 }
