@@ -39,6 +39,7 @@ pub struct Manager {
     domain: Option<SamplingDomain>,
 }
 
+#[inline]
 pub(crate) fn domain_kind(light: &LightPose) -> DomainKind {
     match light.domain() {
         SampleDomain::Sphere => DomainKind::Sphere,
@@ -54,6 +55,7 @@ const PARALLEL_RAYS: usize = 64;
 /// (or area light's) plane — sampling points on the disc's boundary circle, which the
 /// largest-empty-circle search produces, lie exactly in it and stay valid —, its surface
 /// facing the light, and no static geometry in between.
+#[inline]
 fn still_valid(bvh: &SceneBvh, light: &LightPose, v: &Vpl, eps: f32) -> bool {
     if !light.in_front(v.position) {
         return false;
@@ -114,6 +116,7 @@ impl StepTimes {
         ["validity", "update", "deletion", "creation", "intensities"];
 
     /// The parts in step order (as [`NAMES`](Self::NAMES)).
+    #[inline]
     pub fn parts(&self) -> [std::time::Duration; 5] {
         [
             self.validity,
@@ -144,16 +147,19 @@ impl Manager {
     }
 
     /// The live VPLs with their shadow-map slots, in creation order.
+    #[inline]
     pub fn vpls(&self) -> Vec<(u32, Vpl)> {
         self.vpls.iter().map(|m| (m.slot, m.vpl)).collect()
     }
 
     /// The sampling points' domain after the last step (`None` before the first).
+    #[inline]
     pub fn domain(&self) -> Option<&SamplingDomain> {
         self.domain.as_ref()
     }
 
     /// Dispersion (largest empty circle radius) of all sampling points after the last step.
+    #[inline]
     pub fn dispersion(&self) -> f64 {
         self.last_dispersion
     }
@@ -455,10 +461,12 @@ struct Creation {
 struct Clock(std::time::Instant);
 
 impl Clock {
+    #[inline]
     fn start() -> Clock {
         Clock(std::time::Instant::now())
     }
 
+    #[inline]
     fn lap(&mut self) -> std::time::Duration {
         let now = std::time::Instant::now();
         let lap = now - self.0;

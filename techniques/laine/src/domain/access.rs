@@ -9,26 +9,31 @@ use super::{DomainKind, SamplingDomain, Slot};
 
 impl SamplingDomain {
     /// The domain's kind.
+    #[inline]
     pub fn kind(&self) -> DomainKind {
         self.kind
     }
 
     /// The number of sampling points.
+    #[inline]
     pub fn len(&self) -> usize {
         self.slots.len()
     }
 
     /// Whether the domain holds no sampling point.
+    #[inline]
     pub fn is_empty(&self) -> bool {
         self.slots.is_empty()
     }
 
     /// Whether `id` is in the domain.
+    #[inline]
     pub fn contains(&self, id: u64) -> bool {
         self.slots.contains_key(&id)
     }
 
     /// The stored point of `id` (after the normalisation [`insert`](Self::insert) applies).
+    #[inline]
     pub fn point(&self, id: u64) -> Option<DVec3> {
         match *self.slots.get(&id)? {
             Slot::Planar(h) => Some(self.tri.vertex(h).data().point),
@@ -41,6 +46,7 @@ impl SamplingDomain {
     ///
     /// [`points`]: Self::points
     /// [`voronoi_areas`]: Self::voronoi_areas
+    #[inline]
     pub fn site_index(&self, id: u64) -> Option<usize> {
         self.index_of(id)
     }
@@ -48,6 +54,7 @@ impl SamplingDomain {
     /// All `(id, point)` pairs, in the domain's internal order (see [`site_index`]).
     ///
     /// [`site_index`]: Self::site_index
+    #[inline]
     pub fn points(&self) -> Vec<(u64, DVec3)> {
         let mut out: Vec<(u64, DVec3)> = self
             .tri
@@ -61,10 +68,12 @@ impl SamplingDomain {
     }
 
     /// The number of sites, with the sphere's pole at index `tri.num_vertices()`.
+    #[inline]
     pub(super) fn pole_index(&self) -> usize {
         self.tri.num_vertices()
     }
 
+    #[inline]
     pub(super) fn site_point(&self, index: usize) -> DVec3 {
         if index < self.tri.num_vertices() {
             self.tri
@@ -76,6 +85,7 @@ impl SamplingDomain {
         }
     }
 
+    #[inline]
     pub(super) fn site_id(&self, index: usize) -> u64 {
         if index < self.tri.num_vertices() {
             self.tri
@@ -87,6 +97,7 @@ impl SamplingDomain {
         }
     }
 
+    #[inline]
     pub(super) fn index_of(&self, id: u64) -> Option<usize> {
         match *self.slots.get(&id)? {
             Slot::Planar(h) => Some(h.index()),
@@ -124,6 +135,7 @@ impl SamplingDomain {
     /// normalisation the Voronoi vertex). On the sphere these include the wrap-around
     /// triangles at the pole (see the module docs). Fewer than three sites (or, on the disc,
     /// collinear sites) give none.
+    #[inline]
     pub fn triangles(&self) -> Vec<[u64; 3]> {
         self.triangle_indices()
             .into_iter()
@@ -158,6 +170,7 @@ impl SamplingDomain {
         (tris, wraps)
     }
 
+    #[inline]
     pub(super) fn triangle_indices(&self) -> Vec<[u32; 3]> {
         self.triangles_and_wraps().0
     }

@@ -45,6 +45,7 @@ impl SamplingDomain {
     /// Answered from candidates kept between calls (the crate's `lec` module): after an
     /// insertion only the slots it changed are recomputed; after a removal the next call
     /// recomputes all.
+    #[inline]
     pub fn largest_empty_circle(&self) -> Option<(DVec3, f64)> {
         self.largest_empty_circle_near().map(|(c, r, _)| (c, r))
     }
@@ -75,6 +76,7 @@ impl SamplingDomain {
     /// candidates: what [`largest_empty_circle`](Self::largest_empty_circle) must equal bit
     /// for bit (the tests compare them: it checks the keeping and updating, while the slot
     /// functions both use are pinned by the management's layout test).
+    #[inline]
     pub fn largest_empty_circle_by_scan(&self) -> Option<(DVec3, f64)> {
         match self.kind {
             DomainKind::Disc => self.disc_largest_empty_circle(),
@@ -84,12 +86,14 @@ impl SamplingDomain {
 
     /// The dispersion δ (§4.3, Eq. 1): the radius of the [largest empty
     /// circle](Self::largest_empty_circle) (chordal on the sphere).
+    #[inline]
     pub fn dispersion(&self) -> f64 {
         self.largest_empty_circle().map_or(0.0, |(_, r)| r)
     }
 
     /// The largest-empty-circle cache (a poisoned lock only means a panic elsewhere mid-query;
     /// the cache is then recomputed).
+    #[inline]
     pub(super) fn lec_cache(&self) -> std::sync::MutexGuard<'_, LecCache> {
         self.lec.lock().unwrap_or_else(|e| {
             let mut guard = e.into_inner();
@@ -98,6 +102,7 @@ impl SamplingDomain {
         })
     }
 
+    #[inline]
     pub(super) fn lec_mut(&mut self) -> &mut LecCache {
         match self.lec.get_mut() {
             Ok(lec) => lec,
@@ -110,6 +115,7 @@ impl SamplingDomain {
     }
 
     /// Disc: inner face `f`'s corners, counter-clockwise, and the index of the first.
+    #[inline]
     pub(super) fn disc_face_corners(&self, f: FixedFaceHandle<InnerTag>) -> ([DVec2; 3], usize) {
         let [a, b, c] = self.tri.face(f).vertices();
         (
@@ -120,6 +126,7 @@ impl SamplingDomain {
 
     /// Disc: inner face `f`'s circumcentre and its case (1) slot (the circumcentre, if inside
     /// the disc), from one walk round the face.
+    #[inline]
     fn disc_face(&self, f: FixedFaceHandle<InnerTag>) -> (Option<DVec2>, Candidate) {
         let ([a, b, c], site) = self.disc_face_corners(f);
         let m = circumcentre(a, b, c);
@@ -198,6 +205,7 @@ impl SamplingDomain {
     }
 
     /// Sphere: inner face `f`'s triangle.
+    #[inline]
     fn sphere_face_slot(&self, f: FixedFaceHandle<InnerTag>) -> Candidate {
         let [a, b, c] = self.tri.face(f).vertices();
         sphere_triangle_slot([a, b, c].map(|v| v.data().point), a.fix().index())

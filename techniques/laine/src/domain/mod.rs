@@ -102,6 +102,7 @@ pub enum DomainError {
 }
 
 impl fmt::Display for DomainError {
+    #[inline]
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             DomainError::DuplicateId(id) => write!(f, "sampling point id {id} already present"),
@@ -133,6 +134,7 @@ pub struct SamplingDomain {
 }
 
 impl Clone for SamplingDomain {
+    #[inline]
     fn clone(&self) -> Self {
         SamplingDomain {
             kind: self.kind,
@@ -146,6 +148,7 @@ impl Clone for SamplingDomain {
 }
 
 impl fmt::Debug for SamplingDomain {
+    #[inline]
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.debug_struct("SamplingDomain")
             .field("kind", &self.kind)

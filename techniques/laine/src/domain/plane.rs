@@ -7,6 +7,7 @@ use glam::DVec2;
 /// (0, a, b): positive when (0, a, b) is counter-clockwise. Exact: the segment a→b is split
 /// where it crosses the circle; pieces inside contribute triangles, pieces outside the
 /// circular sector they subtend.
+#[inline]
 pub(super) fn disc_triangle_area(a: DVec2, b: DVec2) -> f64 {
     let d = b - a;
     let dd = d.length_squared();
@@ -44,6 +45,7 @@ pub(super) fn disc_triangle_area(a: DVec2, b: DVec2) -> f64 {
 }
 
 /// The circumcentre of the planar triangle (a, b, c), `None` if it is degenerate.
+#[inline]
 pub(super) fn circumcentre(a: DVec2, b: DVec2, c: DVec2) -> Option<DVec2> {
     let (ba, ca) = (b - a, c - a);
     let d = 2.0 * ba.perp_dot(ca);
@@ -56,6 +58,7 @@ pub(super) fn circumcentre(a: DVec2, b: DVec2, c: DVec2) -> Option<DVec2> {
 }
 
 /// Clips the convex polygon `poly` by the half-plane {x : (x − m)·d ≤ 0} into `out`.
+#[inline]
 pub(super) fn clip_half_plane(poly: &[DVec2], m: DVec2, d: DVec2, out: &mut Vec<DVec2>) {
     out.clear();
     let n = poly.len();

@@ -15,6 +15,7 @@ struct EdgeKey {
 }
 
 impl EdgeKey {
+    #[inline]
     fn new(l2: f64, a: u64, b: u64) -> Self {
         EdgeKey {
             bits: l2.to_bits(),
@@ -22,6 +23,7 @@ impl EdgeKey {
         }
     }
 
+    #[inline]
     fn length(&self) -> f64 {
         f64::from_bits(self.bits).sqrt()
     }
@@ -44,6 +46,7 @@ const QUEUED_EDGES: usize = 32;
 impl SamplingDomain {
     /// The shortest Delaunay edge (§4.5) as `(id, id, length)`; `None` with fewer than two
     /// sites.
+    #[inline]
     pub fn shortest_edge(&self) -> Option<(u64, u64, f64)> {
         self.shortest_edge_indices()
             .map(|(a, b, l)| (self.site_id(a), self.site_id(b), l))
@@ -94,6 +97,7 @@ impl SamplingDomain {
 
     /// The distance from `id` to its second-closest Delaunay neighbour (§4.5), `None` if `id`
     /// is absent, +∞ with fewer than two neighbours.
+    #[inline]
     pub fn second_closest_neighbour_distance(&self, id: u64) -> Option<f64> {
         let i = self.index_of(id)?;
         Some(self.second_closest_distance(i, &mut Vec::new()))
@@ -104,6 +108,7 @@ impl SamplingDomain {
     /// neighbor" (second-closest among its Delaunay neighbours, as the paper examines "the
     /// neighbors of the two vertices"). Ties (e.g. two sites) delete the larger id. `None` with
     /// fewer than two sites.
+    #[inline]
     pub fn deletion_candidate(&self) -> Option<u64> {
         let (a, b, _) = self.shortest_edge_indices()?;
         Some(self.redundant_endpoint(a, b))
@@ -159,6 +164,7 @@ impl SamplingDomain {
     }
 
     /// `f` of the queue key of every Delaunay edge of site `index` (`nb`: scratch).
+    #[inline]
     fn edge_keys_of(&self, index: usize, nb: &mut Vec<usize>, mut f: impl FnMut(EdgeKey)) {
         self.neighbours(index, nb);
         let (p, id) = (self.site_point(index), self.site_id(index));
@@ -169,6 +175,7 @@ impl SamplingDomain {
     }
 
     /// Pushes the edges of site `index` onto `q`.
+    #[inline]
     fn queue_edges_of(&self, index: usize, q: &mut RedundancyQueue) {
         let mut nb = std::mem::take(&mut q.scratch);
         self.edge_keys_of(index, &mut nb, |k| q.heap.push(std::cmp::Reverse(k)));

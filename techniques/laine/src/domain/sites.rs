@@ -27,6 +27,7 @@ pub(super) struct Site {
 
 impl HasPosition for Site {
     type Scalar = f64;
+    #[inline]
     fn position(&self) -> Point2<f64> {
         self.pos
     }
@@ -38,14 +39,17 @@ impl HasPosition for Site {
 pub(super) struct IdHasher(u64);
 
 impl std::hash::Hasher for IdHasher {
+    #[inline]
     fn finish(&self) -> u64 {
         self.0
     }
+    #[inline]
     fn write(&mut self, bytes: &[u8]) {
         for &b in bytes {
             self.0 = (self.0.rotate_left(8) ^ b as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15);
         }
     }
+    #[inline]
     fn write_u64(&mut self, n: u64) {
         self.0 = (n ^ (n >> 32)).wrapping_mul(0x9E37_79B9_7F4A_7C15);
     }
@@ -60,6 +64,7 @@ pub(super) type IdMap<V> = HashMap<u64, V, std::hash::BuildHasherDefault<IdHashe
 pub(super) const GRIDS: [(usize, usize); 2] = [(8, 4), (2, 2)];
 
 /// Index of point `p`'s cell in grid `level` of [`GRIDS`] (the disc's grids have one layer).
+#[inline]
 fn grid_cell(kind: DomainKind, level: usize, p: DVec3) -> usize {
     let n = match kind {
         DomainKind::Disc => GRIDS[level].0,
@@ -152,6 +157,7 @@ impl SamplingDomain {
     }
 
     /// An empty domain of `kind`.
+    #[inline]
     pub fn new(kind: DomainKind) -> Self {
         Self::with_capacity(kind, 0)
     }
@@ -245,6 +251,7 @@ impl SamplingDomain {
     /// unchanged, on a repeated id, a non-finite (or, on the sphere, zero) point, or a point
     /// equal to an existing one (on the sphere: within 10⁻¹² of the pole site, or projecting
     /// onto an existing projected point).
+    #[inline]
     pub fn insert(&mut self, id: u64, point: DVec3) -> Result<(), DomainError> {
         self.insert_near(id, point, None)
     }

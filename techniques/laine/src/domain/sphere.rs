@@ -9,6 +9,7 @@ use spade::Point2;
 use crate::lec::Candidate;
 
 /// The angular distance (radians) on the unit sphere of chordal distance `chord`.
+#[inline]
 pub fn chord_to_angle(chord: f64) -> f64 {
     2.0 * (0.5 * chord).clamp(-1.0, 1.0).asin()
 }
@@ -24,6 +25,7 @@ pub(super) struct Pole {
 }
 
 impl Pole {
+    #[inline]
     pub(super) fn new(id: u64, point: DVec3) -> Self {
         let t = point.any_orthonormal_vector();
         let b = point.cross(t);
@@ -35,6 +37,7 @@ impl Pole {
     /// orientation-consistent: a counter-clockwise planar triangle is counter-clockwise seen
     /// from outside the sphere (near the antipode −n, where x' ≈ (x·t, −x·b)/2, a planar ccw
     /// triangle has (b − a) × (c − a) along −n, the outward normal there).
+    #[inline]
     pub(super) fn project(&self, x: DVec3) -> Point2<f64> {
         let denom = 0.5 * (x - self.point).length_squared();
         spade::mitigate_underflow(Point2::new(x.dot(self.t) / denom, -x.dot(self.b) / denom))
@@ -43,6 +46,7 @@ impl Pole {
 
 /// Signed area of the spherical triangle (a, b, c) of unit vectors (Van Oosterom–Strackee,
 /// the stable form of l'Huilier's theorem): positive when counter-clockwise seen from outside.
+#[inline]
 fn spherical_triangle_area(a: DVec3, b: DVec3, c: DVec3) -> f64 {
     let det = a.dot(b.cross(c));
     let den = 1.0 + a.dot(b) + b.dot(c) + c.dot(a);
@@ -106,6 +110,7 @@ fn atan_right_half(y: f64, x: f64) -> f64 {
 
 /// Sphere: the circumcentre of the spherical triangle of sites `[a, b, c]`, with its radius and
 /// `site` (the index of `a`, where a walk to the circumcentre starts).
+#[inline]
 pub(super) fn sphere_triangle_slot([a, b, c]: [DVec3; 3], site: usize) -> Candidate {
     let m = spherical_circumcentre(a, b, c);
     let r = (m - a).length();
@@ -114,6 +119,7 @@ pub(super) fn sphere_triangle_slot([a, b, c]: [DVec3; 3], site: usize) -> Candid
 
 /// Unit circumcentre of the spherical triangle (a, b, c) (counter-clockwise seen from outside):
 /// the outward normal of its plane, i.e. the centre of the circumcap on the empty side.
+#[inline]
 pub(super) fn spherical_circumcentre(a: DVec3, b: DVec3, c: DVec3) -> DVec3 {
     (a.cross(b) + b.cross(c) + c.cross(a)).normalize_or_zero()
 }

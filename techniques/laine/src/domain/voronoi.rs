@@ -21,6 +21,7 @@ const PARALLEL_SITES: usize = 4096;
 
 /// `f(scratch, i)` for every site index `i < n`, in order: across cores (one `init()` scratch
 /// per worker) from [`PARALLEL_SITES`] sites on, on the calling thread below.
+#[inline]
 fn map_sites<T: Send, S>(
     n: usize,
     init: impl Fn() -> S + Sync + Send,
