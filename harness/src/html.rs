@@ -9,7 +9,7 @@
 //! Sections: the summary table and any further tables (a paper's rows beside ours), sortable
 //! by any column; per scene, an image viewer flipping or sliding between any two of the
 //! reference's and every technique's images (composed, and indirect light alone at one
-//! exposure), with the FLIP error maps, and a frame player stepping through every compared
+//! exposure), with the FLIP error maps, and a frame player stepping through the (last 16) compared
 //! frame's indirect light beside the reference's; time versus error; the figures (per-stage bars,
 //! per-frame error and flicker, sweep plots); the device, driver, commit, command line and each
 //! run's settings.
@@ -348,7 +348,10 @@ impl Page {
             else {
                 continue;
             };
-            let frames: Vec<u32> = q.frames.iter().map(|f| f.frame).collect();
+            let frames: Vec<u32> = q.frames[FilmStrip::shown(q.frames.len())]
+                .iter()
+                .map(|f| f.frame)
+                .collect();
             let reference_strip = format!("{stem}{}", QUALITY_IMAGES[6]);
             if frames.len() < 2 || !r.images.contains(&reference_strip) {
                 continue;
@@ -393,9 +396,10 @@ impl Page {
         } in &groups
         {
             let n = frames.len();
-            let columns = FilmStrip::columns(size[0], n);
+            let tile = FilmStrip::shrink(*size).1;
+            let columns = FilmStrip::columns(tile[0], n);
             // Shown 256 pixels wide, whatever the resolution.
-            let (w, hgt) = (256.0, 256.0 * size[1] as f64 / size[0].max(1) as f64);
+            let (w, hgt) = (256.0, 256.0 * tile[1] as f64 / tile[0].max(1) as f64);
             let _ = writeln!(
                 h,
                 "<h3>Frames: {} (indirect light alone, every compared frame at the last one's exposure)</h3>\n\
@@ -406,8 +410,8 @@ impl Page {
                  <span class=\"frame-label\">frame {} (1 of {n})</span></div>\n<div class=\"strip\">",
                 esc(scene),
                 frames.iter().map(|f| f.to_string()).collect::<Vec<_>>().join(","),
-                size[0] as usize * columns,
-                size[1] as usize * n.div_ceil(columns),
+                tile[0] as usize * columns,
+                tile[1] as usize * n.div_ceil(columns),
                 n - 1,
                 frames[0],
             );

@@ -372,8 +372,9 @@ pub struct CapturedFrame {
 /// technique's composed image and the reference's at the scene's exposure, the FLIP map, and
 /// the indirect light alone (ρ/π · E_indirect) of both at one exposure derived from the
 /// reference ([`indirect_exposure`]), so every technique compared on the same frame shares it.
-/// Of every compared frame, in order: the indirect light alone of the technique and of the
-/// reference at that same exposure, as film strips ([`FilmStrip`]) that the HTML page plays.
+/// Of the compared frames (the last [`FilmStrip::MAX_FRAMES`]), in order: the indirect light
+/// alone of the technique and of the reference at that same exposure, as film strips
+/// ([`FilmStrip`]) that the HTML page plays.
 pub struct QualityImages {
     pub size: [u32; 2],
     pub compared_display: Vec<u8>,
@@ -401,6 +402,49 @@ impl FilmStrip {
     /// The widest a strip grows before it wraps (pixels): wide enough for a row of frames at
     /// the default resolutions, small enough for every browser and image viewer.
     pub const MAX_WIDTH: u32 = 8192;
+    /// The most frames a strip holds: the last ones compared (consecutive ones with
+    /// `--quality-all`, so the player still shows flicker and lag), which keeps a strip of a
+    /// 60-frame run near a megabyte.
+    pub const MAX_FRAMES: usize = 16;
+    /// The widest tile (pixels): frames wider are shrunk by a whole factor (a box filter), the
+    /// size the page shows them at.
+    pub const MAX_TILE_WIDTH: u32 = 256;
+
+    /// The indices, among `compared` frames, of those a strip holds ([`Self::MAX_FRAMES`]).
+    pub fn shown(compared: usize) -> std::ops::Range<usize> {
+        compared.saturating_sub(Self::MAX_FRAMES)..compared
+    }
+
+    /// The whole factor a frame of `size` is shrunk by, and the tile size that gives.
+    pub fn shrink(size: [u32; 2]) -> (u32, [u32; 2]) {
+        let f = size[0].div_ceil(Self::MAX_TILE_WIDTH).max(1);
+        (f, [(size[0] / f).max(1), (size[1] / f).max(1)])
+    }
+
+    /// `rgba` (`size`, RGBA8) shrunk by [`Self::shrink`]'s factor: each tile pixel the mean of
+    /// its f × f block.
+    pub fn shrunk(size: [u32; 2], rgba: &[u8]) -> Vec<u8> {
+        let (f, [w, h]) = Self::shrink(size);
+        if f == 1 {
+            return rgba.to_vec();
+        }
+        let mut out = vec![0u8; 4 * (w * h) as usize];
+        for y in 0..h {
+            for x in 0..w {
+                for c in 0..4 {
+                    let mut sum = 0u32;
+                    for dy in 0..f {
+                        for dx in 0..f {
+                            let i = ((y * f + dy) * size[0] + x * f + dx) as usize * 4 + c;
+                            sum += rgba[i] as u32;
+                        }
+                    }
+                    out[(y * w + x) as usize * 4 + c] = ((sum + f * f / 2) / (f * f)) as u8;
+                }
+            }
+        }
+        out
+    }
 
     /// The number of columns a strip of `frames` tiles `width` pixels wide is laid out in (the
     /// HTML page computes the same from the run's resolution and frame count).
@@ -521,10 +565,13 @@ pub fn compare(
             // Every compared frame's indirect light at this frame's exposure, so that a change
             // of brightness from frame to frame shows.
             let strip = |image: &dyn Fn(usize) -> Vec<Vec3>| {
-                let tiles: Vec<Vec<u8>> = (0..captured.len())
-                    .map(|j| opaque_rgba(&metrics::tonemap_srgb8(&image(j), k)))
+                let tiles: Vec<Vec<u8>> = FilmStrip::shown(captured.len())
+                    .map(|j| {
+                        let rgba = opaque_rgba(&metrics::tonemap_srgb8(&image(j), k));
+                        FilmStrip::shrunk(size, &rgba)
+                    })
                     .collect();
-                FilmStrip::tile(size, &tiles)
+                FilmStrip::tile(FilmStrip::shrink(size).1, &tiles)
             };
             let component_of = config.component();
             images = Some(QualityImages {
@@ -551,6 +598,31 @@ pub fn compare(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A strip holds the last 16 compared frames, each at most 256 pixels wide: a 512x8 frame
+    /// becomes a 256x4 tile whose pixels are the means of 2x2 blocks.
+    #[test]
+    fn film_strips_keep_the_last_frames_and_shrink_wide_ones() {
+        assert_eq!(FilmStrip::shown(4), 0..4);
+        assert_eq!(FilmStrip::shown(60), 44..60);
+        assert_eq!(FilmStrip::shrink([256, 192]), (1, [256, 192]));
+        assert_eq!(FilmStrip::shrink([1024, 768]), (4, [256, 192]));
+        let size = [512u32, 8];
+        let rgba: Vec<u8> = (0..size[0] * size[1])
+            .flat_map(|i| [if i % 2 == 0 { 10 } else { 20 }, 0, 255, 255])
+            .collect();
+        let tile = FilmStrip::shrunk(size, &rgba);
+        assert_eq!(tile.len(), 4 * 256 * 4);
+        assert!(
+            tile.chunks_exact(4).all(|p| p == [15, 0, 255, 255]),
+            "{:?}",
+            &tile[..8]
+        );
+        let strip = FilmStrip::tile([2, 1], &[vec![1; 8], vec![2; 8], vec![3; 8]]);
+        assert_eq!(strip.size, [6, 1]);
+        assert_eq!(strip.rgba[..8], [1; 8]);
+        assert_eq!(strip.rgba[16..], [3; 8]);
+    }
     use crate::assets::AssetPaths;
 
     fn tiny(value: f32) -> ReferenceImages {
