@@ -58,10 +58,6 @@ impl Error {
     }
 }
 
-/// The atomic writes live with the output sets that stage them; re-exported here for the
-/// callers that name them by this path.
-pub use crate::output::{write_atomic, write_atomic_direct};
-
 /// Parses JSON `bytes` as `T`. A failure says where: the path of the field that failed
 /// (`light.path.keys[1].position`) before serde's message (which gives the line and column).
 pub fn from_json<T: serde::de::DeserializeOwned>(bytes: &[u8]) -> std::result::Result<T, String> {

@@ -172,7 +172,7 @@ impl Page {
     /// Writes the page to `path` (atomically; staged inside an open output set).
     pub fn write(&self, path: &Path) -> Result<()> {
         let dir = path.parent().unwrap_or(Path::new("."));
-        crate::error::write_atomic(path, self.render(dir).as_bytes())
+        crate::output::write_atomic(path, self.render(dir).as_bytes())
     }
 
     /// Device, driver, commit and command line.
@@ -517,7 +517,7 @@ pub fn write_index(path: &Path, title: &str, command: &str, entries: &[IndexEntr
          <title>{}</title>\n<style>{STYLE}</style>\n<script>{CHECK_SCRIPT}</script>\n</head>\n<body>\n{body}</body>\n</html>\n",
         esc(title)
     );
-    crate::error::write_atomic(path, html.as_bytes())
+    crate::output::write_atomic(path, html.as_bytes())
 }
 
 /// The A/B image viewer `v` of a scene over `shots` (A: the first image, the reference where

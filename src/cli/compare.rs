@@ -46,7 +46,7 @@ pub(crate) fn exec(args: &CompareArgs) -> Result<()> {
     let set = OutputSet::begin("out", &args.out)?;
     report::write_tables(&table, &args.out, &args.stem)?;
     let json = serde_json::to_vec_pretty(&rows).map_err(|e| Error::Invalid(e.to_string()))?;
-    gibench_harness::error::write_atomic(&args.out.join(format!("{}.json", args.stem)), &json)?;
+    gibench_harness::output::write_atomic(&args.out.join(format!("{}.json", args.stem)), &json)?;
     set.publish()?;
     eprintln!(
         "wrote {stem}.md, .csv, .tex and .json to {}",

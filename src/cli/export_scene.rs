@@ -119,8 +119,8 @@ pub(crate) fn exec(args: &ExportArgs) -> Result<()> {
     set.replace_files("mesh-*.ply")?;
     set.replace_files("rays-*.bin")?;
     if let Some((closest, shadow)) = &rays {
-        gibench_harness::error::write_atomic(&args.out.join(crate::rays::CLOSEST), closest)?;
-        gibench_harness::error::write_atomic(&args.out.join(crate::rays::SHADOW), shadow)?;
+        gibench_harness::output::write_atomic(&args.out.join(crate::rays::CLOSEST), closest)?;
+        gibench_harness::output::write_atomic(&args.out.join(crate::rays::SHADOW), shadow)?;
     }
     let mut materials = Vec::new();
     for (k, ((positions, tris, _), material)) in groups.iter().zip(&scene.materials).enumerate() {
@@ -128,7 +128,7 @@ pub(crate) fn exec(args: &ExportArgs) -> Result<()> {
             continue;
         }
         let file = format!("mesh-{k}.ply");
-        gibench_harness::error::write_atomic(&args.out.join(&file), &ply(positions, tris))?;
+        gibench_harness::output::write_atomic(&args.out.join(&file), &ply(positions, tris))?;
         materials.push(serde_json::json!({
             "file": file, "name": material.name, "albedo": material.average_color.to_array(),
             "textured": material.texture.is_some(), "triangles": tris.len(),
@@ -155,7 +155,7 @@ pub(crate) fn exec(args: &ExportArgs) -> Result<()> {
                   light's axis (spot: a cosine lobe about it; omni: every direction).",
     });
     let bytes = serde_json::to_vec_pretty(&json).map_err(|e| Error::Invalid(e.to_string()))?;
-    gibench_harness::error::write_atomic(&args.out.join("scene.json"), &bytes)?;
+    gibench_harness::output::write_atomic(&args.out.join("scene.json"), &bytes)?;
     set.publish()?;
     eprintln!(
         "wrote {} ({} triangles in {} meshes)",

@@ -223,7 +223,7 @@ fn write_baseline(
         "kernels": counts,
     });
     let bytes = serde_json::to_vec_pretty(&json).map_err(|e| Error::Invalid(e.to_string()))?;
-    gibench_harness::error::write_atomic(&args.baseline, &bytes)?;
+    gibench_harness::output::write_atomic(&args.baseline, &bytes)?;
     eprintln!(
         "wrote the instruction counts of {} kernels to {}",
         kernels,

@@ -146,9 +146,9 @@ pub(crate) fn exec(args: &RaycastArgs) -> Result<()> {
     let (t, s) = last.expect("at least one pass");
     let set = OutputSet::begin("out", &args.out)?;
     let t_bytes: Vec<u8> = t.iter().flat_map(|x| x.to_le_bytes()).collect();
-    gibench_harness::error::write_atomic(&args.out.join("closest-t.bin"), &t_bytes)?;
+    gibench_harness::output::write_atomic(&args.out.join("closest-t.bin"), &t_bytes)?;
     let s_bytes: Vec<u8> = s.iter().map(|&b| b as u8).collect();
-    gibench_harness::error::write_atomic(&args.out.join("shadow-hit.bin"), &s_bytes)?;
+    gibench_harness::output::write_atomic(&args.out.join("shadow-hit.bin"), &s_bytes)?;
     let json = serde_json::json!({
         "scene": desc.name, "frame": frame_index, "git_commit": gibench_harness::runner::git_commit(),
         "threads": rayon::current_num_threads(),
@@ -161,7 +161,7 @@ pub(crate) fn exec(args: &RaycastArgs) -> Result<()> {
                   process during the pass (rayon over all cores).",
     });
     let bytes = serde_json::to_vec_pretty(&json).map_err(|e| Error::Invalid(e.to_string()))?;
-    gibench_harness::error::write_atomic(&args.out.join("raycast.json"), &bytes)?;
+    gibench_harness::output::write_atomic(&args.out.join("raycast.json"), &bytes)?;
     set.publish()?;
     eprintln!(
         "raycast: {} closest-hit and {} shadow rays on '{}', {} passes: wrote {}",

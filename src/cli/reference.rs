@@ -166,6 +166,6 @@ pub(crate) fn reference_planned(
         "git_commit": gibench_harness::runner::git_commit(), "error_estimate": estimate,
     });
     let json = serde_json::to_vec_pretty(&info).map_err(|e| Error::Invalid(e.to_string()))?;
-    gibench_harness::error::write_atomic(&out(".json"), &json)?;
+    gibench_harness::output::write_atomic(&out(".json"), &json)?;
     Ok(format!("wrote {stem}.png, .json and -direct/-one-bounce/-multi-bounce/-radiance.exr to {} ({seconds:.1} s)", args.out.display()))
 }

@@ -377,7 +377,7 @@ pub(crate) fn run_planned(
         let path = args.out.join(skipped_file(name));
         let bytes =
             serde_json::to_vec_pretty(&record).map_err(|e| Error::Invalid(e.to_string()))?;
-        gibench_harness::error::write_atomic(&path, &bytes)?;
+        gibench_harness::output::write_atomic(&path, &bytes)?;
         written.push(file_name(&path));
     }
     report::stacked_bar_svg(

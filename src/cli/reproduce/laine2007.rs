@@ -583,7 +583,7 @@ fn management(args: &ReproduceArgs) -> Result<Table> {
         "per_frame_ms": records,
     });
     let bytes = serde_json::to_vec_pretty(&json).map_err(|e| Error::Invalid(e.to_string()))?;
-    gibench_harness::error::write_atomic(&out(args).join("laine-management.json"), &bytes)?;
+    gibench_harness::output::write_atomic(&out(args).join("laine-management.json"), &bytes)?;
     Ok(Table {
         title: format!("VPL management per frame on the CPU ({name}, {MANAGEMENT_PASSES} passes of {frames} frames, recalcMin 4, recalcMax 8)"),
         columns: ["source", "light", "VPLs", "VPLs used mean", "VPLs used min", "median ms", "pass medians ms", "median CPU ms", "p99 ms", "max ms", "fill frame ms", "frames rebuilt", "sites repaired per frame", "part medians ms: validity / update / deletion / creation / intensities"]
@@ -702,7 +702,7 @@ fn dispersion(args: &ReproduceArgs) -> Result<Table> {
         "git_commit": gibench_harness::runner::git_commit(), "dispersion_per_frame_after_the_first": records,
     });
     let bytes = serde_json::to_vec_pretty(&json).map_err(|e| Error::Invalid(e.to_string()))?;
-    gibench_harness::error::write_atomic(&out(args).join("laine-dispersion.json"), &bytes)?;
+    gibench_harness::output::write_atomic(&out(args).join("laine-dispersion.json"), &bytes)?;
     report::lines_svg(
         &lines,
         &out(args).join("laine-dispersion.svg"),

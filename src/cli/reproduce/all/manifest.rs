@@ -161,7 +161,7 @@ impl Manifest {
 
     pub(super) fn write(&self, root: &Path) -> Result<()> {
         let json = serde_json::to_vec_pretty(self).map_err(|e| Error::Invalid(e.to_string()))?;
-        gibench_harness::error::write_atomic(&root.join(format!("{MANIFEST}.json")), &json)?;
+        gibench_harness::output::write_atomic(&root.join(format!("{MANIFEST}.json")), &json)?;
         let mut md = format!(
             "# gibench reproduce all ({} sizes)\n\nLast run: on {}{}, git {}, {} CPU threads: {} ({}). \
              Targets it did not run keep the entry of the run that made their files (\"from git …\").\n\n\
@@ -201,7 +201,7 @@ impl Manifest {
                 figures.join("<br>"),
             ));
         }
-        gibench_harness::error::write_atomic(&root.join(format!("{MANIFEST}.md")), md.as_bytes())
+        gibench_harness::output::write_atomic(&root.join(format!("{MANIFEST}.md")), md.as_bytes())
     }
 
     /// `reproduce-all.html`: every target with its pages, tables and figures.
