@@ -3,7 +3,8 @@
 //! point landed on and leaves regions beyond its reach empty; splatting a dense point set of a
 //! plane and pulling-pushing reproduces the plane's exact (classic) paraboloid depth map.
 
-mod support;
+use gibench_test_support::readback::read_bytes as read_buffer;
+use gibench_test_support::scene as support;
 
 use gibench_harness::glam::Vec3;
 use gibench_harness::gpu::GpuContext;
@@ -289,25 +290,6 @@ fn dense_splats_of_a_plane_reproduce_its_exact_map() {
             "{backend}: mean depth error {mean}, half a texel's change {half}"
         );
     }
-}
-
-/// The bytes of `buffer` (COPY_SRC).
-fn read_buffer(gpu: &GpuContext, buffer: &wgpu::Buffer) -> Vec<u8> {
-    let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("test readback"),
-        size: buffer.size(),
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    let mut enc = gpu.device.create_command_encoder(&Default::default());
-    enc.copy_buffer_to_buffer(buffer, 0, &staging, 0, buffer.size());
-    gpu.queue.submit([enc.finish()]);
-    let slice = staging.slice(..);
-    slice.map_async(wgpu::MapMode::Read, |_| {});
-    gpu.flush().unwrap();
-    let bytes = slice.get_mapped_range().unwrap().to_vec();
-    staging.unmap();
-    bytes
 }
 
 fn luminance(c: Vec3) -> f32 {

@@ -13,8 +13,7 @@ use gibench_harness::reference::{
 use gibench_harness::scene::descriptor::LightKind;
 use gibench_harness::scene::{Material, Mesh, Mover, Scene, Texture};
 
-mod support;
-use support::{material, quad, scene};
+use gibench_test_support::scene::{self as support, material, quad, scene};
 
 /// The square [−h, h]² in the y = 0 plane, facing +Y.
 fn plane(h: f32) -> Mesh {

@@ -14,8 +14,7 @@ use gibench_harness::vpl::{
     radical_inverse, square_to_disc, square_to_sphere, to_local, total_flux, Vpl, VplSettings,
 };
 
-mod support;
-use support::{closed_box_mesh, material, quad, scene};
+use gibench_test_support::scene::{closed_box_mesh, material, quad, scene};
 
 const ALBEDO: Vec3 = Vec3::new(0.5, 0.6, 0.7);
 const BOX: Vec3 = Vec3::new(4.0, 3.0, 5.0);

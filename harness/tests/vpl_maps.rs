@@ -19,7 +19,7 @@ use gibench_harness::scene::Scene;
 use gibench_harness::vpl::{frame_from_normal, Vpl};
 use gibench_harness::wgpu;
 
-mod support;
+use gibench_test_support::scene as support;
 
 /// How the atlas is filled.
 #[derive(Clone, Copy, Debug, PartialEq)]

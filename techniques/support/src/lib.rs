@@ -1,4 +1,4 @@
-//! Helpers the technique crates' integration tests share (a dev-dependency only): every GPU
+//! Helpers the harness's and the technique crates' integration tests share (a dev-dependency only): every GPU
 //! test runs on each portable backend present ([`gpus`], [`each_backend`]), reads its results
 //! back ([`read_f32`], [`read_rgb`]), draws its random numbers from a fixed sequence ([`Lcg`]),
 //! builds small scenes in code ([`scene`]) and runs registered techniques frame by frame

@@ -4,8 +4,8 @@ use gibench_harness::glam::Vec3;
 use gibench_harness::gpu::GpuContext;
 use gibench_harness::wgpu;
 
-/// The floats of `buffer` (COPY_SRC), after every submitted command.
-pub fn read_f32(gpu: &GpuContext, buffer: &wgpu::Buffer) -> Vec<f32> {
+/// The bytes of `buffer` (COPY_SRC), after every submitted command.
+pub fn read_bytes(gpu: &GpuContext, buffer: &wgpu::Buffer) -> Vec<u8> {
     let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("test readback"),
         size: buffer.size(),
@@ -18,9 +18,14 @@ pub fn read_f32(gpu: &GpuContext, buffer: &wgpu::Buffer) -> Vec<f32> {
     let slice = staging.slice(..);
     slice.map_async(wgpu::MapMode::Read, |_| {});
     gpu.flush().unwrap();
-    let v = bytemuck::cast_slice(&slice.get_mapped_range().unwrap()).to_vec();
+    let bytes = slice.get_mapped_range().unwrap().to_vec();
     staging.unmap();
-    v
+    bytes
+}
+
+/// The floats of `buffer` (COPY_SRC), after every submitted command.
+pub fn read_f32(gpu: &GpuContext, buffer: &wgpu::Buffer) -> Vec<f32> {
+    bytemuck::pod_collect_to_vec(&read_bytes(gpu, buffer))
 }
 
 /// The RGB of every texel of `texture`, row by row.
