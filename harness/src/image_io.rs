@@ -1,4 +1,4 @@
-//! Reading textures back from the GPU and writing images: PNG for what a person looks at,
+//! Reading buffers and textures back from the GPU and writing images: PNG for what a person looks at,
 //! OpenEXR (32-bit float RGB) for irradiance buffers. Both are written atomically.
 
 use std::path::Path;
@@ -54,6 +54,29 @@ pub fn read_texture(gpu: &GpuContext, texture: &wgpu::Texture) -> Result<Vec<u8>
     drop(mapped);
     buffer.unmap();
     Ok(out)
+}
+
+/// Copies a whole buffer (COPY_SRC) to the CPU after the queued work (flushes the queue and
+/// makes a staging buffer: for tests, checks and exports, not a frame loop).
+pub fn read_buffer(gpu: &GpuContext, buffer: &wgpu::Buffer) -> Result<Vec<u8>> {
+    let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("buffer readback"),
+        size: buffer.size(),
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let mut enc = gpu.device.create_command_encoder(&Default::default());
+    enc.copy_buffer_to_buffer(buffer, 0, &staging, 0, buffer.size());
+    gpu.queue.submit([enc.finish()]);
+    let slice = staging.slice(..);
+    slice.map_async(wgpu::MapMode::Read, |_| {});
+    gpu.flush()?;
+    let bytes = slice
+        .get_mapped_range()
+        .map_err(|e| Error::Gpu(format!("mapping a readback buffer failed: {e}")))?
+        .to_vec();
+    staging.unmap();
+    Ok(bytes)
 }
 
 /// IEEE half → f32.

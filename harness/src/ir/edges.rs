@@ -144,25 +144,8 @@ impl EdgeMask {
     /// The mask copied to the CPU after the queued work (for tests and inspection: it waits for
     /// the GPU and makes a staging buffer, so not for a frame loop).
     pub fn read(&self, gpu: &GpuContext) -> Result<Vec<u32>> {
-        let size = self.mask.size();
-        let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("edge mask readback"),
-            size,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let mut enc = gpu.device.create_command_encoder(&Default::default());
-        enc.copy_buffer_to_buffer(&self.mask, 0, &staging, 0, size);
-        gpu.queue.submit([enc.finish()]);
-        let slice = staging.slice(..);
-        slice.map_async(wgpu::MapMode::Read, |_| {});
-        gpu.flush()?;
-        let data: Vec<u32> = bytemuck::pod_collect_to_vec(
-            &slice
-                .get_mapped_range()
-                .map_err(|e| Error::Gpu(format!("mapping the edge mask failed: {e}")))?[..],
-        );
-        staging.unmap();
+        let data: Vec<u32> =
+            bytemuck::pod_collect_to_vec(&crate::image_io::read_buffer(gpu, &self.mask)?);
         let [w, h] = self.size;
         Ok(data[..(w * h) as usize].to_vec())
     }

@@ -340,21 +340,9 @@ pub fn measure(gpu: &GpuContext, s: &Slabs, n: u32, iterations: u32) -> Result<I
 }
 
 fn read(gpu: &GpuContext, buffer: &wgpu::Buffer) -> Result<Vec<f32>> {
-    let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("slab readback"),
-        size: buffer.size(),
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    let mut enc = gpu.device.create_command_encoder(&Default::default());
-    enc.copy_buffer_to_buffer(buffer, 0, &staging, 0, buffer.size());
-    gpu.queue.submit([enc.finish()]);
-    let slice = staging.slice(..);
-    slice.map_async(wgpu::MapMode::Read, |_| {});
-    gpu.flush()?;
-    let v = bytemuck::cast_slice(&slice.get_mapped_range().unwrap()).to_vec();
-    staging.unmap();
-    Ok(v)
+    Ok(bytemuck::pod_collect_to_vec(
+        &gibench_harness::image_io::read_buffer(gpu, buffer)?,
+    ))
 }
 
 #[cfg(test)]

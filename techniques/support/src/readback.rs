@@ -6,21 +6,7 @@ use gibench_harness::wgpu;
 
 /// The bytes of `buffer` (COPY_SRC), after every submitted command.
 pub fn read_bytes(gpu: &GpuContext, buffer: &wgpu::Buffer) -> Vec<u8> {
-    let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("test readback"),
-        size: buffer.size(),
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    let mut enc = gpu.device.create_command_encoder(&Default::default());
-    enc.copy_buffer_to_buffer(buffer, 0, &staging, 0, buffer.size());
-    gpu.queue.submit([enc.finish()]);
-    let slice = staging.slice(..);
-    slice.map_async(wgpu::MapMode::Read, |_| {});
-    gpu.flush().unwrap();
-    let bytes = slice.get_mapped_range().unwrap().to_vec();
-    staging.unmap();
-    bytes
+    gibench_harness::image_io::read_buffer(gpu, buffer).expect("buffer read-back")
 }
 
 /// The floats of `buffer` (COPY_SRC), after every submitted command.
