@@ -46,6 +46,7 @@ pub mod reference;
 pub mod report;
 pub mod results;
 pub mod rng;
+pub mod roofline;
 pub mod runner;
 pub mod scene;
 pub mod session;

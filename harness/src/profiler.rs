@@ -19,6 +19,7 @@ use std::time::Instant;
 
 use crate::gpu::GpuContext;
 use crate::results::{FrameResult, StageKind, StageResult};
+use crate::roofline::{CostSum, StageCost};
 use crate::stats::Stats;
 use crate::Result;
 
@@ -43,6 +44,8 @@ struct StageSeries {
     gpu: Vec<f64>,
     /// Thread CPU time (CPU stages).
     cpu: Vec<f64>,
+    /// The costs the stage declared in measured frames ([`Profiler::stage_cost`]).
+    cost: CostSum,
 }
 
 /// A deliberate slowdown for testing `gibench compare`: `GIBENCH_TEST_SLOW_STAGE=NAME:MS` adds
@@ -153,6 +156,7 @@ impl Profiler {
             wall: Vec::new(),
             gpu: Vec::new(),
             cpu: Vec::new(),
+            cost: CostSum::default(),
         });
         self.series.len() - 1
     }
@@ -279,6 +283,24 @@ impl Profiler {
     /// then). `None` in frame mode or before any frame.
     pub fn first_frame_ms(&self) -> Option<f64> {
         (self.mode == ProfileMode::Stages && self.frames_begun > 0).then_some(self.first_frame_ms)
+    }
+
+    /// Declares the GPU stage `name`'s minimum cost this frame ([`crate::roofline`]): what it
+    /// must read, write and compute for its inputs. Called beside the stage, with a cost the
+    /// technique computed once; the results hold its mean over the measured frames.
+    pub fn stage_cost(&mut self, name: &str, cost: StageCost) {
+        let idx = self.series_index(name, StageKind::Gpu);
+        if self.recording {
+            self.series[idx].cost.add(&cost);
+        }
+    }
+
+    /// The declared costs by stage name (means over the measured frames).
+    pub fn stage_costs(&self) -> BTreeMap<String, StageCost> {
+        self.series
+            .iter()
+            .filter_map(|s| Some((s.name.clone(), s.cost.mean()?)))
+            .collect()
     }
 
     /// Records a per-frame counter (e.g. shadow maps rendered this frame).

@@ -135,6 +135,14 @@ pub struct RunResult {
     /// else the largest of those run so far.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub peak_memory_mb: Option<f64>,
+    /// The device's copy bandwidth and arithmetic rate, measured once before the frames of a run
+    /// that times stages ([`crate::roofline`]); absent in older files and frame-only runs.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub device_bounds: Option<crate::roofline::DeviceBounds>,
+    /// Each GPU stage's declared minimum cost per frame (mean over the measured frames), by
+    /// stage name; a stage that declares none is absent.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub stage_costs: BTreeMap<String, crate::roofline::StageCost>,
 }
 
 impl RunResult {
@@ -204,6 +212,35 @@ impl RunResult {
                     CALIBRATION_MS.0,
                     CALIBRATION_MS.1
                 ));
+            }
+        }
+        if let Some(b) = &self.device_bounds {
+            for (field, v) in [
+                ("copy_bytes", b.copy_bytes),
+                ("copy_ms", b.copy_ms),
+                ("fma_ops", b.fma_ops),
+                ("fma_ms", b.fma_ms),
+            ] {
+                if !(v.is_finite() && v > 0.0) {
+                    return Err(format!(
+                        "device_bounds.{field} is {} (expected a finite number above 0)",
+                        shown(v)
+                    ));
+                }
+            }
+        }
+        for (stage, c) in &self.stage_costs {
+            for (field, v) in [
+                ("bytes_read", c.bytes_read),
+                ("bytes_written", c.bytes_written),
+                ("ops", c.ops),
+            ] {
+                if !(v.is_finite() && v >= 0.0) {
+                    return Err(format!(
+                        "stage_costs.{stage}.{field} is {} (expected a finite number, not negative)",
+                        shown(v)
+                    ));
+                }
             }
         }
         if let Some(q) = &self.quality {

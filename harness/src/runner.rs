@@ -18,6 +18,7 @@ use crate::passes::{Compose, DirectLight, FrameUniforms, GBuffer, GpuScene};
 use crate::profiler::{ProfileMode, Profiler};
 use crate::quality::{CapturedFrame, QualityConfig, QualityImages, ReferenceCache};
 use crate::results::{FrameRange, RunResult, SCHEMA_VERSION};
+use crate::roofline::{measure_bounds, DeviceBounds, StageCost};
 use crate::scene::Scene;
 use crate::technique::{
     FrameContext, Params, PrepareContext, Prepared, SceneContext, Technique, TechniqueInfo,
@@ -32,6 +33,35 @@ pub const STAGE_DIRECT_SHADOW_MAP: &str = "direct-shadow-map";
 pub const STAGE_DIRECT_LIGHT: &str = "direct-light";
 /// Stage: composing radiance and its display image.
 pub const STAGE_COMPOSE: &str = "compose";
+
+/// The shared GPU stages' declared minimum costs ([`crate::roofline`]), computed once per
+/// harness.
+struct SharedCosts {
+    gbuffer: StageCost,
+    direct_light: StageCost,
+}
+
+impl SharedCosts {
+    fn new(resolution: [u32; 2], scene: &GpuScene) -> SharedCosts {
+        let pixels = resolution[0] as u64 * resolution[1] as u64;
+        // `gbuffer`: the scene drawn once ([`crate::roofline::scene_draw_cost`]) and every
+        // pixel's depth (4 bytes), normal (Rgba16Float, 8) and albedo (4) written once.
+        // Fragments hidden behind others and texture reads are not counted: the minimum
+        // renders each pixel once.
+        let gbuffer =
+            crate::roofline::scene_draw_cost(scene).plus(StageCost::per_element(pixels, 0, 16, 0));
+        // `direct-light`: per pixel the G-buffer's depth (4 bytes) and normal (8) read and the
+        // irradiance (Rgba16Float, 8) written; the position rebuilt from depth and moved into
+        // the light's map (two 4×4 matrix-vector products, 64 operations) and the 16 PCF taps
+        // summed (16). The taps' texels are not counted as bytes: neighbouring pixels share
+        // them, so the minimum reads the map's texels once, fewer than the pixels here.
+        let direct_light = StageCost::per_element(pixels, 12, 8, 80);
+        SharedCosts {
+            gbuffer,
+            direct_light,
+        }
+    }
+}
 
 /// A technique's once-per-scene preparation and how long it took.
 pub struct PreparedTechnique {
@@ -297,6 +327,10 @@ pub struct Harness<'a> {
     pub gbuffer: GBuffer,
     pub direct: DirectLight,
     pub clock: FrameClock,
+    /// The device's bounds, measured on the first timed run ([`Harness::device_bounds`]).
+    bounds: std::sync::OnceLock<DeviceBounds>,
+    /// The shared stages' declared costs: G-buffer, direct light.
+    shared_costs: SharedCosts,
 }
 
 impl<'a> Harness<'a> {
@@ -346,6 +380,7 @@ impl<'a> Harness<'a> {
         let gbuffer = GBuffer::new(gpu, &gpu_scene, &uniforms);
         let direct = DirectLight::new(gpu, &gpu_scene, &uniforms, &gbuffer);
         gpu.check_errors()?;
+        let shared_costs = SharedCosts::new(config.resolution, &gpu_scene);
         Ok(Harness {
             gpu,
             scene,
@@ -355,7 +390,19 @@ impl<'a> Harness<'a> {
             gbuffer,
             direct,
             clock: FrameClock::new(&scene.descriptor),
+            bounds: std::sync::OnceLock::new(),
+            shared_costs,
         })
+    }
+
+    /// The device's bounds ([`crate::roofline`]), measured the first time they are asked for
+    /// (never inside a frame) and kept for every later run of this harness.
+    pub fn device_bounds(&self) -> Result<DeviceBounds> {
+        if let Some(b) = self.bounds.get() {
+            return Ok(b.clone());
+        }
+        let b = measure_bounds(self.gpu)?;
+        Ok(self.bounds.get_or_init(|| b).clone())
     }
 
     /// The fields every technique call sees.
@@ -417,6 +464,7 @@ impl<'a> Harness<'a> {
         profiler.gpu_stage(gpu, STAGE_GBUFFER, |enc| {
             self.gbuffer.encode(enc, &self.gpu_scene, &self.uniforms)
         })?;
+        profiler.stage_cost(STAGE_GBUFFER, self.shared_costs.gbuffer);
         let faces = profiler.gpu_stage(gpu, STAGE_DIRECT_SHADOW_MAP, |enc| {
             self.direct
                 .encode_shadow_map(enc, &self.gpu_scene, &self.uniforms, &frame.light)
@@ -425,6 +473,7 @@ impl<'a> Harness<'a> {
         profiler.gpu_stage(gpu, STAGE_DIRECT_LIGHT, |enc| {
             self.direct.encode_lighting(enc, &self.gbuffer)
         })?;
+        profiler.stage_cost(STAGE_DIRECT_LIGHT, self.shared_costs.direct_light);
         technique.render(&mut FrameContext {
             base: self.scene_context(),
             frame,
@@ -466,6 +515,12 @@ impl<'a> Harness<'a> {
     ) -> Result<(RunResult, FrameImages)> {
         // Timed before the frames, in the same session: what `gibench compare` divides by.
         let calibration = crate::calibrate::calibration_ms();
+        // The device's bounds, once per harness, before any frame of a run that times stages.
+        let device_bounds = match config.timing {
+            TimingMode::Frame => None,
+            _ => Some(self.device_bounds()?),
+        };
+        let mut stage_costs = BTreeMap::new();
         let mut stages = Vec::new();
         let mut counters = BTreeMap::new();
         let mut frame_result = None;
@@ -494,6 +549,7 @@ impl<'a> Harness<'a> {
                     stages = profiler.stage_results();
                     counters = profiler.counter_results();
                     first_frame_ms = profiler.first_frame_ms();
+                    stage_costs = profiler.stage_costs();
                 }
                 ProfileMode::Frame => {
                     frame_result = profiler.frame_result();
@@ -559,6 +615,8 @@ impl<'a> Harness<'a> {
             warnings: Vec::new(),
             calibration_ms: Some(calibration),
             peak_memory_mb: process_memory_mb("VmHWM"),
+            device_bounds,
+            stage_costs,
         };
         let images = images.expect("at least one timing pass");
         let mut result = result;

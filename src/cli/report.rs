@@ -24,7 +24,8 @@ pub(crate) struct ReportArgs {
     /// File name stem of the outputs.
     #[arg(long, default_value = "report")]
     stem: String,
-    /// Also print full statistics (median, mean, p5, p95, min, max) per stage.
+    /// Also print full statistics (median, mean, p5, p95, min, max) per stage, and each GPU
+    /// stage's fraction of the device's measured bandwidth and arithmetic rate (a roofline).
     #[arg(long)]
     detailed: bool,
     /// Also write an HTML page (`{stem}.html`): the table, the runs' images beside the
@@ -44,6 +45,7 @@ pub(crate) fn exec(args: &ReportArgs) -> Result<()> {
     if args.detailed {
         for r in &results {
             println!("{}", report::stage_table_detailed(r).to_terminal());
+            println!("{}", report::roofline_table(r).to_terminal());
         }
     }
     report::write_tables(&table, &args.out, &args.stem)?;

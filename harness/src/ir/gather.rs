@@ -15,6 +15,7 @@ use super::interleave::{FilterSettings, Interleave};
 use super::raster::{AtlasClear, AtlasRasteriser, StoreViews};
 use super::store::VplStore;
 use crate::passes::DrawSet;
+use crate::roofline::StageCost;
 use crate::technique::{FrameContext, ParamKind, ParamSpec, Params, PrepareContext};
 use crate::vpl::Vpl;
 use crate::Result;
@@ -221,21 +222,30 @@ impl VplGather {
             .fold((u32::MAX, 0), |(lo, hi), &n| (lo.min(n), hi.max(n)));
         ctx.profiler.count("tile-vpls-min", lo as f64);
         ctx.profiler.count("tile-vpls-max", hi as f64);
-        self.gather_store(ctx)
+        self.gather_stages(ctx, vpls.len() as u32)
     }
 
     /// Records split, accumulate, combine and filter over the store as it is (filled by the
-    /// CPU or by a GPU pass earlier in the frame).
+    /// CPU or by a GPU pass earlier in the frame; its cost declared for a full store).
     pub fn gather_store(&self, ctx: &mut FrameContext) -> Result<()> {
+        self.gather_stages(ctx, self.store.capacity())
+    }
+
+    /// The gathering stages over a store holding `vpls` VPLs, with their declared costs.
+    fn gather_stages(&self, ctx: &mut FrameContext, vpls: u32) -> Result<()> {
         let gpu = ctx.gpu;
         let il = &self.interleave;
+        let costs = GatherCosts::new(il, vpls);
         ctx.profiler
             .gpu_stage(gpu, STAGE_SPLIT, |enc| il.encode_split(enc))?;
+        ctx.profiler.stage_cost(STAGE_SPLIT, costs.split);
         ctx.profiler.gpu_stage(gpu, STAGE_ACCUMULATE, |enc| {
             self.accumulation.encode(enc, il, &self.atlas)
         })?;
+        ctx.profiler.stage_cost(STAGE_ACCUMULATE, costs.accumulate);
         ctx.profiler
             .gpu_stage(gpu, STAGE_COMBINE, |enc| il.encode_combine(enc))?;
+        ctx.profiler.stage_cost(STAGE_COMBINE, costs.combine);
         ctx.profiler
             .gpu_stage(gpu, STAGE_FILTER, |enc| il.encode_filter(enc))?;
         Ok(())
@@ -244,5 +254,48 @@ impl VplGather {
     /// The indirect-irradiance output.
     pub fn output(&self) -> &wgpu::TextureView {
         &self.view
+    }
+}
+
+/// The gathering stages' declared minimum costs ([`crate::roofline`]), from the interleave's
+/// sizes and the VPL count (arithmetic only: nothing allocated per frame).
+struct GatherCosts {
+    split: StageCost,
+    accumulate: StageCost,
+    combine: StageCost,
+}
+
+impl GatherCosts {
+    fn new(il: &Interleave, vpls: u32) -> GatherCosts {
+        let pixels = il.full[0] as u64 * il.full[1] as u64;
+        let texels = il.split_texels() as u64;
+        let tiles = (il.tiles[0] * il.tiles[1]) as u64;
+        // `split`: per pixel the G-buffer's depth (4 bytes) and normal (Rgba16Float, 8) read,
+        // its split position and normal (two vec4<f32>, 32) written; the position rebuilt
+        // from depth (a 4×4 matrix times a point, 32 operations).
+        let split = StageCost::per_element(pixels, 12, 32, 32);
+        // `accumulate`: per split texel its position and normal read (32 bytes) and its
+        // irradiance written (16); every VPL read once (`GpuVpl`, 80 bytes). A texel is lit by
+        // its tile's VPLs, vpls / tiles of them, so there are texels × vpls / tiles pairs, each
+        // at least 40 operations: the vector to the VPL and its squared length (8), the
+        // reciprocal distance (1), both cosines (10), the map coordinates of the lookup (10),
+        // the product of the terms (5) and the flux's three channels scaled and added (6).
+        // The shadow-map texels the lookups read are not counted: how many distinct ones
+        // they touch depends on the geometry.
+        let pairs = texels as f64 * vpls as f64 / tiles as f64;
+        let accumulate = StageCost {
+            bytes_read: (texels * 32) as f64
+                + vpls as f64 * std::mem::size_of::<super::store::GpuVpl>() as f64,
+            bytes_written: (texels * 16) as f64,
+            ops: pairs * 40.0,
+        };
+        // `combine`: per pixel its split texel's irradiance read and written back in place
+        // (a vec4<f32> each way, 16 bytes); no arithmetic.
+        let combine = StageCost::per_element(pixels, 16, 16, 0);
+        GatherCosts {
+            split,
+            accumulate,
+            combine,
+        }
     }
 }

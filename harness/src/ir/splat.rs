@@ -183,6 +183,20 @@ impl PointSplat {
         &self.depth
     }
 
+    /// The splat's declared minimum cost per frame ([`crate::roofline`]): the depth buffer
+    /// cleared (slots × size² texels, 4 bytes each, written) and, per (point, slot), the point
+    /// read (a `vec4<f32>`, 16 bytes: every VPL has its own subset) and one texel written (a
+    /// `u32`, 4 bytes — the nearest-first atomic's read of it not counted). Operations per
+    /// point: the object's transform (a 4×4 matrix times a point, 32), the vector to the VPL
+    /// in its frame (3 subtractions, three 3-term dot products: 18), its length and the
+    /// paraboloid's projection (a square root and a division per axis: about 10) — 60.
+    pub fn cost(&self) -> crate::roofline::StageCost {
+        let texels = self.slots as u64 * self.size as u64 * self.size as u64;
+        let points = self.slots as u64 * self.per_vpl as u64;
+        crate::roofline::StageCost::per_element(points, 16, 4, 60)
+            .plus(crate::roofline::StageCost::per_element(texels, 0, 4, 0))
+    }
+
     /// Slots and map edge of the depth buffer.
     pub fn layout(&self) -> (u32, u32) {
         (self.slots, self.size)

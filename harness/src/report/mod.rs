@@ -11,7 +11,9 @@
 //!   median GPU timestamp time ([`StageResult::best_ms`]). This is the table `gibench run` prints and
 //!   `gibench report` writes.
 //! * [`stage_table_detailed`]: one run, one row per stage, with median/mean/p5/p95/min/max of both
-//!   the GPU timestamp and the wall-clock timings (`gibench report --detailed`).
+//!   the GPU timestamp and the wall-clock timings (`gibench report --detailed`);
+//! * [`roofline_table`]: one run, one row per GPU stage, its achieved fractions of the device's
+//!   measured bandwidth and arithmetic rate ([`crate::roofline`]; also `--detailed`).
 //!
 //! and rendered by
 //!
@@ -50,6 +52,7 @@ mod latex;
 mod markdown;
 mod pareto;
 mod plot;
+mod roofline;
 mod runs;
 mod stages;
 mod table;
@@ -62,6 +65,7 @@ pub use plot::{
     check_per_frame_metric, lines_svg, per_frame_lines, quality_over_frames_svg, stacked_bar_svg,
     sweep_plot_svg, time_vs_error_svg, Line, PER_FRAME_METRICS,
 };
+pub use roofline::roofline_table;
 pub use runs::stage_ms;
 pub use stages::{
     device_label, stage_table, stage_table_detailed, tile_balance_cell, vpl_count_cell,

@@ -91,6 +91,8 @@ fn run(scene: &str, technique: &str, stages: Vec<StageResult>, frame_median: f64
         warnings: Vec::new(),
         calibration_ms: None,
         peak_memory_mb: None,
+        device_bounds: None,
+        stage_costs: BTreeMap::new(),
     }
 }
 

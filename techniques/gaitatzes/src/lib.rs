@@ -60,8 +60,9 @@ use gibench_harness::technique::{
 };
 use gibench_harness::{wgpu, Result};
 
+use gibench_harness::roofline::{scene_draw_cost, StageCost};
 use params::PARAMS;
-use volume::{Grid, Propagation, Reconstruction, Volumes, Voxelizer};
+use volume::{Grid, Mode, Propagation, Reconstruction, Volumes, Voxelizer, CELL_BYTES};
 
 /// Stage: voxelization, combine and injection.
 pub const STAGE_VOXELIZATION: &str = "voxelization";
@@ -104,6 +105,61 @@ pub struct Gaitatzes {
     grid: u32,
     _output: wgpu::Texture,
     view: wgpu::TextureView,
+    costs: Costs,
+}
+
+/// The stages' declared minimum costs ([`gibench_harness::roofline`]), computed once. Cells:
+/// `grid`³; a cell of the voxel buffer or of an SH buffer is [`CELL_BYTES`] (three vec4s).
+struct Costs {
+    voxelization: StageCost,
+    propagation: StageCost,
+    reconstruction: StageCost,
+}
+
+impl Costs {
+    fn new(grid: &Grid, iterations: u32, resolution: [u32; 2], ctx: &PrepareContext) -> Costs {
+        let cells = grid.cells();
+        let pixels = resolution[0] as u64 * resolution[1] as u64;
+        // `voxelization` (with injection): the scene drawn once, and per cell its voxel
+        // (normal, albedo, radiosity), its injected SH and its cleared accumulation written
+        // once (3 × 48 bytes). Drawing the scene once per slice (3·grid times) is this
+        // implementation's way, not the minimum; the injection's arithmetic, only in occupied
+        // cells (not known before the frame), is not counted.
+        let voxelization = scene_draw_cost(ctx.gpu_scene).plus(StageCost::per_element(
+            cells,
+            0,
+            3 * CELL_BYTES,
+            0,
+        ));
+        // `propagation`, per iteration and cell: its voxel's normal and occupancy read (a
+        // vec4, 16 bytes), its SH read once (48: every neighbour reads it, but once is the
+        // minimum) and the next SH written (48); plain LPV also adds into every cell's
+        // accumulation (48 read, 48 written), the occluded mode only in occupied cells (not
+        // counted). Operations: each cell's six face integrals once (6 faces × 3 channels × a
+        // 4-term dot product, 144) and the six incoming lobes added (6 × 3 × 4 FMAs, 144).
+        let accumulate = match grid.mode {
+            Mode::Lpv => CELL_BYTES,
+            Mode::Occluded => 0,
+        };
+        let propagation = StageCost::per_element(
+            cells * iterations as u64,
+            16 + CELL_BYTES + accumulate,
+            CELL_BYTES + accumulate,
+            288,
+        );
+        // `reconstruction`: per pixel the G-buffer's depth and normal read (12 bytes) and the
+        // irradiance written (Rgba16Float, 8); the accumulation and the voxels' occupancy read
+        // once (48 + 16 bytes per cell). Per pixel the position rebuilt from depth (32
+        // operations), eight cells' SH weighted (8 × 12 FMAs, 192) and the irradiance's dot
+        // product per channel (3 × 4 FMAs, 24).
+        let reconstruction = StageCost::per_element(pixels, 12, 8, 248)
+            .plus(StageCost::per_element(cells, CELL_BYTES + 16, 0, 0));
+        Costs {
+            voxelization,
+            propagation,
+            reconstruction,
+        }
+    }
 }
 
 fn create(params: &Params, ctx: &PrepareContext, _: &Prepared) -> Result<Box<dyn Technique>> {
@@ -138,6 +194,7 @@ fn create(params: &Params, ctx: &PrepareContext, _: &Prepared) -> Result<Box<dyn
         grid: p.grid,
         _output: output,
         view,
+        costs: Costs::new(&grid, p.iterations, ctx.resolution, ctx),
     }))
 }
 
@@ -149,12 +206,18 @@ impl Technique for Gaitatzes {
         ctx.profiler.gpu_stage(gpu, STAGE_VOXELIZATION, |enc| {
             self.voxelizer.encode(enc, scene, uniforms, direct)
         })?;
+        ctx.profiler
+            .stage_cost(STAGE_VOXELIZATION, self.costs.voxelization);
         ctx.profiler.gpu_stage(gpu, STAGE_PROPAGATION, |enc| {
             self.propagation.encode(enc, self.iterations)
         })?;
+        ctx.profiler
+            .stage_cost(STAGE_PROPAGATION, self.costs.propagation);
         ctx.profiler.gpu_stage(gpu, STAGE_RECONSTRUCTION, |enc| {
             self.reconstruction.encode(enc, gbuffer)
         })?;
+        ctx.profiler
+            .stage_cost(STAGE_RECONSTRUCTION, self.costs.reconstruction);
         ctx.profiler.count("grid", self.grid as f64);
         ctx.profiler.count("iterations", self.iterations as f64);
         Ok(())

@@ -294,6 +294,7 @@ impl Technique for Ism {
                 let atlas = &self.gather.atlas;
                 ctx.profiler
                     .gpu_stage(gpu, STAGE_POINT_SPLAT, |enc| splat.encode(enc, atlas))?;
+                ctx.profiler.stage_cost(STAGE_POINT_SPLAT, splat.cost());
                 ctx.profiler
                     .gpu_stage(gpu, STAGE_PULL_PUSH, |enc| pullpush.encode(enc))?;
                 ctx.profiler.count("shadow-maps", self.vpls as f64);
