@@ -28,6 +28,7 @@
 
 pub mod anim;
 pub mod assets;
+pub mod bounds;
 pub mod bvh;
 pub mod calibrate;
 pub mod compare;

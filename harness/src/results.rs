@@ -135,8 +135,9 @@ pub struct RunResult {
     /// else the largest of those run so far.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub peak_memory_mb: Option<f64>,
-    /// The device's copy bandwidth and arithmetic rate, measured once before the frames of a run
-    /// that times stages ([`crate::roofline`]); absent in older files and frame-only runs.
+    /// The device's copy bandwidth and arithmetic rate, measured once per process after the
+    /// frames of its first run that times stages ([`crate::roofline`]); absent in older files
+    /// and frame-only runs.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub device_bounds: Option<crate::roofline::DeviceBounds>,
     /// Each GPU stage's declared minimum cost per frame (mean over the measured frames), by

@@ -11,6 +11,7 @@ use std::collections::BTreeMap;
 use serde_json::Value;
 
 use crate::anim::{FrameClock, FrameState};
+use crate::bounds::measure_bounds;
 use crate::bvh::SceneBvh;
 use crate::gpu::GpuContext;
 use crate::metrics::QualitySummary;
@@ -18,7 +19,7 @@ use crate::passes::{Compose, DirectLight, FrameUniforms, GBuffer, GpuScene};
 use crate::profiler::{ProfileMode, Profiler};
 use crate::quality::{CapturedFrame, QualityConfig, QualityImages, ReferenceCache};
 use crate::results::{FrameRange, RunResult, SCHEMA_VERSION};
-use crate::roofline::{measure_bounds, DeviceBounds, StageCost};
+use crate::roofline::{DeviceBounds, StageCost};
 use crate::scene::Scene;
 use crate::technique::{
     FrameContext, Params, PrepareContext, Prepared, SceneContext, Technique, TechniqueInfo,
@@ -44,12 +45,13 @@ struct SharedCosts {
 impl SharedCosts {
     fn new(resolution: [u32; 2], scene: &GpuScene) -> SharedCosts {
         let pixels = resolution[0] as u64 * resolution[1] as u64;
-        // `gbuffer`: the scene drawn once ([`crate::roofline::scene_draw_cost`]) and every
+        // `gbuffer`: the scene drawn once ([`crate::passes::GpuScene::draw_cost`]) and every
         // pixel's depth (4 bytes), normal (Rgba16Float, 8) and albedo (4) written once.
         // Fragments hidden behind others and texture reads are not counted: the minimum
         // renders each pixel once.
-        let gbuffer =
-            crate::roofline::scene_draw_cost(scene).plus(StageCost::per_element(pixels, 0, 16, 0));
+        let gbuffer = scene
+            .draw_cost()
+            .plus(StageCost::per_element(pixels, 0, 16, 0));
         // `direct-light`: per pixel the G-buffer's depth (4 bytes) and normal (8) read and the
         // irradiance (Rgba16Float, 8) written; the position rebuilt from depth and moved into
         // the light's map (two 4×4 matrix-vector products, 64 operations) and the 16 PCF taps
@@ -515,11 +517,6 @@ impl<'a> Harness<'a> {
     ) -> Result<(RunResult, FrameImages)> {
         // Timed before the frames, in the same session: what `gibench compare` divides by.
         let calibration = crate::calibrate::calibration_ms();
-        // The device's bounds, once per harness, before any frame of a run that times stages.
-        let device_bounds = match config.timing {
-            TimingMode::Frame => None,
-            _ => Some(self.device_bounds()?),
-        };
         let mut stage_costs = BTreeMap::new();
         let mut stages = Vec::new();
         let mut counters = BTreeMap::new();
@@ -569,6 +566,15 @@ impl<'a> Harness<'a> {
                 negative_indirect,
             });
         }
+        // The process's peak memory is read before the device's bounds are measured: their
+        // buffers (64 MiB on a CPU adapter) are not the technique's.
+        let peak_memory_mb = process_memory_mb("VmHWM");
+        // The device's bounds, once per harness, after the frames of the first run that times
+        // stages (never inside a frame).
+        let device_bounds = match config.timing {
+            TimingMode::Frame => None,
+            _ => Some(self.device_bounds()?),
+        };
         let result = RunResult {
             schema_version: SCHEMA_VERSION,
             gibench_version: env!("CARGO_PKG_VERSION").to_string(),
@@ -614,7 +620,7 @@ impl<'a> Harness<'a> {
             images: Vec::new(),
             warnings: Vec::new(),
             calibration_ms: Some(calibration),
-            peak_memory_mb: process_memory_mb("VmHWM"),
+            peak_memory_mb,
             device_bounds,
             stage_costs,
         };

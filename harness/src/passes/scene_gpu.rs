@@ -639,3 +639,23 @@ impl FrameUniforms {
         queue.write_buffer(&self.light_buffer, 0, bytemuck::bytes_of(&data));
     }
 }
+
+impl GpuScene {
+    /// The least cost of drawing the scene's meshes (static and movers) once, for the roofline
+    /// ([`crate::roofline`]): every vertex and index read once (the meshes' buffers, bytes), and
+    /// every vertex moved to clip space, a 4×4 matrix times a point (16 FMAs, 32 operations).
+    /// What a rasterising stage must do at least; it adds what it writes.
+    pub fn draw_cost(&self) -> crate::roofline::StageCost {
+        let vertex = std::mem::size_of::<Vertex>() as u64;
+        let (mut bytes, mut vertices) = (0, 0);
+        for m in std::iter::once(&self.static_mesh).chain(&self.movers) {
+            bytes += m.vertices.size() + m.indices.size();
+            vertices += m.vertices.size() / vertex;
+        }
+        crate::roofline::StageCost {
+            bytes_read: bytes as f64,
+            bytes_written: 0.0,
+            ops: (vertices * 32) as f64,
+        }
+    }
+}

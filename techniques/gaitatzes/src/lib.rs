@@ -60,7 +60,7 @@ use gibench_harness::technique::{
 };
 use gibench_harness::{wgpu, Result};
 
-use gibench_harness::roofline::{scene_draw_cost, StageCost};
+use gibench_harness::roofline::StageCost;
 use params::PARAMS;
 use volume::{Grid, Mode, Propagation, Reconstruction, Volumes, Voxelizer, CELL_BYTES};
 
@@ -125,12 +125,10 @@ impl Costs {
         // once (3 × 48 bytes). Drawing the scene once per slice (3·grid times) is this
         // implementation's way, not the minimum; the injection's arithmetic, only in occupied
         // cells (not known before the frame), is not counted.
-        let voxelization = scene_draw_cost(ctx.gpu_scene).plus(StageCost::per_element(
-            cells,
-            0,
-            3 * CELL_BYTES,
-            0,
-        ));
+        let voxelization =
+            ctx.gpu_scene
+                .draw_cost()
+                .plus(StageCost::per_element(cells, 0, 3 * CELL_BYTES, 0));
         // `propagation`, per iteration and cell: its voxel's normal and occupancy read (a
         // vec4, 16 bytes), its SH read once (48: every neighbour reads it, but once is the
         // minimum) and the next SH written (48); plain LPV also adds into every cell's
