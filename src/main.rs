@@ -15,6 +15,7 @@ use clap::{Parser, Subcommand};
 use cli::compare::CompareArgs;
 use cli::export_scene::ExportArgs;
 use cli::instructions::InstructionsArgs;
+use cli::merge::MergeArgs;
 use cli::plot_quality::PlotQualityArgs;
 use cli::raycast::RaycastArgs;
 use cli::reference::ReferenceArgs;
@@ -49,6 +50,9 @@ enum Command {
     Sweep(SweepArgs),
     /// Regenerate paper tables, figures and sweeps: `all`, or one target (`reproduce all --list`).
     Reproduce(ReproduceArgs),
+    /// Pool the folders of several `reproduce all` runs (the shards of a fleet) into one output
+    /// set with one reproduce-all.json/.md/.html (docs/fleet.md).
+    Merge(MergeArgs),
     /// Plot per-frame error against the reference from results files made with
     /// `run --quality --quality-all` (e.g. the lag of keller-incremental).
     PlotQuality(PlotQualityArgs),
@@ -76,6 +80,7 @@ fn main() -> ExitCode {
         Some(Command::Report(args)) => cli::report::exec(&args),
         Some(Command::Reference(args)) => cli::reference::exec(&args),
         Some(Command::Sweep(args)) => cli::sweep::exec(&args),
+        Some(Command::Merge(args)) => cli::merge::exec(&args),
         Some(Command::PlotQuality(args)) => cli::plot_quality::exec(&args),
         Some(Command::Compare(args)) => cli::compare::exec(&args),
         Some(Command::Instructions(args)) => cli::instructions::exec(&args),

@@ -2,7 +2,7 @@
 //! helpers several of them share.
 //!
 //! Subcommands: [`run`], [`sweep`], [`list`], [`report`], [`reference`], [`reproduce`],
-//! [`plot_quality`], [`compare`], [`instructions`], [`export_scene`], [`raycast`].
+//! [`plot_quality`], [`compare`], [`merge`], [`instructions`], [`export_scene`], [`raycast`].
 //!
 //! Shared: [`options`] (option groups several commands flatten in: the reference's, the
 //! adapter's), [`params`] (parsing and checking option values, `--param` assignment),
@@ -15,6 +15,7 @@ pub(crate) mod export_scene;
 pub(crate) mod files;
 pub(crate) mod instructions;
 pub(crate) mod list;
+pub(crate) mod merge;
 pub(crate) mod options;
 pub(crate) mod page;
 pub(crate) mod params;
@@ -26,4 +27,5 @@ pub(crate) mod report;
 pub(crate) mod reproduce;
 pub(crate) mod results_io;
 pub(crate) mod run;
+pub(crate) mod shard;
 pub(crate) mod sweep;

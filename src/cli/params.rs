@@ -106,3 +106,56 @@ pub(crate) fn check_frame_number(option: &str, frame: u32) -> Result<()> {
     }
     Ok(())
 }
+
+/// A time budget such as `90s`, `2m`, `9m`, `1m30s` or `1h`: numbers each followed by `h`, `m`
+/// or `s`, more than zero in all (the `--budget` value parser: clap's error names the option).
+pub(crate) fn parse_budget(s: &str) -> std::result::Result<std::time::Duration, String> {
+    let expected = "expected a duration such as 90s, 2m, 9m or 1m30s (numbers with h, m or s)";
+    let mut total = 0.0f64;
+    let mut number = String::new();
+    for c in s.trim().chars() {
+        match c {
+            '0'..='9' | '.' => number.push(c),
+            'h' | 'm' | 's' if !number.is_empty() => {
+                let n: f64 = number
+                    .parse()
+                    .map_err(|_| format!("{expected}; got '{s}'"))?;
+                total += n * match c {
+                    'h' => 3600.0,
+                    'm' => 60.0,
+                    _ => 1.0,
+                };
+                number.clear();
+            }
+            _ => return Err(format!("{expected}; got '{s}'")),
+        }
+    }
+    if !(number.is_empty() && total > 0.0 && total.is_finite()) {
+        return Err(format!("{expected}, more than zero; got '{s}'"));
+    }
+    Ok(std::time::Duration::from_secs_f64(total))
+}
+
+#[cfg(test)]
+mod budget_tests {
+    use super::parse_budget;
+
+    /// Catches: a unit misread (minutes taken for seconds), a bare number or garbage accepted.
+    #[test]
+    fn budgets_parse_and_bad_ones_are_refused() {
+        for (s, secs) in [
+            ("90s", 90.0),
+            ("2m", 120.0),
+            ("9m", 540.0),
+            ("1m30s", 90.0),
+            ("1h", 3600.0),
+            ("1.5m", 90.0),
+        ] {
+            assert_eq!(parse_budget(s).unwrap().as_secs_f64(), secs, "{s}");
+        }
+        for s in ["", "9", "m", "0s", "9x", "-1m", "1m30", "1..2s"] {
+            let e = parse_budget(s).expect_err(s);
+            assert!(e.contains("90s, 2m"), "{s}: {e}");
+        }
+    }
+}

@@ -89,6 +89,7 @@ fn scenes_of(target: &str, args: &ReproduceArgs) -> Vec<String> {
                 .cloned()
                 .unwrap_or_else(|| default.to_string())]
         }
+        _ if args.scenes.is_empty() && args.tiny() => vec!["cornell".to_string()],
         _ if args.scenes.is_empty() => ["cornell", "maze", "sibenik"].map(String::from).to_vec(),
         _ => args.scenes.clone(),
     }
@@ -213,6 +214,9 @@ fn sizes(args: &ReproduceArgs) -> Sizes {
     };
     if let Some(f) = args.frames {
         s.frames = f;
+    }
+    if args.tiny() {
+        s.resolutions = vec![[64, 48], [96, 72]];
     }
     s
 }

@@ -68,6 +68,16 @@ pub struct ReproduceArgs {
     /// Do not show a progress bar.
     #[arg(long)]
     pub quiet: bool,
+    /// With `all`: run the targets in priority order (`--list` prints it) and start none whose
+    /// estimate does not fit what is left of this time, e.g. 90s, 2m, 9m (docs/fleet.md).
+    #[arg(long, value_name = "DURATION", value_parser = crate::cli::params::parse_budget)]
+    pub budget: Option<std::time::Duration>,
+    #[command(flatten)]
+    pub shard: crate::cli::shard::ShardArgs,
+    /// For the test suite only: `tiny` cuts every target to a few frames at tiny sizes. Printed,
+    /// and recorded in reproduce-all.json as the mode (e.g. `quick-tiny`): never benchmark results.
+    #[arg(long, env = "GIBENCH_TEST_SIZE", value_enum, value_name = "SIZE")]
+    pub test_size: Option<TestSize>,
     /// Restrict the adapter to one backend.
     #[arg(long, env = "GIBENCH_BACKEND")]
     pub backend: Option<String>,
@@ -78,6 +88,31 @@ pub struct ReproduceArgs {
     /// wait as long as the work takes).
     #[arg(long, env = "GIBENCH_GPU_TIMEOUT", value_name = "SECONDS")]
     pub gpu_timeout: Option<f64>,
+}
+
+/// `--test-size` / `GIBENCH_TEST_SIZE`: sizes for the test suite, not for results.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TestSize {
+    /// Two frames, 64x48 for the command targets; Laine's tables on the Cornell box only, at
+    /// 64x48 and 96x72.
+    Tiny,
+}
+
+impl ReproduceArgs {
+    /// Whether `--test-size tiny` (or `GIBENCH_TEST_SIZE=tiny`) is on.
+    pub fn tiny(&self) -> bool {
+        self.test_size == Some(TestSize::Tiny)
+    }
+
+    /// The mode recorded and compared: `quick` or `paper`, with `-tiny` at the test size.
+    pub fn mode(&self) -> String {
+        let base = if self.quick { "quick" } else { "paper" };
+        if self.tiny() {
+            format!("{base}-tiny")
+        } else {
+            base.to_string()
+        }
+    }
 }
 
 /// A table and the file stem it is written under.
@@ -244,6 +279,17 @@ pub fn exec(args: &ReproduceArgs) -> Result<()> {
     }
     if let Some(frames) = args.frames {
         super::params::check_frame_number("frames", frames)?;
+    }
+    if args.tiny() {
+        eprintln!(
+            "gibench reproduce: TEST SIZE tiny (--test-size / GIBENCH_TEST_SIZE): every target cut to \
+             a few frames at tiny sizes, recorded as such; not benchmark results"
+        );
+        if args.frames.is_none() {
+            let mut args = args.clone();
+            args.frames = Some(2);
+            return all::reproduce(&args);
+        }
     }
     all::reproduce(args)
 }

@@ -27,19 +27,38 @@ pub(super) struct Record {
     /// The adapter the target ran on ("CPU only" for targets that need none).
     #[serde(default)]
     pub(super) adapter: String,
+    /// Not run because of `--budget`: why (its estimate did not fit what was left, or it had
+    /// none). Files listed are an earlier run's (`carried_from`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub(super) left_out: Option<String>,
 }
 
 /// `reproduce-all.json`: what the last `reproduce all` into a folder ran and wrote.
 #[derive(serde::Serialize, serde::Deserialize)]
 pub(super) struct Manifest {
     pub(super) mode: String,
-    adapter: String,
-    driver: String,
-    git_commit: String,
-    cpu_threads: usize,
-    seconds: f64,
-    estimate_s: Option<f64>,
-    targets: Vec<Record>,
+    pub(super) adapter: String,
+    pub(super) driver: String,
+    pub(super) git_commit: String,
+    pub(super) cpu_threads: usize,
+    pub(super) seconds: f64,
+    pub(super) estimate_s: Option<f64>,
+    pub(super) targets: Vec<Record>,
+    /// `--budget`, in seconds.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub(super) budget_s: Option<f64>,
+    /// The shard this run was ("1/3") and where that came from: its `targets` are that shard's
+    /// part of `selected`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub(super) shard: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub(super) shard_source: Option<String>,
+    /// Every target selected before sharding (what the shards' manifests must cover together).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub(super) selected: Vec<String>,
+    /// `gibench merge`: the folders pooled into this one.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub(super) merged_from: Vec<String>,
     /// The file it was read from (empty for one made by this run).
     #[serde(skip)]
     pub(super) source: PathBuf,
@@ -93,6 +112,22 @@ impl Manifest {
     ) -> Manifest {
         // Targets not run this time keep their earlier entry (their files are untouched).
         if let Some(prev) = previous.filter(|p| p.mode == mode) {
+            // A target left out by the budget keeps the files (and date) of its earlier entry:
+            // its folder was not touched.
+            for t in targets.iter_mut().filter(|t| t.left_out.is_some()) {
+                if let Some(r) = prev
+                    .targets
+                    .iter()
+                    .find(|r| r.name == t.name && r.left_out.is_none())
+                {
+                    t.files = r.files.clone();
+                    t.carried_from = Some(
+                        r.carried_from
+                            .clone()
+                            .unwrap_or_else(|| prev.git_commit.clone()),
+                    );
+                }
+            }
             for r in &prev.targets {
                 if !targets.iter().any(|t| t.name == r.name) {
                     let mut r = r.clone();
@@ -118,8 +153,35 @@ impl Manifest {
             seconds,
             estimate_s,
             targets,
+            budget_s: None,
+            shard: None,
+            shard_source: None,
+            selected: Vec::new(),
+            merged_from: Vec::new(),
             source: PathBuf::new(),
         }
+    }
+
+    /// The manifest of `dir` (`gibench merge`'s input), or an error naming the file.
+    pub(super) fn read(dir: &Path) -> Result<Manifest> {
+        let p = dir.join(format!("{MANIFEST}.json"));
+        let text = gibench_harness::error::read_bounded(&p, 16 << 20)?;
+        let mut m: Manifest = serde_json::from_slice(&text).map_err(|e| Error::BadFile {
+            path: p.clone(),
+            message: format!("not a reproduce-all manifest: {e}"),
+        })?;
+        m.source = p;
+        Ok(m)
+    }
+
+    /// The committed manifest (`results/reproduce-all.json` under the working directory): the
+    /// one estimate source every machine of a fleet has alike (a checkout of the same commit).
+    pub(super) fn committed() -> Option<Manifest> {
+        let p = Path::new("results").join(format!("{MANIFEST}.json"));
+        let text = gibench_harness::error::read_bounded(&p, 16 << 20).ok()?;
+        let mut m: Manifest = serde_json::from_slice(&text).ok()?;
+        m.source = p;
+        Some(m)
     }
 
     /// The entries carried from an earlier run dated by the commit their files record, where
@@ -180,9 +242,44 @@ impl Manifest {
                 .map(|e| format!("estimated {}", duration(e)))
                 .unwrap_or_else(|| "no estimate".into()),
         );
+        if self.mode.ends_with("-tiny") {
+            md.insert_str(0, "**TEST SIZE tiny** (`--test-size` / `GIBENCH_TEST_SIZE`): every target cut to a few frames at tiny sizes; not benchmark results.\n\n");
+        }
+        let mut notes = String::new();
+        if let Some(b) = self.budget_s {
+            notes.push_str(&format!(
+                "Budget: {} (targets in priority order; a target left out says why).\n",
+                duration(b)
+            ));
+        }
+        if let Some(s) = &self.shard {
+            notes.push_str(&format!(
+                "Shard {s} of the selection {} ({}).\n",
+                self.selected.join(", "),
+                self.shard_source.as_deref().unwrap_or_default()
+            ));
+        }
+        if !self.merged_from.is_empty() {
+            notes.push_str(&format!(
+                "Merged by `gibench merge` from: {} (\"ran on\" names each target's device).\n",
+                self.merged_from.join(", ")
+            ));
+        }
+        if !notes.is_empty() {
+            let at = md.find("| target |").unwrap_or(md.len());
+            md.insert_str(at, &format!("{notes}\n"));
+        }
         for r in &self.targets {
             let (tables, figures, files) = Self::outputs(r);
             let time = match (r.seconds, &r.carried_from) {
+                _ if r.left_out.is_some() => format!(
+                    "**left out**: {}{}",
+                    r.left_out.as_deref().unwrap_or_default(),
+                    r.carried_from
+                        .as_ref()
+                        .map(|c| format!(" (files from git {c})"))
+                        .unwrap_or_default()
+                ),
                 (_, Some(c)) => format!("from git {c}"),
                 (Some(s), None) => format!(
                     "{} ({})",
@@ -213,6 +310,9 @@ impl Manifest {
                 name: r.name.clone(),
                 what: r.what.clone(),
                 time: match (r.seconds, &r.carried_from) {
+                    _ if r.left_out.is_some() => {
+                        format!("left out: {}", r.left_out.as_deref().unwrap_or_default())
+                    }
                     (_, Some(c)) => format!("from the run of git {c}"),
                     (Some(s), None) => duration(s),
                     (None, None) => "?".into(),
@@ -242,7 +342,11 @@ impl Manifest {
                 .unwrap_or_else(|| "no estimate".into()),
             root.display()
         );
-        for r in self.targets.iter().filter(|r| r.carried_from.is_none()) {
+        for r in self
+            .targets
+            .iter()
+            .filter(|r| r.carried_from.is_none() && r.left_out.is_none())
+        {
             let (tables, figures, files) = Self::outputs(r);
             out.push_str(&format!("\n  {} ({files} files)", r.name));
             for t in tables {
@@ -256,6 +360,13 @@ impl Manifest {
                 };
                 out.push_str(&format!("\n    {kind} {f}"));
             }
+        }
+        for r in self.targets.iter().filter(|r| r.left_out.is_some()) {
+            out.push_str(&format!(
+                "\n  left out: {} ({})",
+                r.name,
+                r.left_out.as_deref().unwrap_or_default()
+            ));
         }
         out.push_str(&format!(
             "\n  and {MANIFEST}.json / {MANIFEST}.md: every target's command, time and files"

@@ -21,6 +21,7 @@
 //! and [`manifest`] the record of what ran.
 
 mod manifest;
+mod merge;
 mod overall;
 mod planned;
 mod targets;
@@ -36,12 +37,14 @@ use super::{out_dir, ReproduceArgs};
 use crate::cli::files::writable_dir;
 use crate::cli::progress::Bars;
 use manifest::{duration, Manifest, Record, MANIFEST};
+pub use merge::merge;
 pub use overall::Overall;
 use planned::Planned;
 pub use targets::{find, Kind, Target, TARGETS};
 
 /// `gibench reproduce TARGET` (one target) or `gibench reproduce all`.
 pub fn reproduce(args: &ReproduceArgs) -> Result<()> {
+    let began = Instant::now();
     if args.target != "all" {
         return reproduce_one(args);
     }
@@ -53,13 +56,25 @@ pub fn reproduce(args: &ReproduceArgs) -> Result<()> {
     }
     let root = args.out.clone().unwrap_or_else(|| PathBuf::from("results"));
     let selected = selected_targets(args)?;
+    let shard = args.shard.resolve()?;
+    if let Some(s) = &shard {
+        eprintln!(
+            "gibench reproduce all: shard {s} (0-based), from {}",
+            s.source
+        );
+    }
     // Every target is checked before any runs.
     eprintln!("gibench reproduce all: checking {} targets", selected.len());
     let planned: Vec<Planned> = selected
         .iter()
         .map(|t| Planned::new(t, args, root.join(t.dir)))
         .collect::<Result<_>>()?;
-    let mode = if args.quick { "quick" } else { "paper" };
+    let selected_names: Vec<String> = planned.iter().map(|p| p.target.name.to_string()).collect();
+    let planned = match &shard {
+        Some(s) => own_part(planned, s),
+        None => planned,
+    };
+    let mode = args.mode();
     let gpu = if planned.iter().any(Planned::needs_gpu) {
         Some(super::open_gpu(args)?)
     } else {
@@ -70,51 +85,144 @@ pub fn reproduce(args: &ReproduceArgs) -> Result<()> {
         .map(|g| format!("{} ({})", g.info.adapter, g.info.backend))
         .unwrap_or_else(|| "CPU only".into());
     let previous = Manifest::previous(&root);
-    let (estimates, sources) = estimates(&planned, previous.as_ref());
+    let (measured, sources) = estimates(&planned, previous.as_ref());
+    let estimates: Vec<Option<f64>> = measured.iter().map(|m| m.as_ref().map(|e| e.0)).collect();
     let sources: Vec<&str> = sources.iter().map(String::as_str).collect();
     print_plan(
         &planned,
         &estimates,
         previous.as_ref(),
         &sources,
-        mode,
+        &mode,
         &adapter,
         &root,
     );
+    if args.budget.is_some() || args.list {
+        eprintln!(
+            "with --budget, targets run in this order (the papers' headline tables first): {}",
+            targets::PRIORITY.join(", ")
+        );
+    }
     if args.list {
         return Ok(());
     }
     writable_dir("out", &root)?;
     let set = OutputSet::begin("out", &root)?;
-    claim_folders(&set, &planned)?;
+    let budget = args.budget.map(|b| Budget {
+        ends: began + b,
+        total: b.as_secs_f64(),
+        adapter: adapter.clone(),
+        measured,
+    });
     let (records, seconds) = run_targets(
         &planned,
         &estimates,
+        budget.as_ref(),
         gpu.as_ref(),
         &adapter,
         &set,
         args.quiet,
     )?;
     let estimate: Option<f64> = estimates.iter().copied().sum();
-    let manifest = Manifest::new(
-        mode,
+    let mut manifest = Manifest::new(
+        &mode,
         &adapter,
         gpu.as_ref(),
         seconds,
         estimate,
         records,
         // Entries are carried over only from this folder's own manifest: one found elsewhere
-        // (the committed results/) only gives estimates; its files are not here.
+        // (the committed results/) only gives estimates; its files are not here. A shard's
+        // manifest holds its own targets only (what `gibench merge` pools).
         previous
             .as_ref()
-            .filter(|p| p.source == root.join(format!("{MANIFEST}.json"))),
+            .filter(|p| p.source == root.join(format!("{MANIFEST}.json")) && shard.is_none()),
     );
+    manifest.budget_s = args.budget.map(|b| b.as_secs_f64());
+    if let Some(s) = &shard {
+        manifest.shard = Some(s.to_string());
+        manifest.shard_source = Some(s.source.clone());
+        manifest.selected = selected_names;
+    }
     let manifest = manifest.dated_by_their_files(&root);
     manifest.write(&root)?;
     manifest.write_index(&root)?;
     set.publish()?;
     println!("{}", manifest.listing(&root));
     Ok(())
+}
+
+/// The targets of shard `s`: the selection split by [`crate::cli::shard::assign`] on the
+/// estimates of the committed manifest (the same file on every machine of a checkout), a
+/// target never timed there weighing the mean of those timed (1 s where none is).
+fn own_part(planned: Vec<Planned>, s: &crate::cli::shard::Shard) -> Vec<Planned> {
+    let committed = Manifest::committed();
+    let timed: Vec<Option<f64>> = planned
+        .iter()
+        .map(|p| {
+            committed
+                .as_ref()
+                .and_then(|m| m.estimate(p.target.name, p.work.units))
+                .map(|e| e.0)
+        })
+        .collect();
+    let known: Vec<f64> = timed.iter().flatten().copied().collect();
+    let fallback = if known.is_empty() {
+        1.0
+    } else {
+        known.iter().sum::<f64>() / known.len() as f64
+    };
+    let units: Vec<(&str, f64)> = planned
+        .iter()
+        .zip(&timed)
+        .map(|(p, t)| (p.target.name, t.unwrap_or(fallback)))
+        .collect();
+    let split = crate::cli::shard::assign(&units, s.count);
+    for k in 0..s.count {
+        let part: Vec<String> = units
+            .iter()
+            .zip(&split)
+            .filter(|(_, &i)| i == k)
+            .map(|(u, _)| format!("{} ({})", u.0, duration(u.1)))
+            .collect();
+        eprintln!(
+            "  shard {k}/{}{}: {}",
+            s.count,
+            if k == s.index { " (this one)" } else { "" },
+            if part.is_empty() {
+                "nothing".to_string()
+            } else {
+                part.join(", ")
+            }
+        );
+    }
+    eprintln!(
+        "  (balanced by the estimates of {}{})",
+        committed
+            .as_ref()
+            .map(|m| m.source.display().to_string())
+            .unwrap_or_else(|| "nothing: no results/reproduce-all.json here".into()),
+        if known.len() < timed.len() {
+            "; a target never timed there weighs their mean"
+        } else {
+            ""
+        }
+    );
+    planned
+        .into_iter()
+        .zip(split)
+        .filter(|(_, k)| *k == s.index)
+        .map(|(p, _)| p)
+        .collect()
+}
+
+/// `--budget`: when it ends, and what the estimates were measured on.
+struct Budget {
+    ends: Instant,
+    total: f64,
+    adapter: String,
+    /// Per planned target: its estimate and the adapter that estimate was measured on.
+    measured: Vec<Option<(f64, String)>>,
 }
 
 /// `gibench reproduce TARGET`: one target into its folder.
@@ -187,12 +295,14 @@ fn selected_targets(args: &ReproduceArgs) -> Result<Vec<&'static Target>> {
 
 /// Each target's estimate (seconds) from the earlier manifest, and the adapters those
 /// estimates were measured on (a CPU-only target's on any), sorted, each once.
-fn estimates(planned: &[Planned], previous: Option<&Manifest>) -> (Vec<Option<f64>>, Vec<String>) {
+fn estimates(
+    planned: &[Planned],
+    previous: Option<&Manifest>,
+) -> (Vec<Option<(f64, String)>>, Vec<String>) {
     let measured: Vec<Option<(f64, String)>> = planned
         .iter()
         .map(|p| previous.and_then(|m| m.estimate(p.target.name, p.work.units)))
         .collect();
-    let estimates: Vec<Option<f64>> = measured.iter().map(|m| m.as_ref().map(|e| e.0)).collect();
     let mut sources: Vec<String> = measured
         .iter()
         .zip(planned)
@@ -201,30 +311,32 @@ fn estimates(planned: &[Planned], previous: Option<&Manifest>) -> (Vec<Option<f6
         .collect();
     sources.sort();
     sources.dedup();
-    (estimates, sources)
+    (measured, sources)
 }
 
-/// Claims for the output set the folders the targets own entirely: a command target's folder,
+/// Claims for the output set the folders `target` owns entirely: a command target's folder,
 /// a paper target's owned subfolders (files there that the run does not write are removed).
-fn claim_folders(set: &OutputSet, planned: &[Planned]) -> Result<()> {
-    for p in planned {
-        if matches!(p.target.kind, Kind::Command { .. }) {
-            set.replace(Path::new(p.target.dir))?;
-        }
-        if let Kind::Paper(m) = p.target.kind {
-            for sub in (m.owned_folders)(p.target.name) {
-                set.replace(&Path::new(p.target.dir).join(sub))?;
-            }
+/// Claimed just before the target runs: a target the budget leaves out keeps its folder.
+pub(super) fn claim_folders(set: &OutputSet, target: &Target) -> Result<()> {
+    if matches!(target.kind, Kind::Command { .. }) {
+        set.replace(Path::new(target.dir))?;
+    }
+    if let Kind::Paper(m) = target.kind {
+        for sub in (m.owned_folders)(target.name) {
+            set.replace(&Path::new(target.dir).join(sub))?;
         }
     }
     Ok(())
 }
 
-/// Runs the planned targets one after another under one bar; returns each one's record (its
-/// files: what it staged in `set`) and the seconds they took together.
+/// Runs the planned targets one after another under one bar (with a budget: in priority
+/// order, each the first not yet run whose estimate fits what is left); returns each one's
+/// record (its files: what it staged in `set`; a target left out says why) and the seconds
+/// they took together.
 fn run_targets(
     planned: &[Planned],
     estimates: &[Option<f64>],
+    budget: Option<&Budget>,
     gpu: Option<&GpuContext>,
     adapter: &str,
     set: &OutputSet,
@@ -241,17 +353,46 @@ fn run_targets(
     };
     let overall = Overall::new(quiet, spans.iter().sum());
     let started = Instant::now();
-    let mut records = Vec::new();
+    let mut records: Vec<Option<Record>> = planned.iter().map(|_| None).collect();
     let mut before = set.staged().len();
-    for (i, p) in planned.iter().enumerate() {
+    let mut order: Vec<usize> = (0..planned.len()).collect();
+    if budget.is_some() {
+        order.sort_by_key(|&i| targets::priority(planned[i].target.name));
+    }
+    // Measured ÷ estimated over the GPU targets run so far whose estimates came from another
+    // adapter: scales the rest of those estimates (1 until one has run).
+    let (mut took, mut guessed) = (0.0f64, 0.0f64);
+    let mut n = 0;
+    while let Some(pos) = match budget {
+        None => (!order.is_empty()).then_some(0),
+        Some(b) => {
+            let left = b
+                .ends
+                .saturating_duration_since(Instant::now())
+                .as_secs_f64();
+            order
+                .iter()
+                .position(|&i| fits(b, i, planned[i].needs_gpu(), took, guessed, left))
+        }
+    } {
+        let i = order.remove(pos);
+        let p = &planned[i];
+        n += 1;
         overall.start(
-            &format!("{}/{} {}", i + 1, planned.len(), p.target.name),
+            &format!("{}/{} {}", n, planned.len(), p.target.name),
             spans[i],
             p.work.frames,
         );
+        claim_folders(set, p.target)?;
         let t = Instant::now();
         let done = p.run(gpu, &Bars::Shared(&overall))?;
         let seconds = t.elapsed().as_secs_f64();
+        if let Some(Some((e, from))) = budget.map(|b| &b.measured[i]) {
+            if p.needs_gpu() && *from != adapter {
+                took += seconds;
+                guessed += e;
+            }
+        }
         let staged = set.staged();
         let files: Vec<PathBuf> = staged[before..].to_vec();
         before = staged.len();
@@ -260,29 +401,92 @@ fn run_targets(
             p.target.name,
             duration(seconds)
         ));
-        records.push(Record {
-            name: p.target.name.to_string(),
-            dir: p.target.dir.to_string(),
-            what: p.target.description(),
-            command: p.command.clone(),
-            frames: p.work.frames,
-            units: p.work.units,
-            estimate_s: estimates[i],
-            seconds: Some(seconds),
-            files: files
-                .iter()
-                .map(|f| f.to_string_lossy().into_owned())
-                .collect(),
-            carried_from: None,
-            adapter: if p.needs_gpu() {
-                adapter.to_string()
-            } else {
-                "CPU only".into()
-            },
-        });
+        records[i] = Some(record(p, estimates[i], adapter, Some(seconds), files, None));
     }
     overall.finish();
-    Ok((records, started.elapsed().as_secs_f64()))
+    // What the budget left out, and why.
+    if let Some(b) = budget {
+        let left = b
+            .ends
+            .saturating_duration_since(Instant::now())
+            .as_secs_f64();
+        for i in order {
+            let p = &planned[i];
+            let why = match &b.measured[i] {
+                None => format!(
+                    "no estimate: never timed in the manifest the estimates come from, so it cannot be known to fit the {} budget",
+                    duration(b.total)
+                ),
+                Some(_) => format!(
+                    "its estimate {} did not fit the {} left of the {} budget",
+                    duration(scaled(b, i, p.needs_gpu(), took, guessed)),
+                    duration(left),
+                    duration(b.total)
+                ),
+            };
+            eprintln!("left out: {} ({why})", p.target.name);
+            records[i] = Some(record(
+                p,
+                estimates[i],
+                adapter,
+                None,
+                Vec::new(),
+                Some(why),
+            ));
+        }
+    }
+    Ok((
+        records.into_iter().flatten().collect(),
+        started.elapsed().as_secs_f64(),
+    ))
+}
+
+/// Target `i`'s estimate for the budget: as measured, or for a GPU target measured on another
+/// adapter, scaled by `took / guessed` (this run's measured ÷ estimated) once that is known.
+fn scaled(b: &Budget, i: usize, needs_gpu: bool, took: f64, guessed: f64) -> f64 {
+    match &b.measured[i] {
+        None => f64::INFINITY,
+        Some((e, from)) if needs_gpu && *from != b.adapter && guessed > 0.0 => e * took / guessed,
+        Some((e, _)) => *e,
+    }
+}
+
+/// Whether target `i` may start with `left` seconds of the budget left: its (scaled) estimate
+/// plus a tenth for the estimate's noise fits. A target without an estimate never does.
+fn fits(b: &Budget, i: usize, needs_gpu: bool, took: f64, guessed: f64, left: f64) -> bool {
+    scaled(b, i, needs_gpu, took, guessed) * 1.1 <= left
+}
+
+/// A target's manifest entry.
+fn record(
+    p: &Planned,
+    estimate_s: Option<f64>,
+    adapter: &str,
+    seconds: Option<f64>,
+    files: Vec<PathBuf>,
+    left_out: Option<String>,
+) -> Record {
+    Record {
+        name: p.target.name.to_string(),
+        dir: p.target.dir.to_string(),
+        what: p.target.description(),
+        command: p.command.clone(),
+        frames: p.work.frames,
+        units: p.work.units,
+        estimate_s,
+        seconds,
+        files: files
+            .iter()
+            .map(|f| f.to_string_lossy().into_owned())
+            .collect(),
+        carried_from: None,
+        adapter: if p.needs_gpu() {
+            adapter.to_string()
+        } else {
+            "CPU only".into()
+        },
+        left_out,
+    }
 }
 
 #[allow(clippy::too_many_arguments)]

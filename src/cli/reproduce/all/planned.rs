@@ -86,6 +86,10 @@ impl Planned {
                         set_option(&mut argv, "--frames", &f.to_string());
                     }
                 }
+                if args.tiny() {
+                    // The test size: tiny images (the frames are set above).
+                    set_option(&mut argv, "--resolution", "64x48");
+                }
                 if let Some(a) = &args.assets {
                     set_option(&mut argv, "--assets", &a.display().to_string());
                 }

@@ -299,6 +299,54 @@ pub const TARGETS: &[Target] = &[
     },
 ];
 
+/// The order `all --budget` runs the targets in: the papers' headline tables first (Laine's
+/// Tables 1 and 2, the ISM slides' breakdown, Gaitatzes' Table 1, Barczak's figures, Keller's
+/// sweeps), then the rest of the papers' targets, the parameter sweeps, the per-frame error
+/// runs, the clamp sweeps and last the CPU reference (the same at both sizes). Every target of
+/// [`TARGETS`] once (a unit test checks).
+pub const PRIORITY: &[&str] = &[
+    "laine-tables",
+    "ism-breakdown",
+    "gaitatzes-table1",
+    "barczak2006",
+    "keller-tiles",
+    "keller-vpls",
+    "laine-management",
+    "laine-dispersion",
+    "gaitatzes-quality",
+    "gaitatzes-cornell",
+    "laine-tiles",
+    "laine-vpls",
+    "laine-budget",
+    "ism-points",
+    "ism-map-size",
+    "ism-vpls",
+    "ism-tiles",
+    "gaitatzes-grid",
+    "gaitatzes-iterations",
+    "gaitatzes-transport",
+    "laine-sibenik-1024",
+    "laine-sibenik-vpls",
+    "keller-lag",
+    "laine-quality",
+    "ism-quality",
+    "ism-sampling",
+    "ism-sampling-still",
+    "clamp-cornell-laine",
+    "clamp-cornell-keller-full",
+    "clamp-maze-laine",
+    "clamp-sibenik-laine",
+    "reference",
+];
+
+/// `name`'s place in [`PRIORITY`].
+pub fn priority(name: &str) -> usize {
+    PRIORITY
+        .iter()
+        .position(|p| *p == name)
+        .unwrap_or(PRIORITY.len())
+}
+
 impl Target {
     /// What it regenerates, one line.
     pub fn description(&self) -> String {
@@ -346,3 +394,17 @@ const EXTRA: &[Target] = &[
         kind: Kind::Paper(&laine2007::MODULE),
     },
 ];
+
+#[cfg(test)]
+mod tests {
+    /// Catches: a target added to TARGETS but not to the budget's priority order (it would
+    /// always run last, silently), or one listed twice or misspelt.
+    #[test]
+    fn the_priority_order_lists_every_target_once() {
+        let mut p: Vec<&str> = super::PRIORITY.to_vec();
+        let mut t: Vec<&str> = super::TARGETS.iter().map(|t| t.name).collect();
+        p.sort();
+        t.sort();
+        assert_eq!(p, t);
+    }
+}
