@@ -1,5 +1,5 @@
 //! The device's bounds for the roofline ([`crate::roofline`]): a copy kernel and an FMA kernel
-//! of gibench's own, timed once per process after the frames of its first stage-timed run ([`measure_bounds`]).
+//! of gibench's own, timed once per process before the frames of its first stage-timed run ([`measure_bounds`]).
 
 use std::time::Instant;
 
@@ -415,7 +415,9 @@ pub fn measure_bounds(gpu: &GpuContext) -> Result<DeviceBounds> {
     // The first run compiles and warms up; then grown (more workgroups, then longer chains) until a run is long enough to time.
     loop {
         let t = kernels.fma(gpu, workgroups, &params)?;
-        if t.ms >= FMA_TARGET_MS {
+        // The wall time stops the growth too: a timer that reads too little (a timestamp pair
+        // read as equal) must not grow the kernel to minutes; the check below then refuses it.
+        if t.ms >= FMA_TARGET_MS || t.wall_ms >= 4.0 * FMA_TARGET_MS {
             break;
         }
         if workgroups < FMA_MAX_WORKGROUPS {

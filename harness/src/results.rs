@@ -135,7 +135,7 @@ pub struct RunResult {
     /// else the largest of those run so far.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub peak_memory_mb: Option<f64>,
-    /// The device's copy bandwidth and arithmetic rate, measured once per process after the
+    /// The device's copy bandwidth and arithmetic rate, measured once per process before the
     /// frames of its first run that times stages ([`crate::roofline`]); absent in older files
     /// and frame-only runs.
     #[serde(default, skip_serializing_if = "Option::is_none")]

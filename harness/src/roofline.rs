@@ -3,7 +3,7 @@
 //! A stage's time alone does not say how good its implementation is. Each GPU stage may declare
 //! a [`StageCost`]: the fewest bytes it must read and write and the arithmetic operations it must
 //! do for its inputs (a derivation beside each declaration says why it is the minimum). Once per
-//! process, after the frames of its first stage-timed run, [`crate::bounds::measure_bounds`]
+//! process, before the frames of its first stage-timed run, [`crate::bounds::measure_bounds`]
 //! times two kernels of its own on the device: a copy ([`DeviceBounds::bandwidth`], bytes read
 //! plus written per second) and independent FMA chains
 //! ([`DeviceBounds::ops_per_s`], an FMA counting as two operations, as a stage's `ops` do). The

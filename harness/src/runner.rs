@@ -278,6 +278,13 @@ pub fn process_memory_mb(field: &str) -> Option<f64> {
     Some(kb / 1024.0)
 }
 
+/// Resets this process's peak resident memory (`VmHWM`) to what is resident now (Linux 4.0 and
+/// later: `5` written to `/proc/self/clear_refs`); nothing elsewhere, where the peak then keeps
+/// what came before.
+fn reset_peak_memory() {
+    let _ = std::fs::write("/proc/self/clear_refs", "5");
+}
+
 /// Largest finite half float: the irradiance buffers (Rgba16Float) clamp above it.
 pub const HALF_MAX: f32 = 65504.0;
 
@@ -517,6 +524,21 @@ impl<'a> Harness<'a> {
     ) -> Result<(RunResult, FrameImages)> {
         // Timed before the frames, in the same session: what `gibench compare` divides by.
         let calibration = crate::calibrate::calibration_ms();
+        // The device's bounds, once per harness, before any frame of a run that times stages.
+        // Their buffers (64 MiB on a CPU adapter) are not the technique's: the peak resident
+        // memory so far is kept, and the peak is reset after them where Linux allows it.
+        let peak_before_bounds = process_memory_mb("VmHWM");
+        let device_bounds = match config.timing {
+            TimingMode::Frame => None,
+            _ => {
+                let measured = self.bounds.get().is_none();
+                let b = self.device_bounds()?;
+                if measured {
+                    reset_peak_memory();
+                }
+                Some(b)
+            }
+        };
         let mut stage_costs = BTreeMap::new();
         let mut stages = Vec::new();
         let mut counters = BTreeMap::new();
@@ -566,14 +588,9 @@ impl<'a> Harness<'a> {
                 negative_indirect,
             });
         }
-        // The process's peak memory is read before the device's bounds are measured: their
-        // buffers (64 MiB on a CPU adapter) are not the technique's.
-        let peak_memory_mb = process_memory_mb("VmHWM");
-        // The device's bounds, once per harness, after the frames of the first run that times
-        // stages (never inside a frame).
-        let device_bounds = match config.timing {
-            TimingMode::Frame => None,
-            _ => Some(self.device_bounds()?),
+        let peak_memory_mb = match (peak_before_bounds, process_memory_mb("VmHWM")) {
+            (Some(a), Some(b)) => Some(a.max(b)),
+            (a, b) => a.or(b),
         };
         let result = RunResult {
             schema_version: SCHEMA_VERSION,

@@ -60,7 +60,7 @@ pub fn roofline_table(result: &RunResult) -> Table {
     ];
     match bounds {
         Some(b) => notes.push(format!(
-            "Bounds measured on this device before the frames ({:.0} ms in all): bandwidth {:.2} GB/s \
+            "Bounds measured on this device before the first stage-timed run's frames ({:.0} ms in all): bandwidth {:.2} GB/s \
              (a copy reading and writing {:.1} MB in {:.3} ms), arithmetic rate {:.2} Gop/s ({:.1} \
              Mop of FMA chains in {:.3} ms); each the fastest of its runs, timed by {}.",
             b.measure_ms,
