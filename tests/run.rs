@@ -371,3 +371,54 @@ fn a_run_that_skips_nothing_leaves_no_list_of_skipped_techniques() {
     );
     assert!(!stale.exists(), "{stderr}");
 }
+
+/// A multi-frame quality run on the Cornell box with its walking bunny builds the static
+/// mesh's tree once for the whole run (the techniques' CPU rays and every reference frame share
+/// it) and the bunny's tree once per rendered reference frame, and says so in the results
+/// (`quality.reference_work`); run again over the same cache, it renders no reference and
+/// builds no mover tree, and its reference images are the first run's. Catches the reference
+/// building its own trees per frame again (its mover builds then go uncounted), a static tree
+/// built more than once, and a second run that renders what the cache holds.
+#[test]
+fn quality_run_builds_the_static_tree_once_and_movers_per_frame() {
+    use gibench_harness::metrics::ReferenceWork;
+    let tmp = tempfile::tempdir().unwrap();
+    let cache = tmp.path().join("cache");
+    let run = |out: &str| {
+        let out = tmp.path().join(out);
+        #[rustfmt::skip]
+        run_ok(
+            &["--scene", "cornell-bunny", "--technique", "direct", "--resolution", "64x48",
+              "--frames", "3", "--warmup", "1", "--timing", "stages", "--quality",
+              "--quality-all", "--spp", "4", "--cache", cache.to_str().unwrap()],
+            &out,
+        );
+        let r = RunResult::read(&out.join("cornell-bunny-direct.json")).unwrap();
+        let png = std::fs::read(out.join("cornell-bunny-direct-reference-frames.png")).unwrap();
+        (
+            r.quality.unwrap().reference_work.expect("reference_work"),
+            png,
+        )
+    };
+    let (first, png) = run("first");
+    assert_eq!(
+        first,
+        ReferenceWork {
+            rendered: 3,
+            cached: 0,
+            static_tree_builds: 1,
+            mover_tree_builds: 3
+        }
+    );
+    let (again, png_again) = run("again");
+    assert_eq!(
+        again,
+        ReferenceWork {
+            rendered: 0,
+            cached: 3,
+            static_tree_builds: 1,
+            mover_tree_builds: 0
+        }
+    );
+    assert!(png == png_again, "the cached references' images differ");
+}

@@ -435,6 +435,25 @@ pub struct QualitySummary {
     /// frame has it.
     #[serde(skip_serializing_if = "Option::is_none", default)]
     pub temporal: Option<Stats>,
+    /// How the reference images were come by; absent in files written before it was recorded.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub reference_work: Option<ReferenceWork>,
+}
+
+/// How a quality pass came by its reference images: how many it rendered and how many it read
+/// from the reference cache, and the trees the run has built for the scene so far (the static
+/// mesh's, shared by every frame, every technique's CPU rays and the reference; the movers',
+/// one per mover per rendered frame).
+#[derive(Serialize, Deserialize, Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ReferenceWork {
+    /// Reference frames rendered by this pass.
+    pub rendered: u32,
+    /// Reference frames this pass read from the cache.
+    pub cached: u32,
+    /// Builds of the static mesh's tree in the run so far: 1.
+    pub static_tree_builds: u32,
+    /// Builds of movers' trees in the run so far.
+    pub mover_tree_builds: u32,
 }
 
 /// Signed relative error of the image's mean over masked pixels and channels:
@@ -468,6 +487,7 @@ pub fn summarize(reference: String, frames: Vec<FrameQuality>) -> QualitySummary
         bias: of(|f| f.bias),
         temporal: (!temporal.is_empty()).then(|| Stats::of(&temporal)),
         frames,
+        reference_work: None,
     }
 }
 

@@ -14,6 +14,7 @@ use std::path::{Path, PathBuf};
 use glam::Vec3;
 
 use crate::anim::FrameState;
+use crate::bvh::SceneTrees;
 use crate::metrics::{self, FrameQuality, QualitySummary};
 use crate::reference::{self, ReferenceImages, ReferenceSettings};
 use crate::scene::Scene;
@@ -217,6 +218,19 @@ impl ReferenceCache {
         resolution: [u32; 2],
         settings: &ReferenceSettings,
     ) -> Result<(ReferenceImages, Option<reference::TracerSetup>)> {
+        self.get_with(&SceneTrees::new(scene), frame, resolution, settings)
+    }
+
+    /// [`get_timed`](Self::get_timed) for a frame of `trees`' scene: a frame it renders uses
+    /// the scene's static tree, built once for every frame asked of the same `trees`.
+    pub fn get_with(
+        &self,
+        trees: &SceneTrees,
+        frame: &FrameState,
+        resolution: [u32; 2],
+        settings: &ReferenceSettings,
+    ) -> Result<(ReferenceImages, Option<reference::TracerSetup>)> {
+        let scene = trees.scene();
         let path = self
             .dir
             .as_ref()
@@ -233,7 +247,7 @@ impl ReferenceCache {
                 return Ok((r, None));
             }
         }
-        let (r, setup) = reference::render_reference_timed(scene, frame, resolution, settings);
+        let (r, setup) = reference::render_reference_with(trees, frame, resolution, settings);
         if let (Some(p), Some(dir)) = (&path, &self.dir) {
             crate::output::write_atomic_direct(p, &encode(&r))?;
             trim(dir, MAX_CACHE_BYTES, p);

@@ -7,10 +7,12 @@
 //!
 //! ## Geometry and camera
 //!
-//! * One BVH per call over the static mesh **plus** the movers in this frame's pose
+//! * The geometry is the static mesh **plus** the movers in this frame's pose
 //!   ([`frame_mesh`]). Movers cast shadows *and* reflect light here: the reference is physically
 //!   complete, even where a technique (like Laine et al. 2007) bounces light off the static mesh
-//!   only.
+//!   only. The static mesh's BVH is built once per scene and shared by every frame
+//!   ([`SceneTrees`]); each mover's is built per frame in world space (see [`crate::bvh::FrameBvh`]
+//!   for why, and for the one case where the two levels can answer otherwise than one tree).
 //! * One ray per pixel centre ([`camera_ray`]), exactly the GPU camera: pixel (x, y) is NDC
 //!   ((x + ½)/w·2 − 1, 1 − (y + ½)/h·2) unprojected with the inverse of
 //!   `perspective_reverse_z(fov, w/h, near) · look_at(…)`. Rays start at the near plane (the GPU
@@ -66,11 +68,11 @@
 //! seed whatever the number of threads. The error falls as 1/√spp (faster for the stratified
 //! first bounce); two renders with different seeds give an estimate of it.
 
-use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
+use glam::{Mat4, Vec2, Vec3, Vec4};
 use rayon::prelude::*;
 
 use crate::anim::{FrameState, LightPose};
-use crate::bvh::SceneBvh;
+use crate::bvh::{mover_mesh, FrameBvh, SceneTrees};
 use crate::scene::descriptor::LightKind;
 use crate::scene::{Mesh, Scene, Texture};
 use crate::{Error, Result};
@@ -246,21 +248,14 @@ pub fn camera_ray(frame: &FrameState, resolution: [u32; 2], x: u32, y: u32) -> (
 }
 
 /// The static mesh plus every mover transformed by `frame.movers[i]` (identity where the frame
-/// has no transform), in world space. Mover material indices already refer to
-/// [`Scene::materials`].
+/// has no transform), in world space ([`crate::bvh::mover_mesh`]). Mover material indices
+/// already refer to [`Scene::materials`]. The tracer does not build this mesh: its trees are the
+/// scene's static tree and the movers' ([`SceneTrees`]), which answer as one tree over it.
 pub fn frame_mesh(scene: &Scene, frame: &FrameState) -> Mesh {
     let mut mesh = scene.mesh.clone();
     for (i, mover) in scene.movers.iter().enumerate() {
         let model = frame.movers.get(i).copied().unwrap_or(Mat4::IDENTITY);
-        let normal_matrix = Mat3::from_mat4(model).inverse().transpose();
-        let (p0, n0) = (mesh.positions.len(), mesh.normals.len());
-        mesh.append(&mover.mesh, 0);
-        for p in &mut mesh.positions[p0..] {
-            *p = model.transform_point3(*p);
-        }
-        for n in &mut mesh.normals[n0..] {
-            *n = (normal_matrix * *n).normalize_or_zero();
-        }
+        mesh.append(&mover_mesh(mover, model), 0);
     }
     mesh
 }
@@ -374,22 +369,30 @@ enum LightShape {
     Sun,
 }
 
-/// Everything needed to trace one frame: the BVH over the frame's geometry, the light, the
-/// materials. Build one per frame; queries are `&self` and thread-safe.
+/// Everything needed to trace one frame: the trees over the frame's geometry, the light, the
+/// materials. Set up one per frame; queries are `&self` and thread-safe.
 pub struct ReferenceTracer<'a> {
     scene: &'a Scene,
     light: LightPose,
     shape: LightShape,
-    bvh: SceneBvh,
+    bvh: FrameBvh,
     eps: f32,
     srgb: [f32; 256],
 }
 
 impl<'a> ReferenceTracer<'a> {
-    /// Builds the BVH over [`frame_mesh`] and sets up the frame's light.
+    /// Builds the trees over [`frame_mesh`] (the static mesh's too) and sets up the frame's
+    /// light. For several frames of a scene, [`ReferenceTracer::with_trees`] builds the static
+    /// mesh's tree once.
     pub fn new(scene: &'a Scene, frame: &FrameState) -> ReferenceTracer<'a> {
-        let mesh = frame_mesh(scene, frame);
-        let (lo, hi) = mesh.bounds();
+        Self::with_trees(&SceneTrees::new(scene), frame)
+    }
+
+    /// Sets up `frame` over `trees`' scene: its static tree (built if not yet) and the movers'
+    /// trees in `frame`'s pose, and the frame's light.
+    pub fn with_trees(trees: &SceneTrees<'a>, frame: &FrameState) -> ReferenceTracer<'a> {
+        let scene = trees.scene();
+        let (bvh, (lo, hi)) = trees.frame(frame);
         let diagonal = (hi - lo).length();
         let eps = if diagonal.is_finite() && diagonal > 0.0 {
             1e-4 * diagonal
@@ -416,14 +419,14 @@ impl<'a> ReferenceTracer<'a> {
             scene,
             light,
             shape,
-            bvh: SceneBvh::new(&mesh),
+            bvh,
             eps,
             srgb,
         }
     }
 
-    /// The BVH over the frame's geometry (static mesh and movers).
-    pub fn bvh(&self) -> &SceneBvh {
+    /// The trees over the frame's geometry (static mesh and movers).
+    pub fn bvh(&self) -> &FrameBvh {
         &self.bvh
     }
 
@@ -636,8 +639,8 @@ pub fn render_reference(
     render_reference_timed(scene, frame, resolution, settings).0
 }
 
-/// What setting up the tracer cost in a [`render_reference_timed`] call: the frame's mesh and
-/// its BVH, built before any ray is traced. Renderers that build their acceleration structure
+/// What setting up the tracer cost in a [`render_reference_timed`] call: the frame's trees
+/// (the static mesh's when not built yet, and the movers'), built before any ray is traced. Renderers that build their acceleration structure
 /// when the scene loads (Mitsuba, Embree) leave this out of their render time; a like-for-like
 /// comparison subtracts it from the render call's.
 #[derive(Clone, Copy, Debug)]
@@ -656,8 +659,19 @@ pub fn render_reference_timed(
     resolution: [u32; 2],
     settings: &ReferenceSettings,
 ) -> (ReferenceImages, TracerSetup) {
+    render_reference_with(&SceneTrees::new(scene), frame, resolution, settings)
+}
+
+/// [`render_reference_timed`] over `trees`' scene, its static tree built once for every frame
+/// rendered with the same `trees`.
+pub fn render_reference_with(
+    trees: &SceneTrees,
+    frame: &FrameState,
+    resolution: [u32; 2],
+    settings: &ReferenceSettings,
+) -> (ReferenceImages, TracerSetup) {
     let (tracer, seconds, cpu_seconds) =
-        crate::calibrate::timed(|| ReferenceTracer::new(scene, frame));
+        crate::calibrate::timed(|| ReferenceTracer::with_trees(trees, frame));
     let setup = TracerSetup {
         seconds,
         cpu_seconds,

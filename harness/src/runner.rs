@@ -7,14 +7,15 @@
 //! timing whole frames with no added synchronisation.
 
 use std::collections::BTreeMap;
+use std::sync::Arc;
 
 use serde_json::Value;
 
 use crate::anim::{FrameClock, FrameState};
 use crate::bounds::measure_bounds;
-use crate::bvh::SceneBvh;
+use crate::bvh::{SceneBvh, SceneTrees};
 use crate::gpu::GpuContext;
-use crate::metrics::QualitySummary;
+use crate::metrics::{QualitySummary, ReferenceWork};
 use crate::passes::{Compose, DirectLight, FrameUniforms, GBuffer, GpuScene};
 use crate::profiler::{ProfileMode, Profiler};
 use crate::quality::{CapturedFrame, QualityConfig, QualityImages, ReferenceCache};
@@ -330,7 +331,11 @@ impl FrameImages {
 pub struct Harness<'a> {
     pub gpu: &'a GpuContext,
     pub scene: &'a Scene,
-    pub bvh: SceneBvh,
+    /// The static mesh's tree ([`SceneTrees::static_tree`] of `trees`): built once, shared by
+    /// the techniques' CPU rays and the reference.
+    pub bvh: Arc<SceneBvh>,
+    /// The scene's trees for the reference (its static tree is `bvh`).
+    pub trees: SceneTrees<'a>,
     pub gpu_scene: GpuScene,
     pub uniforms: FrameUniforms,
     pub gbuffer: GBuffer,
@@ -390,10 +395,12 @@ impl<'a> Harness<'a> {
         let direct = DirectLight::new(gpu, &gpu_scene, &uniforms, &gbuffer);
         gpu.check_errors()?;
         let shared_costs = SharedCosts::new(config.resolution, &gpu_scene);
+        let trees = SceneTrees::new(scene);
         Ok(Harness {
             gpu,
             scene,
-            bvh: SceneBvh::new(&scene.mesh),
+            bvh: trees.static_tree().clone(),
+            trees,
             gpu_scene,
             uniforms,
             gbuffer,
@@ -685,23 +692,32 @@ impl<'a> Harness<'a> {
         }
         profiler.finish(self.gpu)?;
         let settings = quality.reference_settings();
+        let mut work = ReferenceWork::default();
         let references = captured
             .iter()
             .map(|c| {
-                cache.get(
-                    self.scene,
-                    &self.clock.frame(c.frame),
-                    config.resolution,
-                    &settings,
-                )
+                let frame = self.clock.frame(c.frame);
+                let (r, setup) =
+                    cache.get_with(&self.trees, &frame, config.resolution, &settings)?;
+                *(if setup.is_some() {
+                    &mut work.rendered
+                } else {
+                    &mut work.cached
+                }) += 1;
+                Ok(r)
             })
             .collect::<Result<Vec<_>>>()?;
-        crate::quality::compare(
+        let builds = self.trees.builds();
+        work.static_tree_builds = builds.static_tree;
+        work.mover_tree_builds = builds.mover_trees;
+        let (mut summary, images) = crate::quality::compare(
             &captured,
             &references,
             quality,
             self.scene.descriptor.settings.exposure,
-        )
+        )?;
+        summary.reference_work = Some(work);
+        Ok((summary, images))
     }
 
     /// The technique's irradiance, made [`non_negative`], and what was negative.

@@ -636,3 +636,76 @@ fn reference_default_settings_timing_and_noise() {
         relative_mse(&a.radiance, &b.radiance, &a.hit),
     );
 }
+
+/// The reference's two levels (the scene's static tree, built once, and the movers' trees per
+/// frame) answer as one tree over the frame's whole mesh, the way the reference traced before
+/// them: on the Cornell box with the walking bunny, at three frames, every closest-hit record
+/// (triangle id, `t`, barycentrics, normals, uv, material) is bit for bit the one tree's, and
+/// every any-hit answer the same, for camera rays, rays aimed at the bunny and rays in random
+/// directions; the frame's bounds (the ray offset ε's diagonal) are the frame mesh's. One
+/// static build serves the three frames, and each frame builds the bunny's tree once. Catches
+/// a mover's triangles numbered from the wrong offset, a mover tree asked for hits beyond the
+/// best so far (a farther mover hit would replace a nearer static one), a mover transformed
+/// otherwise than `frame_mesh` does, bounds that leave a part out, and a static tree rebuilt
+/// per frame.
+#[test]
+fn reference_trees_answer_as_one_tree_over_the_frame_mesh() {
+    use gibench_harness::bvh::{SceneBvh, SceneTrees, TreeBuilds};
+    use gibench_harness::reference::frame_mesh;
+    use gibench_harness::rng::SplitMix64;
+    let scene = Scene::load_named("cornell-bunny", &AssetPaths::standard(None)).unwrap();
+    let clock = FrameClock::new(&scene.descriptor);
+    let trees = SceneTrees::new(&scene);
+    let statics = scene.mesh.triangle_count() as u32;
+    let mut rng = SplitMix64::new(7, 0);
+    let unit = |rng: &mut SplitMix64| loop {
+        let v = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 2.0 - 1.0;
+        if v.length_squared() > 1e-4 && v.length_squared() <= 1.0 {
+            break v.normalize();
+        }
+    };
+    let (mut on_mover, mut rays) = (0, 0);
+    for f in [0, 40, 90] {
+        let frame = clock.frame(f);
+        let (two, bounds) = trees.frame(&frame);
+        let mesh = frame_mesh(&scene, &frame);
+        let one = SceneBvh::new(&mesh);
+        assert_eq!(bounds, mesh.bounds(), "frame {f}");
+        assert_eq!(two.triangle_count(), one.triangle_count());
+        let bunny = frame.movers[0].transform_point3(Vec3::ZERO);
+        let mut cast = |origin: Vec3, dir: Vec3| {
+            let (a, b) = (
+                two.closest_hit(origin, dir, 0.0, f32::INFINITY),
+                one.closest_hit(origin, dir, 0.0, f32::INFINITY),
+            );
+            assert_eq!(a, b, "frame {f}: {origin} {dir}");
+            assert_eq!(
+                two.any_hit(origin, dir, 0.0, f32::INFINITY),
+                one.any_hit(origin, dir, 0.0, f32::INFINITY)
+            );
+            rays += 1;
+            on_mover += a.is_some_and(|h| h.triangle >= statics) as u32;
+        };
+        for y in (0..96).step_by(3) {
+            for x in (0..128).step_by(3) {
+                let (o, d) = camera_ray(&frame, [128, 96], x, y);
+                cast(o, d);
+            }
+        }
+        for _ in 0..3000 {
+            let o = Vec3::new(20.0, 20.0, 20.0)
+                + Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 510.0;
+            let target = bunny + unit(&mut rng) * 40.0;
+            cast(o, (target - o).normalize());
+            cast(o, unit(&mut rng));
+        }
+    }
+    assert!(on_mover > 1000, "{on_mover} of {rays} rays hit the bunny");
+    assert_eq!(
+        trees.builds(),
+        TreeBuilds {
+            static_tree: 1,
+            mover_trees: 3
+        }
+    );
+}

@@ -1,7 +1,8 @@
 //! CPU ray casting over the static geometry with an eight-wide BVH (`wide`, collapsed from an
 //! `obvhs` PLOC tree): closest-hit (triangle, barycentrics, position, normals, material) and
 //! any-hit (occlusion) queries. The techniques use it to place and validate VPLs; the reference
-//! renderer traces paths with it.
+//! renderer traces paths with it, over a scene's static tree built once and its movers' trees
+//! per frame (`frame`).
 
 use std::time::Duration;
 
@@ -10,7 +11,9 @@ use obvhs::bvh2::builder::build_bvh2_from_tris;
 use obvhs::triangle::Triangle;
 use obvhs::BvhBuildParams;
 
+mod frame;
 mod wide;
+pub use frame::{mover_mesh, FrameBvh, SceneTrees, TreeBuilds};
 use wide::WideBvh;
 
 use crate::scene::Mesh;
