@@ -1,6 +1,7 @@
 //! **Calibration**: a fixed CPU workload timed in the same session as a run, so that timings
 //! taken at different moments on a shared machine can be compared as ratios to it
-//! (`gibench compare`), and the calling thread's CPU time (beside wall time for CPU stages).
+//! (`gibench compare`), and CPU clocks: the calling thread's, the whole process's (a CPU
+//! stage's, the calling thread and rayon's pool together, is `crate::threads::pool_cpu_ms`).
 
 use std::time::Instant;
 
@@ -41,8 +42,9 @@ pub fn timed<T>(f: impl FnOnce() -> T) -> (T, f64, Option<f64>) {
     (out, wall, cpu)
 }
 
+/// The CPU clock `clock` (a process's, a thread's) in milliseconds.
 #[cfg(unix)]
-fn cpu_clock_ms(clock: libc::clockid_t) -> Option<f64> {
+pub(crate) fn cpu_clock_ms(clock: libc::clockid_t) -> Option<f64> {
     let mut ts = libc::timespec {
         tv_sec: 0,
         tv_nsec: 0,

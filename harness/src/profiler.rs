@@ -219,16 +219,13 @@ impl Profiler {
         }
     }
 
-    /// Runs a CPU stage and times it by wall clock, and by CPU time: in stages mode that of
-    /// every thread of the process (the queue is idle between flushes, so that is the stage's
-    /// own work, across cores when it runs in parallel); in frame mode, where earlier frames'
-    /// GPU work may run beside it, the calling thread's.
+    /// Runs a CPU stage and times it by wall clock, and by CPU time: that of the calling thread
+    /// and of rayon's pool, where the stage's work runs across cores
+    /// ([`crate::threads::pool_cpu_ms`]), in both modes; never the GPU driver's threads, which
+    /// on a CPU driver run earlier frames' GPU work beside it in frame mode.
     pub fn cpu_stage<R>(&mut self, name: &str, work: impl FnOnce() -> R) -> R {
         let idx = self.series_index(name, StageKind::Cpu);
-        let clock = match self.mode {
-            ProfileMode::Stages => crate::calibrate::process_cpu_ms,
-            ProfileMode::Frame => crate::calibrate::thread_cpu_ms,
-        };
+        let clock = crate::threads::pool_cpu_ms;
         let c0 = clock();
         let t0 = Instant::now();
         let r = work();

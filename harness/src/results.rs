@@ -35,9 +35,9 @@ pub struct StageResult {
     /// per-task method); for CPU stages, plain wall time.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub wall_ms: Option<Stats>,
-    /// CPU stages: CPU time beside wall time — with stage timing, of every thread of the
-    /// process (the stage's work across cores; the GPU queue is idle between flushes); with
-    /// frame timing, of the calling thread. Below wall time when the work waits or is
+    /// CPU stages: CPU time beside wall time — of the calling thread and rayon's pool's workers
+    /// (the stage's work across cores; not the GPU driver's threads), in both timing modes
+    /// ([`crate::threads::pool_cpu_ms`]). Below wall time when the work waits or is
     /// descheduled on a busy machine, above it when it runs on several cores.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub cpu_ms: Option<Stats>,

@@ -23,3 +23,50 @@ pub fn join_global_pool() {
         .use_current_thread()
         .build_global();
 }
+
+/// The CPU time, in milliseconds, of the calling thread and of every worker of rayon's global
+/// pool, summed (`None` where the platform has no per-thread CPU clocks): what a CPU stage
+/// costs when its work runs on the pool (`laine`'s rays, the reference) and the calling thread
+/// waits for or joins it, without the process's other threads — the GPU driver's, which on
+/// lavapipe and llvmpipe run the GPU's work on the CPU. The workers' clocks are found once, by
+/// a broadcast to the pool (which builds the default pool if none exists yet).
+pub fn pool_cpu_ms() -> Option<f64> {
+    #[cfg(target_os = "linux")]
+    {
+        let own = own_cpu_clock()?;
+        let workers = worker_cpu_clocks();
+        let mut ms = 0.0;
+        for &clock in workers {
+            ms += crate::calibrate::cpu_clock_ms(clock)?;
+        }
+        if !workers.contains(&own) {
+            ms += crate::calibrate::cpu_clock_ms(own)?;
+        }
+        Some(ms)
+    }
+    #[cfg(not(target_os = "linux"))]
+    {
+        crate::calibrate::thread_cpu_ms()
+    }
+}
+
+/// The calling thread's CPU clock.
+#[cfg(target_os = "linux")]
+fn own_cpu_clock() -> Option<libc::clockid_t> {
+    let mut clock: libc::clockid_t = 0;
+    // SAFETY: `pthread_self` is the calling, live thread; `clock` is writable.
+    let rc = unsafe { libc::pthread_getcpuclockid(libc::pthread_self(), &mut clock) };
+    (rc == 0).then_some(clock)
+}
+
+/// The CPU clocks of the global pool's workers (their threads live as long as the process).
+#[cfg(target_os = "linux")]
+fn worker_cpu_clocks() -> &'static [libc::clockid_t] {
+    static CLOCKS: std::sync::OnceLock<Vec<libc::clockid_t>> = std::sync::OnceLock::new();
+    CLOCKS.get_or_init(|| {
+        rayon::broadcast(|_| own_cpu_clock())
+            .into_iter()
+            .flatten()
+            .collect()
+    })
+}
