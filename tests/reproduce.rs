@@ -309,6 +309,58 @@ fn gaitatzes_table1_has_the_papers_rows_and_the_scaling_figure() {
     }
 }
 
+/// A paper target's quality runs use the reference cache as `gibench run --quality` does (the
+/// default `results/cache`, here under the test's working folder): `gaitatzes-quality` on the
+/// Cornell box renders its two reference frames once, for its first run (its other five read
+/// them), and run again renders none, every run saying so in `quality.reference_work`; the
+/// reference images and every run's quality figures are the first invocation's. Catches a
+/// typed target that renders its references again on every run (as they all did with no
+/// cache).
+#[test]
+fn a_paper_targets_second_quality_run_renders_no_reference() {
+    let tmp = tempfile::tempdir().unwrap();
+    let run = |name: &str| {
+        let out = tmp.path().join(name);
+        #[rustfmt::skip]
+        let args = ["reproduce", "gaitatzes-quality", "--quick", "--scenes", "cornell",
+                    "--frames", "2", "--quiet"];
+        let o = gibench_in(tmp.path(), &args, &out);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let mut runs: Vec<_> = std::fs::read_dir(out.join("runs"))
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.extension().is_some_and(|x| x == "json"))
+            .collect();
+        runs.sort();
+        assert_eq!(runs.len(), 6, "{runs:?}");
+        runs.iter()
+            .map(|p| {
+                let mut v: serde_json::Value =
+                    serde_json::from_slice(&std::fs::read(p).unwrap()).unwrap();
+                let q = v["quality"].take();
+                let reference = p.with_file_name(
+                    p.file_stem().unwrap().to_string_lossy().into_owned() + "-reference.png",
+                );
+                (q, std::fs::read(reference).unwrap())
+            })
+            .collect::<Vec<_>>()
+    };
+    let rendered = |q: &serde_json::Value| q["reference_work"]["rendered"].as_u64();
+    let first = run("first");
+    let again = run("again");
+    assert_eq!(
+        first.iter().map(|r| rendered(&r.0)).collect::<Vec<_>>(),
+        [Some(2), Some(0), Some(0), Some(0), Some(0), Some(0)],
+        "the first invocation renders the two frames once"
+    );
+    for ((q1, png1), (q2, png2)) in first.iter().zip(&again) {
+        assert_eq!(rendered(q2), Some(0), "rendered again: {q2}");
+        assert_eq!(q2["reference_work"]["cached"].as_u64(), Some(2));
+        assert!(png1 == png2, "the cached reference's image differs");
+        assert_eq!(q1["frames"], q2["frames"], "the quality figures differ");
+    }
+}
+
 /// The `gibench` rows of a table's CSV by their `technique` column, as column name → text.
 fn technique_rows(
     csv: &std::path::Path,

@@ -20,11 +20,23 @@ pub(crate) struct ReferenceOpts {
     #[arg(long = "reference-seed", default_value_t = ReferenceSettings::default().seed)]
     pub(crate) reference_seed: u64,
     /// Directory of the reference cache.
-    #[arg(long, default_value = "results/cache")]
+    #[arg(long, default_value = DEFAULT_CACHE_DIR)]
     pub(crate) cache: PathBuf,
     /// Do not read or write the reference cache.
     #[arg(long)]
     pub(crate) no_cache: bool,
+}
+
+/// Where references are cached unless `--cache` or `--no-cache` says otherwise.
+const DEFAULT_CACHE_DIR: &str = "results/cache";
+
+/// The reference cache of a command without cache options (the paper targets of
+/// `gibench reproduce`): the folder `gibench run --quality` uses by default, so that their
+/// references are rendered once and reused by every run, target and later invocation.
+pub(crate) fn default_reference_cache() -> ReferenceCache {
+    ReferenceCache {
+        dir: Some(PathBuf::from(DEFAULT_CACHE_DIR)),
+    }
 }
 
 /// The most reference samples per pixel a command takes (at 256x192 and 8 bounces, hours on

@@ -290,7 +290,7 @@ fn spec<'s>(
         runs,
         config: super::paper_config(args, res, frames, warmup, compared),
         quality,
-        cache: Default::default(),
+        cache: crate::cli::options::default_reference_cache(),
         out: runs_folder(args),
         images: compared,
     })
@@ -345,7 +345,7 @@ fn cornell_spec<'s>(
             reference: ReferenceSettings::default(),
             component: Some(IndirectComponent::MultiBounce),
         }),
-        cache: Default::default(),
+        cache: crate::cli::options::default_reference_cache(),
         out: runs_folder(args),
         images: true,
     })

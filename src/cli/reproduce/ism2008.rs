@@ -190,7 +190,7 @@ fn spec<'s>(args: &ReproduceArgs, scene: &'s gibench_harness::scene::Scene) -> R
             shadow_size: s.shadow_size,
         },
         quality: None,
-        cache: Default::default(),
+        cache: crate::cli::options::default_reference_cache(),
         out: runs_folder(args),
         images: false,
     })

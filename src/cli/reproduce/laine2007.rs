@@ -281,7 +281,7 @@ fn run_pairs(args: &ReproduceArgs, gpu: Option<&GpuContext>, bars: &Bars) -> Res
                         shadow_size,
                     },
                     quality: None,
-                    cache: Default::default(),
+                    cache: crate::cli::options::default_reference_cache(),
                     out: out(args).join("runs"),
                     images: false,
                 },

@@ -299,7 +299,7 @@ fn spec<'s>(args: &ReproduceArgs, scene: &'s Scene, set: Set) -> Result<RunSpec<
         config: super::paper_config(args, s.resolution, frames, s.warmup, quality.is_some()),
         // The quality runs at the size the reference affords (as every quality target).
         quality,
-        cache: Default::default(),
+        cache: crate::cli::options::default_reference_cache(),
         out: runs_folder(args),
         images: false,
     })
