@@ -99,9 +99,9 @@ fn every_running_example_succeeds_at_a_small_size() {
     assert!(commands.len() >= 10, "{commands:?}");
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path();
-    // What the examples take as given: two builds' results (three repeats a side, alternated,
+    // What the examples take as given: two builds' results (five repeats a side, alternated,
     // as *Comparing two builds* says) and the committed lag results.
-    for repeat in 1..=3 {
+    for repeat in 1..=5 {
         for side in ["base", "current"] {
             let out = format!("{side}/r{repeat}");
             let mut args: Vec<String> = [

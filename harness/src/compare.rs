@@ -1,22 +1,30 @@
 //! **Compare**: whether CURRENT runs are faster or slower than BASE runs of the same benchmark,
-//! stage by stage, with a verdict only where the repeats' spread allows one (`gibench compare`).
+//! stage by stage, decided by a rank test and a minimum effect size (`gibench compare`).
 //!
 //! Runs are matched by scene, technique, resolution and parameters; each side needs at least
 //! [`MIN_REPEATS`] repeats of every run it is compared on (run them alternating BASE and
 //! CURRENT, so that a shared machine's drift falls on both). For every stage (the tables'
 //! figure: flushed wall time, else GPU timestamps), and for the whole frame where it was timed:
 //!
-//! * each repeat's median is divided by the calibration workload timed in the same session
-//!   ([`crate::calibrate`]), so drift between sessions cancels — when every repeat of the run
-//!   on both sides has one; otherwise both sides are compared raw (the row says so);
-//! * the **ratio** is median(CURRENT) / median(BASE) over the repeats, normalised (and raw
+//! * each repeat's median is the figure; with [`Settings::calibrate`] it is divided by the
+//!   calibration workload timed in the same session ([`crate::calibrate`]), for runs made in
+//!   sessions far apart — when every repeat of the run on both sides has one; otherwise both
+//!   sides are compared raw (the row says so). Runs made alternating in one session are
+//!   compared raw: on the shared 2-core machine (load about 7) the calibration of 10 runs in a
+//!   row ranged from 5.5 to 13.6 ms while their stages varied by about 10 %, and dividing by
+//!   it made a 30 % slowdown visible in 20 % of 5-against-5 draws instead of all;
+//! * the **ratio** is median(CURRENT) / median(BASE) over the repeats' figures (and raw
 //!   beside it);
-//! * the **band** is [min CURRENT / max BASE, max CURRENT / min BASE]: every pairing of a
-//!   CURRENT repeat with a BASE repeat lies in it;
-//! * the **verdict** is *slower* when the whole band lies above 1 + tolerance, *faster* when it
-//!   lies below 1 / (1 + tolerance), and *unchanged* otherwise. A stage timed at 0 ms in some
-//!   BASE repeat has no ratio: it is *slower* when every CURRENT repeat took time and every
-//!   BASE repeat none, *unchanged* otherwise (and the reverse for *faster*).
+//! * the **p-value** is the two-sided Mann–Whitney U test of the CURRENT repeats against the
+//!   BASE repeats ([`crate::stats::mann_whitney_u`]: exact for fewer than 8 repeats a side
+//!   without ties, else the normal approximation with tie correction; the row says which), as
+//!   Google Benchmark's `compare.py` decides;
+//! * the **verdict** is *slower* when p < alpha **and** the ratio exceeds 1 + tolerance,
+//!   *faster* when p < alpha and the ratio is below 1 / (1 + tolerance), and *unchanged*
+//!   otherwise: the test says whether the repeats differ beyond their spread, the tolerance
+//!   whether the difference is large enough to matter. A stage timed at 0 ms in some repeat has
+//!   no ratio: it is *slower* when every CURRENT repeat took time and every BASE repeat none,
+//!   *unchanged* otherwise (and the reverse for *faster*).
 //!
 //! CPU stages also report the median thread CPU time of each side.
 
@@ -26,11 +34,70 @@ use serde::Serialize;
 
 use crate::report::{stage_ms, Cell, Table};
 use crate::results::RunResult;
-use crate::stats::median;
+use crate::stats::{mann_whitney_u, median};
 use crate::{Error, Result};
 
-/// Repeats each side needs of every run it is compared on.
-pub const MIN_REPEATS: usize = 3;
+/// Repeats each side needs of every run it is compared on: with 5 against 5 the rank test's
+/// smallest two-sided p-value is 2/252 ≈ 0.008, so a shift can reach alpha 0.05 (with 3
+/// against 3 it could never go below 0.1).
+pub const MIN_REPEATS: usize = 5;
+
+/// The default significance level of the rank test, Google Benchmark's `compare.py`'s. With 5
+/// repeats against 5 it allows at most two of the 25 pairings the other way (p = 8/252 ≈
+/// 0.032; complete separation gives 2/252): at 0.01 only complete separation would count, and
+/// one stray repeat would hide a real change (a 30 % slower stage was missed in that way in
+/// `tests/compare.rs`). A comparison tests every stage of every run, so some p below 0.05
+/// come by chance: the tolerance is what keeps them from a verdict.
+pub const DEFAULT_ALPHA: f64 = 0.05;
+
+/// The default minimum effect (see [`Settings::tolerance`]).
+pub const DEFAULT_TOLERANCE: f64 = 0.25;
+
+/// How a comparison decides, checked by [`Settings::new`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Settings {
+    /// Smallest relative change a verdict needs: the median ratio above 1 + tolerance (or
+    /// below 1 / (1 + tolerance)).
+    pub tolerance: f64,
+    /// Significance level of the rank test: a verdict needs p < alpha.
+    pub alpha: f64,
+    /// Divide each repeat by its session's calibration (when every repeat has one).
+    pub calibrate: bool,
+}
+
+impl Settings {
+    /// Checked settings: an error names `tolerance` (a number >= 0) or `alpha` (between 0 and
+    /// 1).
+    pub fn new(tolerance: f64, alpha: f64, calibrate: bool) -> Result<Settings> {
+        if !(tolerance.is_finite() && tolerance >= 0.0) {
+            return Err(Error::param(
+                "tolerance",
+                format!("must be a number >= 0 (got {tolerance})"),
+            ));
+        }
+        if !(alpha > 0.0 && alpha < 1.0) {
+            return Err(Error::param(
+                "alpha",
+                format!("must be a significance level between 0 and 1, exclusive (got {alpha})"),
+            ));
+        }
+        Ok(Settings {
+            tolerance,
+            alpha,
+            calibrate,
+        })
+    }
+}
+
+impl Default for Settings {
+    fn default() -> Settings {
+        Settings {
+            tolerance: DEFAULT_TOLERANCE,
+            alpha: DEFAULT_ALPHA,
+            calibrate: false,
+        }
+    }
+}
 
 /// What a comparison concludes for one stage.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -62,13 +129,20 @@ pub struct CompareRow {
     pub current_ms: f64,
     /// current / base, raw; `None` where a time is 0.
     pub ratio_raw: Option<f64>,
-    /// current / base, each repeat divided by its session's calibration (raw where a repeat
-    /// has none: see `calibrated`); `None` where a time is 0.
+    /// current / base of the figures the verdict was decided on (calibrated where `calibrated`);
+    /// `None` where a time is 0.
     pub ratio: Option<f64>,
-    /// Whether `ratio` and `band` are calibrated (every repeat on both sides has a calibration).
+    /// current / base, each repeat divided by its session's calibration, where every repeat on
+    /// both sides has one (shown whether or not the verdict used it).
+    pub ratio_calibrated: Option<f64>,
+    /// Whether `ratio` and `p_value` are of calibrated figures (`--calibrate` given and every
+    /// repeat on both sides has a calibration).
     pub calibrated: bool,
-    /// The band of ratios (see the module docs); `None` where a time is 0.
-    pub band: Option<[f64; 2]>,
+    /// The two-sided Mann–Whitney U test's p-value (see the module docs); `None` where a time
+    /// is 0.
+    pub p_value: Option<f64>,
+    /// Whether `p_value` is exact (else the normal approximation).
+    pub p_exact: bool,
     pub verdict: Verdict,
     pub repeats: [usize; 2],
     /// CPU stages: median thread CPU time, base and current.
@@ -76,8 +150,8 @@ pub struct CompareRow {
     pub cpu_ms: Option<[f64; 2]>,
 }
 
-/// The key runs are matched by.
-fn run_key(r: &RunResult) -> String {
+/// The key runs are matched by: `scene/technique/WxH`, then the parameters in brackets.
+pub fn run_key(r: &RunResult) -> String {
     let params: Vec<String> = r
         .parameters
         .iter()
@@ -126,9 +200,17 @@ fn figures(r: &RunResult, calibrated: bool) -> BTreeMap<String, Figure> {
     out
 }
 
-/// The band and verdict for one stage's repeats (see the module docs): `base` and `current`
-/// are each repeat's figure, non-negative.
-pub fn judge(base: &[f64], current: &[f64], tolerance: f64) -> (Option<[f64; 2]>, Verdict) {
+/// The rank test and verdict for one stage's repeats (see the module docs): `base` and
+/// `current` are each repeat's figure, non-negative. Returns the test (`None` where a time is 0)
+/// and the verdict.
+pub fn judge(
+    base: &[f64],
+    current: &[f64],
+    settings: &Settings,
+) -> (Option<crate::stats::RankTest>, Verdict) {
+    let Settings {
+        tolerance, alpha, ..
+    } = *settings;
     let max_of = |v: &[f64]| v.iter().copied().fold(0.0, f64::max);
     let min_of = |v: &[f64]| v.iter().copied().fold(f64::INFINITY, f64::min);
     if min_of(base) <= 0.0 || min_of(current) <= 0.0 {
@@ -141,18 +223,18 @@ pub fn judge(base: &[f64], current: &[f64], tolerance: f64) -> (Option<[f64; 2]>
         };
         return (None, verdict);
     }
-    let band = [
-        min_of(current) / max_of(base),
-        max_of(current) / min_of(base),
-    ];
-    let verdict = if band[0] > 1.0 + tolerance {
+    let test = mann_whitney_u(current, base);
+    let ratio = median(current) / median(base);
+    let verdict = if test.p >= alpha {
+        Verdict::Unchanged
+    } else if ratio > 1.0 + tolerance {
         Verdict::Slower
-    } else if band[1] < 1.0 / (1.0 + tolerance) {
+    } else if ratio < 1.0 / (1.0 + tolerance) {
         Verdict::Faster
     } else {
         Verdict::Unchanged
     };
-    (Some(band), verdict)
+    (Some(test), verdict)
 }
 
 /// `a / b`, or `None` when either is 0.
@@ -160,8 +242,8 @@ fn ratio(a: f64, b: f64) -> Option<f64> {
     (a > 0.0 && b > 0.0).then(|| a / b)
 }
 
-/// Runs grouped by [`run_key`].
-fn group(runs: &[RunResult]) -> BTreeMap<String, Vec<&RunResult>> {
+/// Runs grouped by [`run_key`] (the repeats of each run).
+pub fn group(runs: &[RunResult]) -> BTreeMap<String, Vec<&RunResult>> {
     let mut g: BTreeMap<String, Vec<&RunResult>> = BTreeMap::new();
     for r in runs {
         g.entry(run_key(r)).or_default().push(r);
@@ -169,19 +251,13 @@ fn group(runs: &[RunResult]) -> BTreeMap<String, Vec<&RunResult>> {
     g
 }
 
-/// Compares `current` with `base` (see the module docs). Errors name the run that has too few
-/// repeats on either side, or say that no run is on both sides.
+/// Compares `current` with `base` (see the module docs). Errors name the side and the run
+/// that has too few repeats, or say that no run is on both sides.
 pub fn compare(
     base: &[RunResult],
     current: &[RunResult],
-    tolerance: f64,
+    settings: &Settings,
 ) -> Result<Vec<CompareRow>> {
-    if !(tolerance.is_finite() && tolerance >= 0.0) {
-        return Err(Error::param(
-            "tolerance",
-            format!("must be a number >= 0 (got {tolerance})"),
-        ));
-    }
     let (b, c) = (group(base), group(current));
     let common: Vec<&String> = b.keys().filter(|k| c.contains_key(*k)).collect();
     if common.is_empty() {
@@ -202,9 +278,10 @@ pub fn compare(
                 )));
             }
         }
-        let calibrated = bs.iter().chain(cs.iter()).all(|r| has_calibration(r));
-        let bf: Vec<_> = bs.iter().map(|r| figures(r, calibrated)).collect();
-        let cf: Vec<_> = cs.iter().map(|r| figures(r, calibrated)).collect();
+        let all_calibrated = bs.iter().chain(cs.iter()).all(|r| has_calibration(r));
+        let calibrated = settings.calibrate && all_calibrated;
+        let bf: Vec<_> = bs.iter().map(|r| figures(r, all_calibrated)).collect();
+        let cf: Vec<_> = cs.iter().map(|r| figures(r, all_calibrated)).collect();
         let mut stages: Vec<String> = Vec::new();
         for f in bf.iter().chain(&cf) {
             for name in f.keys() {
@@ -230,7 +307,12 @@ pub fn compare(
                 (!c.is_empty()).then(|| median(&c))
             };
             let (bn, cn) = (norm(&bv), norm(&cv));
-            let (band, verdict) = judge(&bn, &cn, tolerance);
+            let (bd, cd) = if calibrated {
+                (bn.clone(), cn.clone())
+            } else {
+                (raw(&bv), raw(&cv))
+            };
+            let (test, verdict) = judge(&bd, &cd, settings);
             let (base_ms, current_ms) = (median(&raw(&bv)), median(&raw(&cv)));
             rows.push(CompareRow {
                 run: key.clone(),
@@ -238,9 +320,11 @@ pub fn compare(
                 base_ms,
                 current_ms,
                 ratio_raw: ratio(current_ms, base_ms),
-                ratio: ratio(median(&cn), median(&bn)),
+                ratio: ratio(median(&cd), median(&bd)),
+                ratio_calibrated: ratio(median(&cn), median(&bn)).filter(|_| all_calibrated),
                 calibrated,
-                band,
+                p_value: test.map(|t| t.p),
+                p_exact: test.is_some_and(|t| t.exact),
                 verdict,
                 repeats: [bv.len(), cv.len()],
                 cpu_ms: cpu(&bv).zip(cpu(&cv)).map(|(a, b)| [a, b]),
@@ -251,7 +335,12 @@ pub fn compare(
 }
 
 /// The comparison as a table (see the module docs for the columns' meaning).
-pub fn compare_table(rows: &[CompareRow], tolerance: f64) -> Table {
+pub fn compare_table(rows: &[CompareRow], settings: &Settings) -> Table {
+    let Settings {
+        tolerance,
+        alpha,
+        calibrate,
+    } = *settings;
     let columns = [
         "run",
         "stage",
@@ -259,7 +348,7 @@ pub fn compare_table(rows: &[CompareRow], tolerance: f64) -> Table {
         "current ms",
         "ratio (raw)",
         "ratio (calibrated)",
-        "band",
+        "p",
         "verdict",
         "CPU ms base / current",
     ]
@@ -274,13 +363,16 @@ pub fn compare_table(rows: &[CompareRow], tolerance: f64) -> Table {
                 Cell::Ms(Some(r.base_ms)),
                 Cell::Ms(Some(r.current_ms)),
                 Cell::Num(r.ratio_raw, 3),
-                Cell::Num(r.ratio.filter(|_| r.calibrated), 3),
-                Cell::text(r.band.map_or("–".to_string(), |[a, b]| {
+                Cell::Num(r.ratio_calibrated, 3),
+                Cell::text(r.p_value.map_or("–".to_string(), |p| {
                     format!(
-                        "{}–{}{}",
-                        Cell::Num(Some(a), 3).display(),
-                        Cell::Num(Some(b), 3).display(),
-                        if r.calibrated { "" } else { " (raw)" }
+                        "{p:.4}{}{}",
+                        if r.p_exact { "" } else { " (normal)" },
+                        if r.calibrated || !calibrate {
+                            ""
+                        } else {
+                            " (raw)"
+                        }
                     )
                 })),
                 Cell::text(r.verdict.name()),
@@ -302,11 +394,18 @@ pub fn compare_table(rows: &[CompareRow], tolerance: f64) -> Table {
         rows: rows_out,
         notes: vec![format!(
             "Per stage, the median over the repeats of each repeat's median (ms). Ratios are CURRENT / BASE; \
-             \"calibrated\" divides each repeat by the calibration workload timed in its session. Band: every \
-             pairing of a CURRENT repeat with a BASE repeat (calibrated; \"(raw)\" where a repeat on either side has \
-             no calibration, and then both sides are compared raw). Verdict: slower when the whole band \
-             is above {:.2}, faster when it is below {:.3}, else unchanged (tolerance {tolerance}); a stage \
-             timed at 0 ms has no ratio.",
+             \"calibrated\" divides each repeat by the calibration workload timed in its session{}. p: the \
+             two-sided Mann–Whitney U test of the CURRENT repeats against the BASE repeats ({}), exact \
+             (fewer than 8 repeats a side, no ties) or \"(normal)\": the normal approximation with tie \
+             correction. Verdict: slower when p < {alpha} and the ratio is above {:.2}, faster \
+             when p < {alpha} and it is below {:.3}, else unchanged (tolerance {tolerance}); a stage timed \
+             at 0 ms has no ratio.",
+            if calibrate { "" } else { " (--calibrate was not given: shown only)" },
+            if calibrate {
+                "calibrated; \"(raw)\" where a repeat on either side has no calibration, and then both sides are compared raw"
+            } else {
+                "raw times, as the ratio (raw)"
+            },
             1.0 + tolerance,
             1.0 / (1.0 + tolerance)
         )],
@@ -344,63 +443,92 @@ mod tests {
         r
     }
 
-    /// Noise within the band and a machine twice as slow in one session give "unchanged"; a
-    /// stage 1.5× slower is "slower" and the others stay "unchanged"; too few repeats is an
-    /// error naming the run.
+    const A: f64 = DEFAULT_ALPHA;
+
+    /// Settings with this tolerance, the default alpha and the calibration used.
+    fn t(tolerance: f64) -> Settings {
+        Settings::new(tolerance, A, true).unwrap()
+    }
+
+    /// Noise and a machine twice as slow in one session give "unchanged"; a stage 1.5× slower
+    /// is "slower" and the others stay "unchanged"; too few repeats is an error naming the side
+    /// and the run.
     #[test]
-    fn verdicts_follow_the_band_and_the_calibration() {
-        let base: Vec<RunResult> = [1.0, 1.04, 0.97]
+    fn verdicts_follow_the_rank_test_and_the_calibration() {
+        let noise = [1.0, 1.04, 0.97, 1.01, 0.99];
+        let base: Vec<RunResult> = noise
             .iter()
             .map(|n| run(&[("a", 2.0 * n), ("b", 5.0 * n)], 10.0))
             .collect();
-        // The same work; the second session ran on a machine twice as slow, and its
-        // calibration says so.
-        let same: Vec<RunResult> = [(1.02, 10.0), (2.0, 20.0), (0.99, 10.0)]
+        // The same work; two sessions ran on a machine twice as slow, and their calibrations
+        // say so.
+        let same: Vec<RunResult> = [(1.02, 10.0), (2.0, 20.0), (0.99, 10.0), (2.06, 20.0)]
             .iter()
+            .chain(&[(0.98, 10.0)])
             .map(|(n, c)| run(&[("a", 2.0 * n), ("b", 5.0 * n)], *c))
             .collect();
-        let rows = compare(&base, &same, 0.1).unwrap();
+        let rows = compare(&base, &same, &t(0.1)).unwrap();
         assert!(
             rows.iter().all(|r| r.verdict == Verdict::Unchanged),
             "{rows:?}"
         );
-        let slow: Vec<RunResult> = [1.0, 1.03, 0.98]
+        let slow: Vec<RunResult> = [1.0, 1.03, 0.98, 1.02, 0.97]
             .iter()
             .map(|n| run(&[("a", 3.0 * n), ("b", 5.0 * n)], 10.0))
             .collect();
-        let rows = compare(&base, &slow, 0.1).unwrap();
-        let verdict = |s: &str| rows.iter().find(|r| r.stage == s).unwrap().verdict;
-        assert_eq!(verdict("a"), Verdict::Slower);
-        assert_eq!(verdict("b"), Verdict::Unchanged);
-        let rows = compare(&slow, &base, 0.1).unwrap();
+        let rows = compare(&base, &slow, &t(0.1)).unwrap();
+        let row = |s: &str| rows.iter().find(|r| r.stage == s).unwrap().clone();
+        assert_eq!(row("a").verdict, Verdict::Slower);
+        // Every SLOW repeat above every BASE repeat: the exact test's smallest p, 2/252.
+        let p = row("a").p_value.unwrap();
+        assert!(row("a").p_exact && (p - 2.0 / 252.0).abs() < 1e-12, "{p}");
+        assert_eq!(row("b").verdict, Verdict::Unchanged);
+        let rows = compare(&slow, &base, &t(0.1)).unwrap();
         assert_eq!(
             rows.iter().find(|r| r.stage == "a").unwrap().verdict,
             Verdict::Faster
         );
-        let e = compare(&base[..2], &slow, 0.1).unwrap_err().to_string();
+        let e = compare(&base[..4], &slow, &t(0.1)).unwrap_err().to_string();
         assert!(
-            e.contains("BASE has 2 repeat(s) of cornell/direct/64x48"),
+            e.contains("BASE has 4 repeat(s) of cornell/direct/64x48") && e.contains("at least 5"),
             "{e}"
         );
+        let e = compare(&base, &slow[..3], &t(0.1)).unwrap_err().to_string();
+        assert!(e.contains("CURRENT has 3 repeat(s)"), "{e}");
+        let e = Settings::new(0.1, 1.5, true).unwrap_err().to_string();
+        assert!(e.contains("alpha"), "{e}");
+        let e = Settings::new(-0.1, A, true).unwrap_err().to_string();
+        assert!(e.contains("tolerance"), "{e}");
     }
 
-    /// The band's edges decide exactly: a band wholly above 1 + tolerance is slower, one
-    /// touching it is not; wholly below 1 / (1 + tolerance) is faster.
+    /// Both conditions decide: a large shift the rank test cannot tell from the spread stays
+    /// unchanged (the old band rule's job, now the test's), and a shift the test is sure of but
+    /// within the tolerance stays unchanged too; only both together make a verdict.
     #[test]
-    fn the_verdict_is_decided_by_the_band_edges() {
-        let (band, v) = judge(&[1.0, 2.0, 1.5], &[2.4, 2.5, 2.45], 0.1);
-        assert_eq!(band, Some([1.2, 2.5]));
+    fn a_verdict_needs_both_the_test_and_the_effect_size() {
+        let base = [1.0, 1.1, 0.9, 1.05, 0.95];
+        // Every CURRENT repeat 1.5× its BASE repeat: p = 2/252 and ratio 1.5.
+        let slow: Vec<f64> = base.iter().map(|x| x * 1.5).collect();
+        let (test, v) = judge(&base, &slow, &t(0.25));
         assert_eq!(v, Verdict::Slower);
-        let (_, v) = judge(&[1.0, 2.0], &[2.2, 3.0], 0.1);
-        assert_eq!(
-            v,
-            Verdict::Unchanged,
-            "band [1.1, 3]: its lower edge is not above 1.1"
+        assert!(test.unwrap().p < A);
+        // The same ratio of medians, but one CURRENT repeat as fast as BASE: the ranks
+        // overlap (U = 22 of 25) and p = 14/252 = 0.0556 (exact;
+        // scipy.stats.mannwhitneyu([0.97, 1.5, 1.6, 1.45, 1.55], base) gives 0.05555...).
+        let overlapping = [0.97, 1.5, 1.6, 1.45, 1.55];
+        let (test, v) = judge(&base, &overlapping, &t(0.25));
+        let test = test.unwrap();
+        assert!(
+            test.exact && test.u == 22.0 && (test.p - 14.0 / 252.0).abs() < 1e-12,
+            "{test:?}"
         );
-        let (_, v) = judge(&[2.0, 2.0], &[1.0, 1.8], 0.1);
-        assert_eq!(v, Verdict::Faster, "band [0.5, 0.9] lies below 1/1.1");
-        let (_, v) = judge(&[2.0, 2.0], &[1.0, 1.85], 0.1);
-        assert_eq!(v, Verdict::Unchanged, "band [0.5, 0.925]");
+        assert_eq!(v, Verdict::Unchanged, "p {} is not below {A}", test.p);
+        // Separated ranks but only 10 % slower, tolerance 25 %: unchanged; tolerance 5 %: slower.
+        let slightly: Vec<f64> = [1.0, 1.01, 1.02, 1.03, 1.04].map(|x| x * 1.1).into();
+        let tight = [1.0, 1.01, 1.02, 1.03, 1.04];
+        assert_eq!(judge(&tight, &slightly, &t(0.25)).1, Verdict::Unchanged);
+        assert_eq!(judge(&tight, &slightly, &t(0.05)).1, Verdict::Slower);
+        assert_eq!(judge(&slightly, &tight, &t(0.05)).1, Verdict::Faster);
     }
 
     /// A side whose files carry no calibration: both sides are compared raw. Before, the
@@ -409,13 +537,13 @@ mod tests {
     #[test]
     fn a_side_without_calibration_is_compared_raw() {
         let side = |calibration: Option<f64>| -> Vec<RunResult> {
-            [1.0, 1.02, 0.99]
+            [1.0, 1.02, 0.99, 1.01, 0.98]
                 .iter()
                 .map(|n| run(&[("a", 2.0 * n), ("b", 5.0 * n)], calibration))
                 .collect()
         };
         for (base, current) in [(Some(10.0), None), (None, Some(10.0))] {
-            let rows = compare(&side(base), &side(current), 0.1).unwrap();
+            let rows = compare(&side(base), &side(current), &t(0.1)).unwrap();
             assert_eq!(rows.len(), 2);
             for r in &rows {
                 assert_eq!(r.verdict, Verdict::Unchanged, "{r:?}");
@@ -426,11 +554,11 @@ mod tests {
         // One repeat without calibration among calibrated ones: raw as well.
         let mut mixed = side(Some(10.0));
         mixed[1].calibration_ms = None;
-        let rows = compare(&side(Some(10.0)), &mixed, 0.1).unwrap();
+        let rows = compare(&side(Some(10.0)), &mixed, &t(0.1)).unwrap();
         assert!(rows
             .iter()
             .all(|r| !r.calibrated && r.verdict == Verdict::Unchanged));
-        let table = compare_table(&rows, 0.1).to_terminal();
+        let table = compare_table(&rows, &t(0.1)).to_terminal();
         assert!(table.contains("(raw)"), "{table}");
     }
 
@@ -439,21 +567,21 @@ mod tests {
     #[test]
     fn zero_ms_stages_have_no_ratio() {
         let side = |a: f64, b: f64| -> Vec<RunResult> {
-            (0..3).map(|_| run(&[("a", a), ("b", b)], 10.0)).collect()
+            (0..5).map(|_| run(&[("a", a), ("b", b)], 10.0)).collect()
         };
-        let rows = compare(&side(0.0, 0.0), &side(0.0, 1.0), 0.1).unwrap();
+        let rows = compare(&side(0.0, 0.0), &side(0.0, 1.0), &t(0.1)).unwrap();
         let row = |s: &str| rows.iter().find(|r| r.stage == s).unwrap();
         assert_eq!(row("a").verdict, Verdict::Unchanged);
         assert_eq!(row("b").verdict, Verdict::Slower);
         for r in &rows {
             assert!(
-                r.ratio.is_none() && r.ratio_raw.is_none() && r.band.is_none(),
+                r.ratio.is_none() && r.ratio_raw.is_none() && r.p_value.is_none(),
                 "{r:?}"
             );
         }
-        let table = compare_table(&rows, 0.1).to_terminal();
+        let table = compare_table(&rows, &t(0.1)).to_terminal();
         assert!(!table.contains("inf"), "{table}");
-        let rows = compare(&side(1.0, 1.0), &side(0.0, 1.0), 0.1).unwrap();
+        let rows = compare(&side(1.0, 1.0), &side(0.0, 1.0), &t(0.1)).unwrap();
         assert_eq!(
             rows.iter().find(|r| r.stage == "a").unwrap().verdict,
             Verdict::Faster

@@ -54,6 +54,48 @@ pub struct FrameResult {
     /// Every measured frame's time, in order (for spotting spikes and their frames).
     #[serde(default)]
     pub samples_ms: Vec<f64>,
+    /// The GPU frame time: per measured frame, GPU timestamps from the first stage's start to
+    /// the last stage's end (where the adapter has timestamp queries).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gpu_span_ms: Option<Stats>,
+    /// Per measured frame, in order: its GPU span and its stages' own timestamp intervals,
+    /// summed and the longest.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub gpu_spans: Vec<GpuFrameSpan>,
+}
+
+/// One frame's GPU timestamps in frame timing (every stage's commands submitted together,
+/// on one queue), milliseconds.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct GpuFrameSpan {
+    /// From the first stage's start to the last stage's end.
+    pub span_ms: f64,
+    /// The stages' own intervals (end − start) summed: more than the span where the GPU
+    /// overlaps stages (tiled GPUs), less where it idles between them.
+    pub stage_sum_ms: f64,
+    /// The longest stage's interval: never more than the span on one in-order queue.
+    pub longest_stage_ms: f64,
+}
+
+impl GpuFrameSpan {
+    /// The span of one frame's stage intervals `(start, end)` in ticks, in submission order,
+    /// `period_ns` nanoseconds a tick.
+    pub fn of(intervals: &[(u64, u64)], period_ns: f64) -> GpuFrameSpan {
+        let ms = |ticks: u64| ticks as f64 * period_ns * 1e-6;
+        let own: Vec<f64> = intervals
+            .iter()
+            .map(|&(a, b)| ms(b.saturating_sub(a)))
+            .collect();
+        let span = match (intervals.first(), intervals.last()) {
+            (Some(first), Some(last)) => ms(last.1.saturating_sub(first.0)),
+            _ => 0.0,
+        };
+        GpuFrameSpan {
+            span_ms: span,
+            stage_sum_ms: own.iter().sum(),
+            longest_stage_ms: own.iter().copied().fold(0.0, f64::max),
+        }
+    }
 }
 
 /// What the run was run on.
@@ -203,6 +245,10 @@ impl RunResult {
         if let Some(f) = &self.frame {
             non_negative(&f.frame_ms)
                 .map_err(|v| format!("frame.frame_ms.{v} (times are not negative)"))?;
+            if let Some(s) = &f.gpu_span_ms {
+                non_negative(s)
+                    .map_err(|v| format!("frame.gpu_span_ms.{v} (times are not negative)"))?;
+            }
         }
         if let Some(c) = self.calibration_ms {
             if !(CALIBRATION_MS.0..=CALIBRATION_MS.1).contains(&c) {
@@ -319,5 +365,25 @@ impl StageResult {
     /// time.
     pub fn best_ms(&self) -> Option<f64> {
         self.wall_ms.or(self.gpu_ms).map(|s| s.median)
+    }
+}
+
+#[cfg(test)]
+mod span_tests {
+    use super::GpuFrameSpan;
+
+    /// The span runs from the first stage's start to the last stage's end: overlapping stages
+    /// (a tiled GPU) give a span below their sum, stages with gaps between them one above it.
+    /// Catches a span taken as the sum, or from the wrong ends.
+    #[test]
+    fn the_span_is_first_start_to_last_end() {
+        // Ticks of 1 µs: stages 0–4, 2–7 and 6–9 ms, overlapping.
+        let overlapping = GpuFrameSpan::of(&[(0, 4000), (2000, 7000), (6000, 9000)], 1000.0);
+        assert_eq!(overlapping.span_ms, 9.0);
+        assert_eq!(overlapping.stage_sum_ms, 12.0);
+        assert_eq!(overlapping.longest_stage_ms, 5.0);
+        let gaps = GpuFrameSpan::of(&[(100, 200), (500, 600)], 1e6);
+        assert_eq!((gaps.span_ms, gaps.stage_sum_ms), (500.0, 200.0));
+        assert_eq!(GpuFrameSpan::of(&[], 1.0).span_ms, 0.0);
     }
 }

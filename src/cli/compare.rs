@@ -1,5 +1,5 @@
-//! `gibench compare`: CURRENT runs against BASE runs stage by stage, with a noise band and a
-//! verdict, refusing to compare runs with themselves.
+//! `gibench compare`: CURRENT runs against BASE runs stage by stage, with a rank test's
+//! p-value, the median ratio and a verdict, refusing to compare runs with themselves.
 
 use std::path::{Path, PathBuf};
 
@@ -18,10 +18,19 @@ pub(crate) struct CompareArgs {
     base: PathBuf,
     /// Folder of the CURRENT runs, likewise.
     current: PathBuf,
-    /// Relative change a verdict needs beyond the band: slower when every pairing is above
-    /// 1 + tolerance (0.25 keeps a shared CPU's run-to-run noise from deciding).
-    #[arg(long, default_value_t = 0.25)]
+    /// Smallest relative change a verdict needs: slower only when the median ratio is above
+    /// 1 + tolerance (and the rank test's p is below --alpha); 0.25 keeps a shared CPU's
+    /// run-to-run drift from deciding.
+    #[arg(long, default_value_t = gibench_harness::compare::DEFAULT_TOLERANCE)]
     tolerance: f64,
+    /// Significance level of the two-sided Mann–Whitney U test a verdict needs (p < alpha).
+    #[arg(long, default_value_t = gibench_harness::compare::DEFAULT_ALPHA)]
+    alpha: f64,
+    /// Decide on each repeat divided by the calibration workload timed in its session (for
+    /// runs made in sessions far apart, such as a committed baseline); without it the verdict
+    /// is decided on raw times and the calibrated ratio is only shown.
+    #[arg(long)]
+    calibrate: bool,
     /// Output directory for the comparison (Markdown, CSV, LaTeX, JSON).
     #[arg(long, default_value = "results/local")]
     out: PathBuf,
@@ -33,6 +42,8 @@ pub(crate) struct CompareArgs {
 /// `gibench compare`: reads both sides, compares, prints and writes the table and JSON.
 pub(crate) fn exec(args: &CompareArgs) -> Result<()> {
     check_stem(&args.stem)?;
+    let settings =
+        gibench_harness::compare::Settings::new(args.tolerance, args.alpha, args.calibrate)?;
     let base = results_under("base", &args.base)?;
     let current = results_under("current", &args.current)?;
     check_distinct_runs(args, &base, &current)?;
@@ -40,8 +51,8 @@ pub(crate) fn exec(args: &CompareArgs) -> Result<()> {
         base.into_iter().map(|(_, r)| r).collect(),
         current.into_iter().map(|(_, r)| r).collect(),
     );
-    let rows = gibench_harness::compare::compare(&base, &current, args.tolerance)?;
-    let table = gibench_harness::compare::compare_table(&rows, args.tolerance);
+    let rows = gibench_harness::compare::compare(&base, &current, &settings)?;
+    let table = gibench_harness::compare::compare_table(&rows, &settings);
     println!("{}", table.to_terminal());
     let set = OutputSet::begin("out", &args.out)?;
     report::write_tables(&table, &args.out, &args.stem)?;
@@ -58,7 +69,7 @@ pub(crate) fn exec(args: &CompareArgs) -> Result<()> {
 
 /// Refuses a comparison of runs with themselves: BASE and CURRENT the same folder, a results
 /// file reached from both sides or twice from one (through a link), or two byte-identical
-/// copies of one run (counted as two repeats, a copy would narrow the noise band falsely).
+/// copies of one run (counted as two repeats, a copy would make the rank test surer than the runs allow).
 fn check_distinct_runs(
     args: &CompareArgs,
     base: &[(PathBuf, RunResult)],

@@ -68,7 +68,10 @@ fn timing_notes(results: &[&RunResult]) -> Vec<String> {
         "Times in milliseconds, median over {frames}; GPU stages: CPU wall time with the queue flushed before and \
          after (Laine et al. 2007's per-task method; GPU timestamps are in the results files and in \
          `gibench report --detailed`); frame: no added synchronisation (time between frame starts); CPU stages: \
-         wall time; FPS: 1000 / mean frame time."
+         wall time; frame p95 / p99: the 95th and 99th percentiles of the frame times (stutters); GPU frame span: \
+         median over the frames of GPU timestamps from the first stage's start to the last stage's end, whole \
+         frames submitted at once (the stages' own intervals would count twice what a GPU overlaps); FPS: \
+         1000 / mean frame time."
     )];
 
     let fallbacks: Vec<String> = results
@@ -133,7 +136,8 @@ pub fn tile_balance_cell(r: &RunResult) -> Cell {
 
 /// One row per run: scene, technique, resolution "WxH", "VPLs (mean / min)" and "tile VPLs
 /// (fewest / most)" when any run counts them, one column per stage (median ms: flushed wall time, else GPU timestamps),
-/// "Σ stages", "frame (median ms)", "FPS". Notes say how the times were taken and on which
+/// "Σ stages", "frame (median ms)", "frame p95", "frame p99", "GPU frame span" (median ms),
+/// "FPS". Notes say how the times were taken and on which
 /// device(s).
 pub fn stage_table(results: &[RunResult]) -> Table {
     let stages = stage_names(results);
@@ -159,7 +163,17 @@ pub fn stage_table(results: &[RunResult]) -> Table {
         columns.push("tile VPLs (fewest / most)".into());
     }
     columns.extend(stages.iter().cloned());
-    columns.extend(["Σ stages", "frame (median ms)", "FPS"].map(String::from));
+    columns.extend(
+        [
+            "Σ stages",
+            "frame (median ms)",
+            "frame p95",
+            "frame p99",
+            "GPU frame span",
+            "FPS",
+        ]
+        .map(String::from),
+    );
     let quality = results.iter().any(|r| r.quality.is_some());
     if quality {
         columns.extend(["RMSE", "relMSE", "bias", "FLIP", "flicker"].map(String::from));
@@ -188,8 +202,14 @@ pub fn stage_table(results: &[RunResult]) -> Table {
                     .map(|name| Cell::Ms(r.stage(name).and_then(stage_ms))),
             );
             row.push(Cell::Ms(stage_sum(r)));
-            row.push(Cell::Ms(r.frame.as_ref().map(|f| f.frame_ms.median)));
-            row.push(Cell::Num(r.frame.as_ref().map(|f| f.fps), 1));
+            let frame = r.frame.as_ref();
+            row.push(Cell::Ms(frame.map(|f| f.frame_ms.median)));
+            row.push(Cell::Ms(frame.map(|f| f.frame_ms.p95)));
+            row.push(Cell::Ms(frame.map(|f| f.frame_ms.p99)));
+            row.push(Cell::Ms(
+                frame.and_then(|f| f.gpu_span_ms).map(|s| s.median),
+            ));
+            row.push(Cell::Num(frame.map(|f| f.fps), 1));
             if quality {
                 let q = r.quality.as_ref();
                 row.push(Cell::Num(q.map(|q| q.rmse.mean), 4));

@@ -82,6 +82,8 @@ fn run(scene: &str, technique: &str, stages: Vec<StageResult>, frame_median: f64
             fps: 1000.0 / (frame_median * 1.01),
             frames_in_flight: 2,
             samples_ms: vec![frame_median],
+            gpu_span_ms: None,
+            gpu_spans: Vec::new(),
         }),
         counters: BTreeMap::from([("shadow maps".to_string(), stats(1.0))]),
         prepare_ms: None,
@@ -152,6 +154,9 @@ fn stage_union_keeps_execution_order() {
         "compose",
         "Σ stages",
         "frame (median ms)",
+        "frame p95",
+        "frame p99",
+        "GPU frame span",
         "FPS",
     ];
     assert_eq!(t.columns, expected);
@@ -169,12 +174,12 @@ fn markdown_has_header_separator_and_one_row_per_result() {
     );
     assert_eq!(
         lines[1],
-        "| --- | --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"
+        "| --- | --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"
     );
     // Run A: medians 0.50, 1.23 (1.234), no vpl trace, 0.75 (wall); sum 2.484; frame 3.00.
     assert_eq!(
         lines[2],
-        "| sponza | direct | 1280x720 | 0.50 | 1.23 | – | 0.75 | 2.48 | 3.00 | 330.0 |"
+        "| sponza | direct | 1280x720 | 0.50 | 1.23 | – | 0.75 | 2.48 | 3.00 | 3.60 | 4.20 | – | 330.0 |"
     );
     // Run B: 0.05 ms shows three decimals.
     assert!(
@@ -291,7 +296,7 @@ fn csv_quotes_commas_and_quotes() {
     assert!(records[0].starts_with("scene,technique,resolution,g-buffer,shadow map,"));
     assert_eq!(
         records[1],
-        "sponza,direct,1280x720,0.5000,1.2340,,0.7500,2.4840,3.0000,330.0"
+        "sponza,direct,1280x720,0.5000,1.2340,,0.7500,2.4840,3.0000,3.6000,4.2000,,330.0"
     );
     assert!(
         records[2].starts_with("cornell_box 100%,\"ism, \"\"imperfect\"\"\",1280x720,"),
@@ -304,7 +309,7 @@ fn csv_quotes_commas_and_quotes() {
 #[test]
 fn latex_escapes_specials() {
     let tex = stage_table(&two_runs()).to_latex();
-    assert!(tex.contains("\\begin{tabular}{lllrrrrrrr}"), "{tex}");
+    assert!(tex.contains("\\begin{tabular}{lllrrrrrrrrrr}"), "{tex}");
     assert!(tex.contains("\\toprule") && tex.contains("\\midrule") && tex.contains("\\bottomrule"));
     assert!(
         tex.contains("cornell\\_box 100\\% & ism, \"imperfect\" & 1280x720"),
@@ -463,7 +468,7 @@ fn zero_and_missing_stage_times_do_not_panic() {
     let t = stage_table(&runs);
     assert_eq!(
         t.rows[3].iter().filter(|c| **c == Cell::Ms(None)).count(),
-        5,
+        6,
         "{:?}",
         t.rows[3]
     );
