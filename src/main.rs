@@ -13,6 +13,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 use cli::compare::CompareArgs;
+use cli::export::ExportResultsArgs;
 use cli::export_scene::ExportArgs;
 use cli::instructions::InstructionsArgs;
 use cli::merge::MergeArgs;
@@ -56,9 +57,12 @@ enum Command {
     /// Plot per-frame error against the reference from results files made with
     /// `run --quality --quality-all` (e.g. the lag of keller-incremental).
     PlotQuality(PlotQualityArgs),
-    /// Compare CURRENT runs with BASE runs stage by stage: ratios, a noise band from at least
-    /// three repeats on each side, and a verdict (faster / slower / unchanged).
+    /// Compare CURRENT runs with BASE runs stage by stage: ratios, a rank test (Mann–Whitney U)
+    /// over at least five repeats on each side, and a verdict (faster / slower / unchanged).
     Compare(CompareArgs),
+    /// Write results folders (and instruction counts) as Bencher Metric Format JSON, for
+    /// `bencher run --adapter json` to keep their history (`--format bmf`).
+    Export(ExportResultsArgs),
     /// Count the CPU kernels' instructions under callgrind (deterministic, unlike time) and
     /// compare them with a baseline; fails on a regression beyond the threshold.
     Instructions(InstructionsArgs),
@@ -83,6 +87,7 @@ fn main() -> ExitCode {
         Some(Command::Merge(args)) => cli::merge::exec(&args),
         Some(Command::PlotQuality(args)) => cli::plot_quality::exec(&args),
         Some(Command::Compare(args)) => cli::compare::exec(&args),
+        Some(Command::Export(args)) => cli::export::exec(&args),
         Some(Command::Instructions(args)) => cli::instructions::exec(&args),
         Some(Command::ExportScene(args)) => cli::export_scene::exec(&args),
         Some(Command::Raycast(args)) => cli::raycast::exec(&args),

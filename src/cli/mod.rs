@@ -2,7 +2,8 @@
 //! helpers several of them share.
 //!
 //! Subcommands: [`run`], [`sweep`], [`list`], [`report`], [`reference`], [`reproduce`],
-//! [`plot_quality`], [`compare`], [`merge`], [`instructions`], [`export_scene`], [`raycast`].
+//! [`plot_quality`], [`compare`], [`merge`], [`export`], [`instructions`], [`export_scene`],
+//! [`raycast`]. [`shard`] is the work split of the commands that shard.
 //!
 //! Shared: [`options`] (option groups several commands flatten in: the reference's, the
 //! adapter's), [`params`] (parsing and checking option values, `--param` assignment),
@@ -11,6 +12,7 @@
 //! [`page`] (the HTML page a command writes with `--html`).
 
 pub(crate) mod compare;
+pub(crate) mod export;
 pub(crate) mod export_scene;
 pub(crate) mod files;
 pub(crate) mod instructions;

@@ -1,0 +1,340 @@
+//! `gibench export --format bmf`: results folders (and an instruction-count file) as Bencher
+//! Metric Format JSON, for `bencher run --adapter json --file ...` to keep their history
+//! (docs/history.md).
+//!
+//! Benchmarks are named `SCENE@WxH/TECHNIQUE/STAGE` (and `.../frame`, `.../gpu-frame-span`,
+//! `.../image-error`, `kernels/KERNEL`); each holds measures whose `value` is the median over
+//! the repeats found and whose `lower_value` and `upper_value` are the smallest and largest
+//! repeat (present with two repeats or more):
+//!
+//! * `latency`, Bencher's built-in measure, in its unit, **nanoseconds**: per stage, each
+//!   repeat's median stage time (flushed wall time, else GPU timestamps, as the tables show);
+//!   per frame, each repeat's median frame time; `gpu-frame-span`, the median GPU span of a
+//!   frame (first stage's start to last stage's end);
+//! * `rmse` and `flip` (custom measures, no unit): each repeat's mean RMSE and mean FLIP over
+//!   its compared frames, where the runs were made with `--quality`;
+//! * `instructions` (custom): a kernel's instruction count under callgrind, from a file that
+//!   `gibench instructions --write` made.
+//!
+//! The testbed (`--print-testbed`) is named from the runs' adapter, backend and driver.
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+use clap::{Args, ValueEnum};
+use gibench_harness::compare::group;
+use gibench_harness::report::stage_ms;
+use gibench_harness::results::RunResult;
+use gibench_harness::stats::median;
+use gibench_harness::{Error, Result};
+use serde_json::{json, Map, Value};
+
+use super::files::writable_file;
+use super::results_io::results_under;
+
+/// Formats `gibench export` writes.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub(crate) enum Format {
+    /// Bencher Metric Format JSON (`bencher run --adapter json`).
+    Bmf,
+}
+
+#[derive(Args)]
+pub(crate) struct ExportResultsArgs {
+    /// Folders of results files, searched recursively (one subfolder per repeat, as for
+    /// `gibench compare`).
+    inputs: Vec<PathBuf>,
+    /// The output format.
+    #[arg(long, value_enum)]
+    format: Format,
+    /// An instruction-count file (`gibench instructions --write`, e.g.
+    /// results/baseline/instructions.json) to export beside the runs.
+    #[arg(long)]
+    instructions: Option<PathBuf>,
+    /// The file to write (default: standard output).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Print only the testbed name (adapter, backend, driver) of the runs, for
+    /// `bencher run --testbed`.
+    #[arg(long)]
+    print_testbed: bool,
+}
+
+/// `gibench export`: reads the inputs, checks they make one testbed, writes the JSON.
+pub(crate) fn exec(args: &ExportResultsArgs) -> Result<()> {
+    if args.inputs.is_empty() && args.instructions.is_none() {
+        return Err(Error::param(
+            "inputs",
+            "give at least one folder of results files, or --instructions FILE",
+        ));
+    }
+    if let Some(out) = &args.out {
+        writable_file("out", out, "history.json")?;
+    }
+    let mut runs: Vec<RunResult> = Vec::new();
+    let mut seen: Vec<PathBuf> = Vec::new();
+    for dir in &args.inputs {
+        for (path, r) in results_under("inputs", dir)? {
+            let canonical = path.canonicalize().map_err(|e| Error::io(&path, e))?;
+            if seen.contains(&canonical) {
+                return Err(Error::bad_file(
+                    &path,
+                    "reached twice through the inputs (a folder and one inside it?); each run \
+                     must count once",
+                ));
+            }
+            seen.push(canonical);
+            runs.push(r);
+        }
+    }
+    let testbed = testbed(&runs)?;
+    if args.print_testbed {
+        match testbed {
+            Some(t) => println!("{t}"),
+            None => {
+                return Err(Error::param(
+                    "print-testbed",
+                    "needs folders of results files: the testbed is named from their device",
+                ))
+            }
+        }
+        return Ok(());
+    }
+    let instructions = args
+        .instructions
+        .as_ref()
+        .map(|p| read_instructions(p).map(|k| (p.clone(), k)))
+        .transpose()?;
+    let bmf = bmf(&runs, instructions.as_ref().map(|(_, k)| k))?;
+    let text = serde_json::to_string_pretty(&bmf).map_err(|e| Error::Invalid(e.to_string()))?;
+    match &args.out {
+        Some(out) => {
+            gibench_harness::output::write_atomic(out, format!("{text}\n").as_bytes())?;
+            eprintln!(
+                "wrote {} benchmarks ({} runs{}) to {}",
+                bmf.len(),
+                runs.len(),
+                if instructions.is_some() {
+                    ", instruction counts"
+                } else {
+                    ""
+                },
+                out.display()
+            );
+        }
+        None => println!("{text}"),
+    }
+    Ok(())
+}
+
+/// The testbed the runs were made on, as a Bencher slug (lower case, digits and dashes, at
+/// most 64 characters): adapter, backend and driver. `None` without runs; an error when the
+/// runs come from more than one (their histories must not mix).
+fn testbed(runs: &[RunResult]) -> Result<Option<String>> {
+    let name = |r: &RunResult| {
+        let d = &r.device;
+        let words = format!("{} {} {}", d.adapter, d.backend, d.driver);
+        let mut slug = String::new();
+        for c in words.chars() {
+            if c.is_ascii_alphanumeric() {
+                slug.push(c.to_ascii_lowercase());
+            } else if !slug.is_empty() && !slug.ends_with('-') {
+                slug.push('-');
+            }
+        }
+        let mut slug: String = slug.trim_end_matches('-').chars().take(64).collect();
+        while slug.ends_with('-') {
+            slug.pop();
+        }
+        slug
+    };
+    let mut names: Vec<String> = runs.iter().map(name).collect();
+    names.sort();
+    names.dedup();
+    match names.as_slice() {
+        [] => Ok(None),
+        [one] if !one.is_empty() => Ok(Some(one.clone())),
+        [_] => Err(Error::param(
+            "inputs",
+            "the runs' device has no adapter, backend or driver name to name a testbed by",
+        )),
+        many => Err(Error::param(
+            "inputs",
+            format!(
+                "the runs come from {} devices ({}); export each device's runs on their own \
+                 (one testbed per upload)",
+                many.len(),
+                many.join(", ")
+            ),
+        )),
+    }
+}
+
+/// The kernels' instruction counts in `path` (`{"kernels": {"NAME": COUNT, ...}}`).
+fn read_instructions(path: &std::path::Path) -> Result<BTreeMap<String, u64>> {
+    let bytes = gibench_harness::error::read_bounded(path, 1 << 24)?;
+    let v: Value = serde_json::from_slice(&bytes)
+        .map_err(|e| Error::bad_file(path, format!("not JSON: {e}")))?;
+    let kernels = v.get("kernels").and_then(Value::as_object).ok_or_else(|| {
+        Error::bad_file(
+            path,
+            "has no 'kernels' object; expected an instruction-count file of `gibench instructions --write`",
+        )
+    })?;
+    kernels
+        .iter()
+        .map(|(k, n)| {
+            n.as_u64().map(|n| (k.clone(), n)).ok_or_else(|| {
+                Error::bad_file(
+                    path,
+                    format!("kernels.{k} is {n}; expected a count (a whole number >= 0)"),
+                )
+            })
+        })
+        .collect()
+}
+
+/// A BMF metric: the median of `values` (non-empty, finite), with the smallest and largest as
+/// lower and upper values when there are two or more.
+fn metric(values: &[f64]) -> Value {
+    let mut m = Map::new();
+    m.insert("value".into(), json!(median(values)));
+    if values.len() > 1 {
+        let lo = values.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        m.insert("lower_value".into(), json!(lo));
+        m.insert("upper_value".into(), json!(hi));
+    }
+    Value::Object(m)
+}
+
+/// The BMF document (see the module docs): benchmark name → measure slug → metric.
+fn bmf(
+    runs: &[RunResult],
+    instructions: Option<&BTreeMap<String, u64>>,
+) -> Result<BTreeMap<String, Map<String, Value>>> {
+    let mut out: BTreeMap<String, Map<String, Value>> = BTreeMap::new();
+    // Benchmark names carry scene, resolution and technique, not the parameters: two runs
+    // that differ only in them would share names, and are refused.
+    let mut named: BTreeMap<String, String> = BTreeMap::new();
+    for (key, repeats) in group(runs) {
+        let r0 = repeats[0];
+        let prefix = format!(
+            "{}@{}x{}/{}",
+            r0.scene, r0.resolution[0], r0.resolution[1], r0.technique
+        );
+        if let Some(other) = named.insert(prefix.clone(), key.clone()) {
+            return Err(Error::param(
+                "inputs",
+                format!(
+                    "two runs would share the benchmark names {prefix}/...: {other}; {key} \
+                     (they differ in parameters); export them from separate folders"
+                ),
+            ));
+        }
+        let mut add = |bench: String, measure: &str, values: Vec<f64>| {
+            let values: Vec<f64> = values.into_iter().filter(|v| v.is_finite()).collect();
+            if !values.is_empty() {
+                out.entry(bench)
+                    .or_default()
+                    .insert(measure.to_string(), metric(&values));
+            }
+        };
+        let mut stages: Vec<&str> = Vec::new();
+        for r in &repeats {
+            for s in &r.stages {
+                if !stages.contains(&s.name.as_str()) {
+                    stages.push(&s.name);
+                }
+            }
+        }
+        const NS_PER_MS: f64 = 1e6;
+        for stage in stages {
+            let ms: Vec<f64> = repeats
+                .iter()
+                .filter_map(|r| r.stage(stage).and_then(stage_ms))
+                .collect();
+            add(
+                format!("{prefix}/{stage}"),
+                "latency",
+                ms.iter().map(|m| m * NS_PER_MS).collect(),
+            );
+        }
+        let frames: Vec<&gibench_harness::results::FrameResult> =
+            repeats.iter().filter_map(|r| r.frame.as_ref()).collect();
+        add(
+            format!("{prefix}/frame"),
+            "latency",
+            frames
+                .iter()
+                .map(|f| f.frame_ms.median * NS_PER_MS)
+                .collect(),
+        );
+        add(
+            format!("{prefix}/gpu-frame-span"),
+            "latency",
+            frames
+                .iter()
+                .filter_map(|f| f.gpu_span_ms.map(|s| s.median * NS_PER_MS))
+                .collect(),
+        );
+        let quality: Vec<_> = repeats.iter().filter_map(|r| r.quality.as_ref()).collect();
+        add(
+            format!("{prefix}/image-error"),
+            "rmse",
+            quality.iter().map(|q| q.rmse.mean).collect(),
+        );
+        add(
+            format!("{prefix}/image-error"),
+            "flip",
+            quality.iter().map(|q| q.flip_mean.mean).collect(),
+        );
+    }
+    for (kernel, count) in instructions.into_iter().flatten() {
+        out.entry(format!("kernels/{kernel}"))
+            .or_default()
+            .insert("instructions".into(), json!({ "value": *count as f64 }));
+    }
+    if out.is_empty() {
+        return Err(Error::param(
+            "inputs",
+            "nothing to export: the runs have no timed stage, frame or image error",
+        ));
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The testbed slug keeps Bencher's slug rules (lower case, digits, single dashes, at
+    /// most 64 characters) whatever the adapter's name holds.
+    #[test]
+    fn testbed_names_are_slugs() {
+        let mut r: RunResult = serde_json::from_slice(
+            &std::fs::read(
+                std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                    .join("results/baseline/r1/cornell-direct.json"),
+            )
+            .unwrap(),
+        )
+        .unwrap();
+        r.device.adapter = "llvmpipe (LLVM 19.1.7, 256 bits) ".repeat(4);
+        r.device.backend = "Vulkan".into();
+        let t = testbed(std::slice::from_ref(&r)).unwrap().unwrap();
+        assert!(t.len() <= 64, "{t}");
+        assert!(t.starts_with("llvmpipe-llvm-19-1-7-256-bits-"), "{t}");
+        assert!(
+            t.chars()
+                .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '-')
+                && !t.contains("--")
+                && !t.ends_with('-'),
+            "{t}"
+        );
+        let mut other = r.clone();
+        other.device.backend = "gl".into();
+        let e = testbed(&[r, other]).unwrap_err().to_string();
+        assert!(e.contains("2 devices"), "{e}");
+    }
+}
