@@ -172,6 +172,58 @@ fn verdicts_on_synthetic_results_are_exact() {
     assert!(busy.iter().all(|(_, v)| v == "unchanged"), "{busy:?}");
 }
 
+/// A run on one side only (here `direct` with a parameter it gained since BASE was run) is
+/// listed as not compared, in the terminal and in the table's notes; with `--require-all` the
+/// command fails naming it, before writing anything. Catches the comparison passing over such
+/// runs silently (how the committed baseline once lacked `ism`, `ism-classic` and `gaitatzes`
+/// without anyone seeing it) and a `--require-all` that lets an incomplete baseline through.
+#[test]
+fn a_run_on_one_side_only_is_listed_and_fails_require_all() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let cal = serde_json::json!(10.0);
+    synthetic(&dir.join("base"), &BASE, |_| 1.0, cal.clone());
+    let current = [1.01, 0.99, 1.02, 1.0, 0.985];
+    synthetic(&dir.join("current"), &current, |_| 1.0, cal);
+    for i in 0..current.len() {
+        let d = dir.join(format!("current/r{i}"));
+        let mut v: Value =
+            serde_json::from_slice(&std::fs::read(d.join("cornell-direct.json")).unwrap()).unwrap();
+        v["parameters"]["gained"] = serde_json::json!(1);
+        std::fs::write(
+            d.join("cornell-direct-gained.json"),
+            serde_json::to_vec_pretty(&v).unwrap(),
+        )
+        .unwrap();
+    }
+    let (ok, rows, stderr) = compare(dir, "base", "current");
+    assert!(ok, "{stderr}");
+    assert_eq!(rows.len(), STAGES.len(), "{rows:?}");
+    assert!(
+        stderr.contains("only in CURRENT: cornell/direct/") && stderr.contains("gained=1"),
+        "{stderr}"
+    );
+    let md = std::fs::read_to_string(dir.join("cmp-base-current/compare.md")).unwrap();
+    assert!(md.contains("Not compared (on one side only)"), "{md}");
+
+    let out = dir.join("strict");
+    let o = support::gibench()
+        .arg("compare")
+        .arg(dir.join("base"))
+        .arg(dir.join("current"))
+        .args(["--require-all", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("require-all") && stderr.contains("gained=1"),
+        "{stderr}"
+    );
+    assert!(!out.exists(), "nothing is written when --require-all fails");
+}
+
 /// The synthetic BASE repeats' factors.
 const BASE: [f64; 5] = [1.0, 1.03, 0.98, 1.01, 0.99];
 

@@ -251,6 +251,17 @@ pub fn group(runs: &[RunResult]) -> BTreeMap<String, Vec<&RunResult>> {
     g
 }
 
+/// The runs (by [`run_key`]) that are on one side only, BASE's then CURRENT's: [`compare`]
+/// passes over them, since runs are matched by scene, technique, resolution and parameters (a
+/// technique that gained a parameter since the BASE runs has no match until they are run again).
+pub fn unmatched(base: &[RunResult], current: &[RunResult]) -> [Vec<String>; 2] {
+    let (b, c) = (group(base), group(current));
+    let only = |x: &BTreeMap<String, Vec<&RunResult>>, y: &BTreeMap<String, Vec<&RunResult>>| {
+        x.keys().filter(|k| !y.contains_key(*k)).cloned().collect()
+    };
+    [only(&b, &c), only(&c, &b)]
+}
+
 /// Compares `current` with `base` (see the module docs). Errors name the side and the run
 /// that has too few repeats, or say that no run is on both sides.
 pub fn compare(

@@ -31,6 +31,10 @@ pub(crate) struct CompareArgs {
     /// is decided on raw times and the calibrated ratio is only shown.
     #[arg(long)]
     calibrate: bool,
+    /// Fail when a run is on one side only (by default such runs are listed and passed over):
+    /// CI's check that the committed baseline covers every technique as it is run today.
+    #[arg(long)]
+    require_all: bool,
     /// Output directory for the comparison (Markdown, CSV, LaTeX, JSON).
     #[arg(long, default_value = "results/local")]
     out: PathBuf,
@@ -51,8 +55,31 @@ pub(crate) fn exec(args: &CompareArgs) -> Result<()> {
         base.into_iter().map(|(_, r)| r).collect(),
         current.into_iter().map(|(_, r)| r).collect(),
     );
+    let unmatched = gibench_harness::compare::unmatched(&base, &current);
+    let listing: Vec<String> = ["BASE", "CURRENT"]
+        .iter()
+        .zip(&unmatched)
+        .filter(|(_, runs)| !runs.is_empty())
+        .map(|(side, runs)| format!("only in {side}: {}", runs.join("; ")))
+        .collect();
+    if args.require_all && !listing.is_empty() {
+        return Err(Error::param(
+            "require-all",
+            format!(
+                "every run must be on both sides (matched by scene, technique, resolution and \
+                 parameters), but {}; run the missing side again (the committed baseline: bash \
+                 results/regenerate.sh baseline)",
+                listing.join(", and ")
+            ),
+        ));
+    }
     let rows = gibench_harness::compare::compare(&base, &current, &settings)?;
-    let table = gibench_harness::compare::compare_table(&rows, &settings);
+    let mut table = gibench_harness::compare::compare_table(&rows, &settings);
+    if !listing.is_empty() {
+        let note = format!("Not compared (on one side only): {}.", listing.join("; "));
+        eprintln!("warning: {note}");
+        table.notes.push(note);
+    }
     println!("{}", table.to_terminal());
     let set = OutputSet::begin("out", &args.out)?;
     report::write_tables(&table, &args.out, &args.stem)?;
