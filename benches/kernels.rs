@@ -11,11 +11,11 @@
 
 use criterion::measurement::{Measurement, ValueFormatter};
 use criterion::{criterion_group, Criterion, Throughput};
-use gibench_harness::assets::AssetPaths;
 use gibench_harness::glam::Vec3;
+use gibench_harness::gpu::profiler::{ProfileMode, Profiler};
 use gibench_harness::gpu::{GpuContext, GpuOptions};
-use gibench_harness::profiler::{ProfileMode, Profiler};
-use gibench_harness::runner::{Harness, RunConfig, TimingMode};
+use gibench_harness::run::runner::{Harness, RunConfig, TimingMode};
+use gibench_harness::scene::assets::AssetPaths;
 use gibench_harness::scene::Scene;
 
 #[path = "../src/registry.rs"]
@@ -30,7 +30,7 @@ impl Measurement for ProcessCpuTime {
     type Value = f64;
 
     fn start(&self) -> f64 {
-        gibench_harness::calibrate::process_cpu_ms().unwrap_or(0.0)
+        gibench_harness::measure::calibrate::process_cpu_ms().unwrap_or(0.0)
     }
 
     fn end(&self, start: f64) -> f64 {
@@ -103,12 +103,12 @@ fn rays(c: &mut Criterion) {
             eprintln!("skipping rays/{name}: scene not found");
             continue;
         };
-        let bvh = gibench_harness::bvh::SceneBvh::new(&scene.mesh);
-        let origin = gibench_harness::anim::FrameClock::new(&scene.descriptor)
+        let bvh = gibench_harness::cpu::bvh::SceneBvh::new(&scene.mesh);
+        let origin = gibench_harness::scene::anim::FrameClock::new(&scene.descriptor)
             .frame(0)
             .light
             .position;
-        let dirs = gibench_harness::vpl::fibonacci_sphere(1024);
+        let dirs = gibench_harness::cpu::vpl::fibonacci_sphere(1024);
         c.bench_function(&format!("rays/closest-hit-1024/{name}"), |b| {
             b.iter(|| {
                 dirs.iter()
@@ -169,8 +169,8 @@ fn vpl_generation(c: &mut Criterion) {
             eprintln!("skipping vpl-generation/{name}: scene not found");
             continue;
         };
-        let bvh = gibench_harness::bvh::SceneBvh::new(&scene.mesh);
-        let light = gibench_harness::anim::FrameClock::new(&scene.descriptor)
+        let bvh = gibench_harness::cpu::bvh::SceneBvh::new(&scene.mesh);
+        let light = gibench_harness::scene::anim::FrameClock::new(&scene.descriptor)
             .frame(0)
             .light;
         let rho = scene.average_reflectance().max_element();
@@ -179,7 +179,7 @@ fn vpl_generation(c: &mut Criterion) {
                 &format!("vpl-generation/256-bounces-{bounces}/{name}"),
                 |b| {
                     b.iter(|| {
-                        gibench_harness::vpl::generate_at_least(
+                        gibench_harness::cpu::vpl::generate_at_least(
                             &scene, &bvh, &light, 256, bounces, rho,
                         )
                         .1
@@ -202,7 +202,7 @@ fn point_pool(c: &mut Criterion) {
         };
         c.bench_function(&format!("point-pool/65536/{name}"), |b| {
             b.iter(|| {
-                gibench_harness::ir::points::sample_scene(&scene, 65_536, 1)
+                gibench_harness::kit::ir::points::sample_scene(&scene, 65_536, 1)
                     .expect("surfaces")
                     .len()
             })
@@ -224,14 +224,16 @@ fn reference_paths_cpu(c: &mut Criterion<ProcessCpuTime>) {
 fn reference_paths_by<M: Measurement + 'static>(c: &mut Criterion<M>, group: &str) {
     let scene =
         Scene::load_named("cornell", &AssetPaths::standard(None)).expect("cornell is generated");
-    let frame = gibench_harness::anim::FrameClock::new(&scene.descriptor).frame(0);
-    let settings = gibench_harness::reference::ReferenceSettings {
+    let frame = gibench_harness::scene::anim::FrameClock::new(&scene.descriptor).frame(0);
+    let settings = gibench_harness::cpu::reference::ReferenceSettings {
         spp: 1,
         bounces: 8,
         seed: 0,
     };
     c.bench_function(&format!("{group}/1-path-per-pixel-64x48/cornell"), |b| {
-        b.iter(|| gibench_harness::reference::render_reference(&scene, &frame, [64, 48], &settings))
+        b.iter(|| {
+            gibench_harness::cpu::reference::render_reference(&scene, &frame, [64, 48], &settings)
+        })
     });
 }
 
@@ -256,11 +258,11 @@ fn laine_management_by<M: Measurement + 'static>(c: &mut Criterion<M>, group: &s
             Scene::load_named("cornell", &assets)
         })
         .expect("cornell is generated");
-    let bvh = gibench_harness::bvh::SceneBvh::new(&scene.mesh);
+    let bvh = gibench_harness::cpu::bvh::SceneBvh::new(&scene.mesh);
     for kind in [LightKind::Spot, LightKind::Omni] {
         let mut desc = scene.descriptor.clone();
         desc.light.kind = kind;
-        let clock = gibench_harness::anim::FrameClock::new(&desc);
+        let clock = gibench_harness::scene::anim::FrameClock::new(&desc);
         for vpls in [256, 1024] {
             let mut m = gibench_laine::Manager::new(vpls, 4, 8);
             m.step(&scene, &bvh, clock.frame(0).light);
@@ -328,9 +330,9 @@ criterion_group! {
     targets = laine_management_cpu, reference_paths_cpu
 }
 // `criterion_main!`'s `main`, with this thread made a worker of the CPU pool first (as the
-// gibench binary does: see `gibench_harness::threads`).
+// gibench binary does: see `gibench_harness::cpu::threads`).
 fn main() {
-    gibench_harness::threads::join_global_pool();
+    gibench_harness::cpu::threads::join_global_pool();
     benches();
     cpu_benches();
     Criterion::default().configure_from_args().final_summary();

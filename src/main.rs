@@ -75,7 +75,7 @@ enum Command {
 }
 
 fn main() -> ExitCode {
-    gibench_harness::threads::join_global_pool();
+    gibench_harness::cpu::threads::join_global_pool();
     let cli = Cli::parse();
     let outcome = match cli.command {
         None => cli::run::exec(&RunArgs::parse_default()),

@@ -19,8 +19,8 @@
 
 use std::path::Path;
 
+use gibench_harness::cpu::reference::{camera_ray, cosine_direction, ReferenceTracer};
 use gibench_harness::glam::{Vec2, Vec3};
-use gibench_harness::reference::{camera_ray, cosine_direction, ReferenceTracer};
 use gibench_harness::scene::descriptor::LightKind;
 use gibench_harness::scene::Scene;
 use gibench_harness::{Error, Result};
@@ -53,7 +53,7 @@ fn uniform(k: u64) -> f32 {
 /// reference's BVH and ε, its camera rays and its cosine sampling (see the module docs).
 pub(crate) fn make_rays(
     scene: &Scene,
-    frame: &gibench_harness::anim::FrameState,
+    frame: &gibench_harness::scene::anim::FrameState,
     resolution: [u32; 2],
     count: u32,
 ) -> Result<(Vec<u8>, Vec<u8>)> {

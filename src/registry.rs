@@ -1,7 +1,7 @@
 //! The technique registry: every technique crate's `TechniqueInfo`, in the order `gibench list`
 //! shows them.
 
-use gibench_harness::technique::TechniqueInfo;
+use gibench_harness::kit::technique::TechniqueInfo;
 
 static ALL: [TechniqueInfo; 8] = [
     gibench_direct::INFO,

@@ -378,7 +378,7 @@ const DRAWN: usize = 7;
 /// shared 2-core development machine it passed 2 of 3 times with five a side and 1 of 3 with
 /// seven, the failures a 30 % slowdown measured as 11 to 13 % (base runs slowed by a busy
 /// moment) or a same-build stage "slower" — the machine's noise, not the statistics, which the
-/// synthetic tests above and `harness/src/stats.rs`'s check exactly.
+/// synthetic tests above and `harness/src/measure/stats.rs`'s check exactly.
 #[test]
 #[ignore = "statistical on real runs: flaky on a loaded shared machine (see its doc)"]
 fn compare_runs_end_to_end() {

@@ -17,15 +17,15 @@
 #[path = "../src/registry.rs"]
 mod registry;
 
-use gibench_harness::assets::AssetPaths;
+use gibench_harness::cpu::reference::{render_reference, ReferenceSettings};
 use gibench_harness::glam::Vec3;
+use gibench_harness::gpu::profiler::{ProfileMode, Profiler};
 use gibench_harness::gpu::{GpuContext, GpuOptions};
-use gibench_harness::profiler::{ProfileMode, Profiler};
-use gibench_harness::quality::IndirectComponent;
-use gibench_harness::reference::{render_reference, ReferenceSettings};
-use gibench_harness::runner::{Harness, RunConfig, TimingMode};
+use gibench_harness::kit::technique::TechniqueInfo;
+use gibench_harness::run::quality::IndirectComponent;
+use gibench_harness::run::runner::{Harness, RunConfig, TimingMode};
+use gibench_harness::scene::assets::AssetPaths;
 use gibench_harness::scene::Scene;
-use gibench_harness::technique::TechniqueInfo;
 
 const SIZE: [u32; 2] = [96, 72];
 const FRAMES: u32 = 3;
@@ -44,7 +44,7 @@ fn render(gpu: &GpuContext, h: &Harness, info: &TechniqueInfo, config: &RunConfi
             .expect("frame renders");
     }
     profiler.finish(gpu).expect("frames finish");
-    gibench_harness::image_io::read_rgb_f32(gpu, t.output().texture())
+    gibench_harness::gpu::image_io::read_rgb_f32(gpu, t.output().texture())
         .expect("output reads back")
         .into_iter()
         .map(Vec3::from)

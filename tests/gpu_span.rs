@@ -2,7 +2,7 @@
 
 mod support;
 
-use gibench_harness::results::RunResult;
+use gibench_harness::measure::results::RunResult;
 
 /// A real `laine` run with frame timing (its frames have a CPU stage between GPU stages, so
 /// the stages' order on the queue is not the order of the code alone). Per measured frame:

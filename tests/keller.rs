@@ -4,11 +4,11 @@
 //! the reference's (VPL clamping and shadow-map bias only darken). Also: colour bleeds from the
 //! red wall.
 
-use gibench_harness::assets::AssetPaths;
+use gibench_harness::cpu::reference::{render_reference, ReferenceSettings};
 use gibench_harness::glam::Vec3;
 use gibench_harness::gpu::{GpuContext, GpuOptions};
-use gibench_harness::reference::{render_reference, ReferenceSettings};
-use gibench_harness::runner::{Harness, RunConfig, TimingMode};
+use gibench_harness::run::runner::{Harness, RunConfig, TimingMode};
+use gibench_harness::scene::assets::AssetPaths;
 use gibench_harness::scene::Scene;
 
 #[test]
@@ -50,18 +50,18 @@ fn keller_full_matches_the_reference_one_bounce() {
             .unwrap();
         let prepared = h.prepare(info, &params, &config).unwrap();
         let (mut t, compose) = h.build(info, &params, &config, &prepared).unwrap();
-        let mut profiler = gibench_harness::profiler::Profiler::new(
+        let mut profiler = gibench_harness::gpu::profiler::Profiler::new(
             &gpu,
-            gibench_harness::profiler::ProfileMode::Stages,
+            gibench_harness::gpu::profiler::ProfileMode::Stages,
         );
         h.render_frame(t.as_mut(), &compose, &mut profiler, &frame, false)
             .unwrap();
-        let e: Vec<Vec3> = gibench_harness::image_io::read_rgb_f32(&gpu, t.output().texture())
+        let e: Vec<Vec3> = gibench_harness::gpu::image_io::read_rgb_f32(&gpu, t.output().texture())
             .unwrap()
             .into_iter()
             .map(Vec3::from)
             .collect();
-        let rel = gibench_harness::metrics::relative_mse(&e, &r.one_bounce, &r.hit);
+        let rel = gibench_harness::measure::metrics::relative_mse(&e, &r.one_bounce, &r.hit);
         let (mut a, mut b) = (0.0f64, 0.0f64);
         for ((t, x), hit) in e.iter().zip(&r.one_bounce).zip(&r.hit) {
             if *hit {

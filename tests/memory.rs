@@ -15,9 +15,9 @@
 #[path = "../src/registry.rs"]
 mod registry;
 
-use gibench_harness::assets::AssetPaths;
-use gibench_harness::profiler::{ProfileMode, Profiler};
-use gibench_harness::runner::{process_memory_mb, Harness, RunConfig, TimingMode};
+use gibench_harness::gpu::profiler::{ProfileMode, Profiler};
+use gibench_harness::run::runner::{process_memory_mb, Harness, RunConfig, TimingMode};
+use gibench_harness::scene::assets::AssetPaths;
 use gibench_harness::scene::Scene;
 
 const MAX_GROWTH_MB: f64 = 12.0;

@@ -7,8 +7,8 @@ mod support;
 
 use std::path::Path;
 
-use gibench_harness::results::RunResult;
-use gibench_harness::roofline::roofline;
+use gibench_harness::measure::results::RunResult;
+use gibench_harness::measure::roofline::roofline;
 
 /// `direct` on the Cornell box, 3 frames of stage timing at 64x48, into `out`; with the hook
 /// adding `slow_ms` to `direct-light` when given.

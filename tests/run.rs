@@ -2,7 +2,7 @@
 
 mod support;
 
-use gibench_harness::results::RunResult;
+use gibench_harness::measure::results::RunResult;
 
 fn run_ok(args: &[&str], out: &std::path::Path) -> String {
     let o = support::gibench()
@@ -381,7 +381,7 @@ fn a_run_that_skips_nothing_leaves_no_list_of_skipped_techniques() {
 /// built more than once, and a second run that renders what the cache holds.
 #[test]
 fn quality_run_builds_the_static_tree_once_and_movers_per_frame() {
-    use gibench_harness::metrics::ReferenceWork;
+    use gibench_harness::measure::metrics::ReferenceWork;
     let tmp = tempfile::tempdir().unwrap();
     let cache = tmp.path().join("cache");
     let run = |out: &str| {

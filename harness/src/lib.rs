@@ -1,11 +1,18 @@
 //! # gibench-harness
 //!
-//! Everything the techniques share, written once: the GPU context ([`gpu`]), the scene model and
-//! its loaders ([`scene`]), the deterministic animation clock ([`anim`]), CPU ray casting over the
-//! static geometry ([`bvh`]), the one light model ([`light`]), the shared GPU passes
-//! ([`passes`]), the instant-radiosity kit ([`ir`]), the profiler ([`profiler`]), the
-//! technique interface ([`technique`]), the frame loop ([`runner`]), results ([`results`]) and
-//! their tables and plots ([`report`]).
+//! Everything the techniques share, written once, in folders by concern. Each folder uses only
+//! the ones above it in this list (`harness/tests/layers.rs` checks it):
+//!
+//! * [`error`], [`output`] and [`rng`]: errors; atomic files and output sets; random numbers;
+//! * [`measure`]: statistics, image metrics, the timer calibration, the results file model,
+//!   the roofline's costs and bounds;
+//! * [`scene`]: the scene model and its loaders, the asset search path, the animation clock;
+//! * [`cpu`]: the BVH over the static geometry, the one light model, VPL paths, the reference
+//!   path tracer;
+//! * [`gpu`]: the GPU context, the profiler, image read-back and image files;
+//! * [`kit`]: the technique interface, the shared GPU passes, the instant-radiosity kit;
+//! * [`run`]: the frame loop, the quality pass, a session of runs, the bounds' kernels;
+//! * [`report`]: tables, plots, comparisons of results and the HTML page.
 //!
 //! ## Radiometric convention
 //!
@@ -26,35 +33,16 @@
 //! * The composed outgoing radiance of a diffuse pixel is L = (ρ / π)(E_direct + E_ind).
 //! * PNG images are `clamp(exposure · L)` encoded as sRGB; the exposure is a scene setting.
 
-pub mod anim;
-pub mod assets;
-pub mod bounds;
-pub mod bvh;
-pub mod calibrate;
-pub mod compare;
+pub mod cpu;
 pub mod error;
 pub mod gpu;
-pub mod html;
-pub mod image_io;
-pub mod ir;
-pub mod light;
-pub mod metrics;
+pub mod kit;
+pub mod measure;
 pub mod output;
-pub mod passes;
-pub mod profiler;
-pub mod quality;
-pub mod reference;
 pub mod report;
-pub mod results;
 pub mod rng;
-pub mod roofline;
-pub mod runner;
+pub mod run;
 pub mod scene;
-pub mod session;
-pub mod stats;
-pub mod technique;
-pub mod threads;
-pub mod vpl;
 
 pub use error::{Error, Result};
 pub use glam;

@@ -2,10 +2,10 @@
 //! direct irradiance equals I(ω) cos θ / r² with CPU ray-cast visibility, away from shadow
 //! boundaries; and Vulkan and GL agree. Needs a GPU adapter (lavapipe and llvmpipe are enough).
 
-use gibench_harness::assets::AssetPaths;
 use gibench_harness::gpu::{GpuContext, GpuOptions};
+use gibench_harness::scene::assets::AssetPaths;
 
-use gibench_harness::runner::{Harness, RunConfig, TimingMode};
+use gibench_harness::run::runner::{Harness, RunConfig, TimingMode};
 use gibench_harness::scene::descriptor::LightKind;
 use gibench_harness::scene::Scene;
 
@@ -35,7 +35,7 @@ fn direct_irradiance(backend: &str, frame_index: u32) -> Vec<Option<(f32, f32)>>
         .encode_shadow_map(&mut enc, &h.gpu_scene, &h.uniforms, &frame.light);
     h.direct.encode_lighting(&mut enc, &h.gbuffer);
     gpu.queue.submit([enc.finish()]);
-    let gpu_e = gibench_harness::image_io::read_rgb_f32(&gpu, &h.direct.irradiance).unwrap();
+    let gpu_e = gibench_harness::gpu::image_io::read_rgb_f32(&gpu, &h.direct.irradiance).unwrap();
     let g = h.gbuffer.export(&gpu).unwrap();
     let light = frame.light;
     assert_eq!(light.kind, LightKind::Spot);
@@ -76,7 +76,7 @@ fn direct_pass_matches_reference_direct_sun() {
 }
 
 fn direct_pass_matches_reference_direct_on(scene_name: &str) {
-    use gibench_harness::reference::{render_reference, ReferenceSettings};
+    use gibench_harness::cpu::reference::{render_reference, ReferenceSettings};
     let scene = Scene::load_named(scene_name, &AssetPaths::standard(None)).unwrap();
     let gpu = GpuContext::new(&GpuOptions::default()).expect("a GPU adapter (Vulkan or GL)");
     let [w, h] = [128u32, 96];
@@ -95,16 +95,16 @@ fn direct_pass_matches_reference_direct_on(scene_name: &str) {
     for frame_index in [0, 40] {
         let prepared = harness.prepare(&info, &params, &config).unwrap();
         let (mut technique, compose) = harness.build(&info, &params, &config, &prepared).unwrap();
-        let mut profiler = gibench_harness::profiler::Profiler::new(
+        let mut profiler = gibench_harness::gpu::profiler::Profiler::new(
             &gpu,
-            gibench_harness::profiler::ProfileMode::Stages,
+            gibench_harness::gpu::profiler::ProfileMode::Stages,
         );
         let frame = harness.clock.frame(frame_index);
         harness
             .render_frame(technique.as_mut(), &compose, &mut profiler, &frame, false)
             .unwrap();
         let gpu_e =
-            gibench_harness::image_io::read_rgb_f32(&gpu, &harness.direct.irradiance).unwrap();
+            gibench_harness::gpu::image_io::read_rgb_f32(&gpu, &harness.direct.irradiance).unwrap();
         let settings = ReferenceSettings {
             spp: 1,
             bounces: 1,
@@ -149,7 +149,7 @@ fn direct_pass_matches_reference_direct_on(scene_name: &str) {
 }
 
 /// The `direct` technique's registry entry, built here without the root crate.
-fn gibench_direct_info() -> gibench_harness::technique::TechniqueInfo {
+fn gibench_direct_info() -> gibench_harness::kit::technique::TechniqueInfo {
     gibench_direct::INFO
 }
 

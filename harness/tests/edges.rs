@@ -3,11 +3,11 @@
 //! (blocks against walls, the open front) but not the interiors of flat walls, and widens with
 //! the step. Runs on Vulkan and GL.
 
-use gibench_harness::assets::AssetPaths;
 use gibench_harness::gpu::{GpuContext, GpuOptions};
-use gibench_harness::ir::edges::{EdgeMask, EdgeSettings};
-use gibench_harness::passes::GBufferTexels;
-use gibench_harness::runner::{Harness, RunConfig, TimingMode};
+use gibench_harness::kit::ir::edges::{EdgeMask, EdgeSettings};
+use gibench_harness::kit::passes::GBufferTexels;
+use gibench_harness::run::runner::{Harness, RunConfig, TimingMode};
+use gibench_harness::scene::assets::AssetPaths;
 use gibench_harness::scene::Scene;
 
 const W: u32 = 160;

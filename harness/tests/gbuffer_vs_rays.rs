@@ -1,10 +1,10 @@
 //! The G-buffer read back from the GPU agrees with CPU ray casts through the same pixel centres
 //! (hit position and normal) on the Cornell box. Needs a GPU adapter (lavapipe is enough).
 
-use gibench_harness::assets::AssetPaths;
 use gibench_harness::glam::{Vec3, Vec4};
 use gibench_harness::gpu::{GpuContext, GpuOptions};
-use gibench_harness::runner::{Harness, RunConfig, TimingMode};
+use gibench_harness::run::runner::{Harness, RunConfig, TimingMode};
+use gibench_harness::scene::assets::AssetPaths;
 use gibench_harness::scene::Scene;
 
 fn check_backend(backend: Option<&str>) {

@@ -6,7 +6,9 @@
 use std::time::{Duration, Instant};
 
 use gibench_harness::gpu::{available_backends, say_uncaptured, GpuContext, GpuOptions};
-use gibench_harness::passes::{draw_fullscreen, fullscreen_pipeline, render_target, shader_module};
+use gibench_harness::kit::passes::{
+    draw_fullscreen, fullscreen_pipeline, render_target, shader_module,
+};
 use gibench_harness::wgpu;
 
 /// Each pixel of a fullscreen draw steps a linear congruential generator [`STEPS`] times from

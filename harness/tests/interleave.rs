@@ -3,13 +3,13 @@
 //! output through a `texture_storage_2d<rgba16float, write>` binding, which these tests read
 //! back on both backends.
 
-use gibench_harness::assets::AssetPaths;
 use gibench_harness::glam::Vec3;
 use gibench_harness::gpu::GpuContext;
 use gibench_harness::gpu::{backend_context, backends_for};
-use gibench_harness::ir::interleave::{FilterSettings, Interleave, INTERLEAVE_WGSL};
-use gibench_harness::passes::{shader_module, GBufferTexels};
-use gibench_harness::runner::{Harness, RunConfig, TimingMode};
+use gibench_harness::kit::ir::interleave::{FilterSettings, Interleave, INTERLEAVE_WGSL};
+use gibench_harness::kit::passes::{shader_module, GBufferTexels};
+use gibench_harness::run::runner::{Harness, RunConfig, TimingMode};
+use gibench_harness::scene::assets::AssetPaths;
 use gibench_harness::scene::Scene;
 use gibench_harness::wgpu;
 use gibench_harness::Error;
@@ -48,7 +48,7 @@ fn with_cornell(gpu: &GpuContext, resolution: [u32; 2], f: impl FnOnce(&Harness,
 }
 
 fn output_texture(gpu: &GpuContext, size: [u32; 2]) -> wgpu::Texture {
-    gibench_harness::passes::indirect_target(&gpu.device, size, true)
+    gibench_harness::kit::passes::indirect_target(&gpu.device, size, true)
 }
 
 /// Reads a buffer of `vec4<f32>` back to the CPU.
@@ -102,7 +102,7 @@ fn filter(
     inter.encode_split(&mut enc);
     inter.encode_filter(&mut enc);
     gpu.queue.submit([enc.finish()]);
-    let out = gibench_harness::image_io::read_rgb_f32(gpu, output).unwrap();
+    let out = gibench_harness::gpu::image_io::read_rgb_f32(gpu, output).unwrap();
     gpu.check_errors().unwrap();
     out
 }

@@ -6,15 +6,15 @@
 use gibench_test_support::readback::read_bytes as read_buffer;
 use gibench_test_support::scene as support;
 
+use gibench_harness::cpu::vpl::{frame_from_normal, Vpl};
 use gibench_harness::glam::Vec3;
 use gibench_harness::gpu::GpuContext;
 use gibench_harness::gpu::{backend_context, backends_for};
-use gibench_harness::ir::atlas::{AtlasFormat, AtlasSettings, MapKind, ShadowAtlas};
-use gibench_harness::ir::pullpush::PullPush;
-use gibench_harness::ir::splat::PointSplat;
-use gibench_harness::ir::store::VplStore;
+use gibench_harness::kit::ir::atlas::{AtlasFormat, AtlasSettings, MapKind, ShadowAtlas};
+use gibench_harness::kit::ir::pullpush::PullPush;
+use gibench_harness::kit::ir::splat::PointSplat;
+use gibench_harness::kit::ir::store::VplStore;
 use gibench_harness::scene::{Mesh, SceneExtent};
-use gibench_harness::vpl::{frame_from_normal, Vpl};
 use gibench_harness::wgpu;
 
 /// The plane z = 1, x and y in [-2, 2], as a mesh (for the scene extent the atlas's far
@@ -77,7 +77,7 @@ fn points_buffer(gpu: &GpuContext, points: &[Vec3]) -> (wgpu::Buffer, wgpu::Buff
 
 /// Slot `slot`'s map out of the atlas, row-major.
 fn read_map(gpu: &GpuContext, atlas: &ShadowAtlas, slot: u32) -> Vec<f32> {
-    let bytes = gibench_harness::image_io::read_texture(gpu, atlas.texture()).unwrap();
+    let bytes = gibench_harness::gpu::image_io::read_texture(gpu, atlas.texture()).unwrap();
     let width = atlas.texture().width() as usize;
     let size = atlas.settings.size;
     let ([ox, oy], _) = atlas.block(slot);
@@ -303,9 +303,9 @@ fn sample_vpls(
     texels: [&[gibench_harness::glam::Vec4]; 3],
     side: u32,
     n: u32,
-    warp: gibench_harness::ir::vpl_sample::VplWarp,
+    warp: gibench_harness::kit::ir::vpl_sample::VplWarp,
 ) -> (Vec<[f32; 20]>, Vec3) {
-    use gibench_harness::ir::vpl_sample::{RsmTexels, VplSampler};
+    use gibench_harness::kit::ir::vpl_sample::{RsmTexels, VplSampler};
     let upload = |data: &[gibench_harness::glam::Vec4]| {
         let raw: Vec<[f32; 4]> = data.iter().map(|v| v.to_array()).collect();
         let b = gpu.device.create_buffer(&wgpu::BufferDescriptor {
@@ -361,7 +361,7 @@ fn sample_vpls(
 /// row, misses it by far more).
 #[test]
 fn sampled_vpls_carry_the_flux_the_map_saw() {
-    use gibench_harness::ir::vpl_sample::VplWarp;
+    use gibench_harness::kit::ir::vpl_sample::VplWarp;
     const SIDE: u32 = 64;
     const N: u32 = 256;
     let texels = SIDE * SIDE;
@@ -447,7 +447,7 @@ fn sampled_vpls_carry_the_flux_the_map_saw() {
 /// second for a `flat` warp that stopped being flattened.
 #[test]
 fn the_row_column_warp_keeps_vpls_in_place_when_the_light_changes_a_little() {
-    use gibench_harness::ir::vpl_sample::VplWarp;
+    use gibench_harness::kit::ir::vpl_sample::VplWarp;
     const SIDE: u32 = 64;
     const N: u32 = 256;
     let map = |gain: f32| {
@@ -496,11 +496,11 @@ fn the_row_column_warp_keeps_vpls_in_place_when_the_light_changes_a_little() {
 /// light's map is taken from its centre, the direct pass's simplification).
 #[test]
 fn reflective_shadow_map_carries_the_first_bounce_flux() {
-    use gibench_harness::assets::AssetPaths;
-    use gibench_harness::ir::rsm::ReflectiveShadowMap;
-    use gibench_harness::runner::{Harness, RunConfig, TimingMode};
+    use gibench_harness::cpu::vpl::{self, VplSettings};
+    use gibench_harness::kit::ir::rsm::ReflectiveShadowMap;
+    use gibench_harness::run::runner::{Harness, RunConfig, TimingMode};
+    use gibench_harness::scene::assets::AssetPaths;
     use gibench_harness::scene::Scene;
-    use gibench_harness::vpl::{self, VplSettings};
     for backend in backends_for("ism_kit") {
         let gpu = backend_context(backend);
         for name in ["cornell", "cornell-omni", "cornell-area", "cornell-sun"] {

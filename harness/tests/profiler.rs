@@ -3,9 +3,9 @@
 //! does), and no other thread of the process (the GPU driver's, which on lavapipe and llvmpipe
 //! run the GPU's work on the CPU).
 
-use gibench_harness::calibrate::thread_cpu_ms;
+use gibench_harness::gpu::profiler::{ProfileMode, Profiler};
 use gibench_harness::gpu::{GpuContext, GpuOptions};
-use gibench_harness::profiler::{ProfileMode, Profiler};
+use gibench_harness::measure::calibrate::thread_cpu_ms;
 
 /// Keeps the calling thread busy until it has used `ms` of CPU time.
 fn burn(ms: f64) {

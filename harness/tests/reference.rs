@@ -4,12 +4,12 @@
 
 use std::f32::consts::PI;
 
-use gibench_harness::anim::{CameraPose, FrameClock, FrameState, LightPose};
-use gibench_harness::assets::AssetPaths;
-use gibench_harness::glam::{Mat4, Vec2, Vec3};
-use gibench_harness::reference::{
+use gibench_harness::cpu::reference::{
     camera_ray, render_reference, ReferenceImages, ReferenceSettings, ReferenceTracer,
 };
+use gibench_harness::glam::{Mat4, Vec2, Vec3};
+use gibench_harness::scene::anim::{CameraPose, FrameClock, FrameState, LightPose};
+use gibench_harness::scene::assets::AssetPaths;
 use gibench_harness::scene::descriptor::LightKind;
 use gibench_harness::scene::{Material, Mesh, Mover, Scene, Texture};
 
@@ -650,8 +650,8 @@ fn reference_default_settings_timing_and_noise() {
 /// per frame.
 #[test]
 fn reference_trees_answer_as_one_tree_over_the_frame_mesh() {
-    use gibench_harness::bvh::{SceneBvh, SceneTrees, TreeBuilds};
-    use gibench_harness::reference::frame_mesh;
+    use gibench_harness::cpu::bvh::{SceneBvh, SceneTrees, TreeBuilds};
+    use gibench_harness::cpu::reference::frame_mesh;
     use gibench_harness::rng::SplitMix64;
     let scene = Scene::load_named("cornell-bunny", &AssetPaths::standard(None)).unwrap();
     let clock = FrameClock::new(&scene.descriptor);

@@ -1,11 +1,11 @@
-//! The roofline's bound kernels ([`gibench_harness::roofline`]): the copy moves what it claims,
+//! The roofline's bound kernels ([`gibench_harness::measure::roofline`]): the copy moves what it claims,
 //! the FMA kernel does the operations it claims, and the bounds are those counts over the
 //! kernels' times. On every portable backend present.
 
-use gibench_harness::bounds::{
+use gibench_harness::measure::roofline::{roofline, Binding, BoundTimer, StageCost};
+use gibench_harness::run::bounds::{
     copy_pattern, fma_model, measure_bounds, BoundKernels, FmaParams, FMA_WORKGROUP,
 };
-use gibench_harness::roofline::{roofline, Binding, BoundTimer, StageCost};
 use gibench_test_support::gpu::gpus;
 
 /// The copy kernel over a buffer of B bytes writes every one of its B / 16 elements with the

@@ -6,10 +6,10 @@
 
 use std::path::Path;
 
-use gibench_harness::anim::FrameClock;
-use gibench_harness::assets::AssetPaths;
-use gibench_harness::bvh::SceneBvh;
+use gibench_harness::cpu::bvh::SceneBvh;
 use gibench_harness::glam::Vec3;
+use gibench_harness::scene::anim::FrameClock;
+use gibench_harness::scene::assets::AssetPaths;
 use gibench_harness::scene::gltf_load::{load_gltf, load_gltf_with_offsets};
 use gibench_harness::scene::{descriptor::builtin_names, PunctualKind, Scene, SceneDescriptor};
 use gibench_harness::Error;

@@ -9,10 +9,10 @@ use rayon::prelude::*;
 #[test]
 fn the_calling_thread_becomes_a_worker_of_the_global_pool() {
     assert_eq!(rayon::current_thread_index(), None);
-    gibench_harness::threads::join_global_pool();
+    gibench_harness::cpu::threads::join_global_pool();
     assert_eq!(rayon::current_thread_index(), Some(0));
     let sum: u64 = (0..100_000u64).into_par_iter().map(|i| i * i).sum();
     assert_eq!(sum, (0..100_000u64).map(|i| i * i).sum::<u64>());
-    gibench_harness::threads::join_global_pool();
+    gibench_harness::cpu::threads::join_global_pool();
     assert_eq!(rayon::current_thread_index(), Some(0));
 }

@@ -3,16 +3,16 @@
 //! absorption, the spot's sampling distribution, incremental continuation and determinism.
 //! Scenes are built in code, plus the Cornell box. No GPU needed.
 
-use gibench_harness::anim::{FrameClock, LightPose};
-use gibench_harness::assets::AssetPaths;
-use gibench_harness::bvh::SceneBvh;
-use gibench_harness::glam::{Vec2, Vec3};
-use gibench_harness::scene::descriptor::LightKind;
-use gibench_harness::scene::{Mesh, Scene};
-use gibench_harness::vpl::{
+use gibench_harness::cpu::bvh::SceneBvh;
+use gibench_harness::cpu::vpl::{
     continuing_paths, disc_to_hemisphere, generate, halton, hemisphere_to_disc, mean_reflectance,
     radical_inverse, square_to_disc, square_to_sphere, to_local, total_flux, Vpl, VplSettings,
 };
+use gibench_harness::glam::{Vec2, Vec3};
+use gibench_harness::scene::anim::{FrameClock, LightPose};
+use gibench_harness::scene::assets::AssetPaths;
+use gibench_harness::scene::descriptor::LightKind;
+use gibench_harness::scene::{Mesh, Scene};
 
 use gibench_test_support::scene::{closed_box_mesh, material, quad, scene};
 

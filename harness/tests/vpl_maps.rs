@@ -4,19 +4,19 @@
 //! receivers; the accumulation's irradiance clamp bounds each VPL's irradiance at k / A times
 //! the store's summed flux. Runs on Vulkan and GL.
 
-use gibench_harness::assets::AssetPaths;
+use gibench_harness::cpu::light::point_irradiance;
+use gibench_harness::cpu::vpl::{frame_from_normal, Vpl};
 use gibench_harness::glam::Vec3;
 use gibench_harness::gpu::{backend_context, backends_for};
-use gibench_harness::ir::accumulate::{Accumulation, IrradianceClamp};
-use gibench_harness::ir::atlas::{AtlasFormat, AtlasSettings, MapKind, ShadowAtlas};
-use gibench_harness::ir::interleave::{FilterSettings, Interleave};
-use gibench_harness::ir::raster::{AtlasClear, AtlasRasteriser};
-use gibench_harness::ir::store::VplStore;
-use gibench_harness::light::point_irradiance;
-use gibench_harness::passes::DrawSet;
-use gibench_harness::runner::{Harness, RunConfig, TimingMode};
+use gibench_harness::kit::ir::accumulate::{Accumulation, IrradianceClamp};
+use gibench_harness::kit::ir::atlas::{AtlasFormat, AtlasSettings, MapKind, ShadowAtlas};
+use gibench_harness::kit::ir::interleave::{FilterSettings, Interleave};
+use gibench_harness::kit::ir::raster::{AtlasClear, AtlasRasteriser};
+use gibench_harness::kit::ir::store::VplStore;
+use gibench_harness::kit::passes::DrawSet;
+use gibench_harness::run::runner::{Harness, RunConfig, TimingMode};
+use gibench_harness::scene::assets::AssetPaths;
 use gibench_harness::scene::Scene;
-use gibench_harness::vpl::{frame_from_normal, Vpl};
 use gibench_harness::wgpu;
 
 use gibench_test_support::scene as support;
@@ -82,7 +82,7 @@ fn one_vpl_in(
     let harness = Harness::new(&gpu, scene, &config).unwrap();
     let frame = harness.clock.frame(0);
     harness.uniforms.write(&gpu.queue, &frame);
-    let output = gibench_harness::passes::indirect_target(&gpu.device, [w, h], true);
+    let output = gibench_harness::kit::passes::indirect_target(&gpu.device, [w, h], true);
     // 1x1 tiles and a filter that never averages: the output is the raw accumulation.
     let interleave = Interleave::new(
         &gpu,
@@ -197,7 +197,7 @@ fn one_vpl_in(
     interleave.encode_combine(&mut enc);
     interleave.encode_filter(&mut enc);
     gpu.queue.submit([enc.finish()]);
-    let e = gibench_harness::image_io::read_rgb_f32(&gpu, &output).unwrap();
+    let e = gibench_harness::gpu::image_io::read_rgb_f32(&gpu, &output).unwrap();
     let g = harness.gbuffer.export(&gpu).unwrap();
     (0..e.len())
         .map(|i| {

@@ -8,9 +8,9 @@
 //! `GIBENCH_TEST_SLOW_KERNEL=NAME` runs that kernel's body twice: a deliberate regression for
 //! testing the gate, never set otherwise.
 
-use gibench_harness::assets::AssetPaths;
-use gibench_harness::bvh::SceneBvh;
+use gibench_harness::cpu::bvh::SceneBvh;
 use gibench_harness::glam::{DVec3, Vec3};
+use gibench_harness::scene::assets::AssetPaths;
 use gibench_harness::scene::Scene;
 use gibench_laine::domain::{DomainKind, SamplingDomain};
 
@@ -41,10 +41,10 @@ pub struct Setup {
 fn setup() -> Setup {
     let scene = Scene::load_named("cornell", &AssetPaths::standard(None)).expect("cornell");
     let bvh = SceneBvh::new(&scene.mesh);
-    let light = gibench_harness::anim::FrameClock::new(&scene.descriptor)
+    let light = gibench_harness::scene::anim::FrameClock::new(&scene.descriptor)
         .frame(0)
         .light;
-    let dirs = gibench_harness::vpl::fibonacci_sphere(1024);
+    let dirs = gibench_harness::cpu::vpl::fibonacci_sphere(1024);
     let targets = dirs
         .iter()
         .filter_map(|d| bvh.closest_hit(light.position, *d, 0.0, f32::INFINITY))
@@ -109,7 +109,7 @@ fn domain_frame(d: &mut SamplingDomain, round: u64) -> f64 {
 #[inline(never)]
 #[no_mangle]
 pub extern "Rust" fn gibench_kernel_body(name: &str, s: &mut Setup, round: u64) -> f64 {
-    let light = gibench_harness::anim::FrameClock::new(&s.scene.descriptor)
+    let light = gibench_harness::scene::anim::FrameClock::new(&s.scene.descriptor)
         .frame(0)
         .light;
     match name {
@@ -156,7 +156,7 @@ pub extern "Rust" fn gibench_kernel_body(name: &str, s: &mut Setup, round: u64) 
         "domain-voronoi-areas-disc-256" => s.disc.voronoi_areas().iter().map(|(_, a)| a).sum(),
         "vpl-generation-cornell" => {
             let rho = s.scene.average_reflectance().max_element();
-            gibench_harness::vpl::generate_at_least(&s.scene, &s.bvh, &light, 256, 1, rho)
+            gibench_harness::cpu::vpl::generate_at_least(&s.scene, &s.bvh, &light, 256, 1, rho)
                 .1
                 .len() as f64
         }
@@ -165,7 +165,7 @@ pub extern "Rust" fn gibench_kernel_body(name: &str, s: &mut Setup, round: u64) 
 }
 
 fn main() -> std::process::ExitCode {
-    gibench_harness::threads::join_global_pool();
+    gibench_harness::cpu::threads::join_global_pool();
     let args: Vec<String> = std::env::args().skip(1).collect();
     match args
         .iter()

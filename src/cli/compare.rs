@@ -4,9 +4,9 @@
 use std::path::{Path, PathBuf};
 
 use clap::Args;
+use gibench_harness::measure::results::RunResult;
 use gibench_harness::output::OutputSet;
 use gibench_harness::report;
-use gibench_harness::results::RunResult;
 use gibench_harness::{Error, Result};
 
 use super::files::check_stem;
@@ -21,10 +21,10 @@ pub(crate) struct CompareArgs {
     /// Smallest relative change a verdict needs: slower only when the median ratio is above
     /// 1 + tolerance (and the rank test's p is below --alpha); 0.25 keeps a shared CPU's
     /// run-to-run drift from deciding.
-    #[arg(long, default_value_t = gibench_harness::compare::DEFAULT_TOLERANCE)]
+    #[arg(long, default_value_t = gibench_harness::report::compare::DEFAULT_TOLERANCE)]
     tolerance: f64,
     /// Significance level of the two-sided Mann–Whitney U test a verdict needs (p < alpha).
-    #[arg(long, default_value_t = gibench_harness::compare::DEFAULT_ALPHA)]
+    #[arg(long, default_value_t = gibench_harness::report::compare::DEFAULT_ALPHA)]
     alpha: f64,
     /// Decide on each repeat divided by the calibration workload timed in its session (for
     /// runs made in sessions far apart, such as a committed baseline); without it the verdict
@@ -46,8 +46,11 @@ pub(crate) struct CompareArgs {
 /// `gibench compare`: reads both sides, compares, prints and writes the table and JSON.
 pub(crate) fn exec(args: &CompareArgs) -> Result<()> {
     check_stem(&args.stem)?;
-    let settings =
-        gibench_harness::compare::Settings::new(args.tolerance, args.alpha, args.calibrate)?;
+    let settings = gibench_harness::report::compare::Settings::new(
+        args.tolerance,
+        args.alpha,
+        args.calibrate,
+    )?;
     let base = results_under("base", &args.base)?;
     let current = results_under("current", &args.current)?;
     check_distinct_runs(args, &base, &current)?;
@@ -55,7 +58,7 @@ pub(crate) fn exec(args: &CompareArgs) -> Result<()> {
         base.into_iter().map(|(_, r)| r).collect(),
         current.into_iter().map(|(_, r)| r).collect(),
     );
-    let unmatched = gibench_harness::compare::unmatched(&base, &current);
+    let unmatched = gibench_harness::report::compare::unmatched(&base, &current);
     let listing: Vec<String> = ["BASE", "CURRENT"]
         .iter()
         .zip(&unmatched)
@@ -73,8 +76,8 @@ pub(crate) fn exec(args: &CompareArgs) -> Result<()> {
             ),
         ));
     }
-    let rows = gibench_harness::compare::compare(&base, &current, &settings)?;
-    let mut table = gibench_harness::compare::compare_table(&rows, &settings);
+    let rows = gibench_harness::report::compare::compare(&base, &current, &settings)?;
+    let mut table = gibench_harness::report::compare::compare_table(&rows, &settings);
     if !listing.is_empty() {
         let note = format!("Not compared (on one side only): {}.", listing.join("; "));
         eprintln!("warning: {note}");

@@ -22,10 +22,10 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use clap::{Args, ValueEnum};
-use gibench_harness::compare::group;
+use gibench_harness::measure::results::RunResult;
+use gibench_harness::measure::stats::median;
+use gibench_harness::report::compare::group;
 use gibench_harness::report::stage_ms;
-use gibench_harness::results::RunResult;
-use gibench_harness::stats::median;
 use gibench_harness::{Error, Result};
 use serde_json::{json, Map, Value};
 
@@ -260,7 +260,7 @@ fn bmf(
                 ms.iter().map(|m| m * NS_PER_MS).collect(),
             );
         }
-        let frames: Vec<&gibench_harness::results::FrameResult> =
+        let frames: Vec<&gibench_harness::measure::results::FrameResult> =
             repeats.iter().filter_map(|r| r.frame.as_ref()).collect();
         add(
             format!("{prefix}/frame"),

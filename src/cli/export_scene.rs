@@ -7,8 +7,8 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use gibench_harness::assets::AssetPaths;
 use gibench_harness::output::OutputSet;
+use gibench_harness::scene::assets::AssetPaths;
 use gibench_harness::scene::{Scene, SceneDescriptor};
 use gibench_harness::{Error, Result};
 
@@ -65,7 +65,7 @@ fn ply(positions: &[[f32; 3]], tris: &[[u32; 3]]) -> Vec<u8> {
 
 pub(crate) fn exec(args: &ExportArgs) -> Result<()> {
     let resolution = super::params::parse_resolution(&args.resolution)?;
-    gibench_harness::runner::check_resolution(resolution)?;
+    gibench_harness::run::runner::check_resolution(resolution)?;
     super::params::check_frame_number("frame", args.frame)?;
     if args.rays > crate::rays::MAX_RAYS {
         return Err(Error::param(
@@ -81,8 +81,8 @@ pub(crate) fn exec(args: &ExportArgs) -> Result<()> {
     let desc = SceneDescriptor::resolve(&args.scene)?;
     let scene = Scene::load(&desc, &AssetPaths::standard(args.assets.as_deref()))?;
     super::files::writable_dir("out", &args.out)?;
-    let frame = gibench_harness::anim::FrameClock::new(&desc).frame(args.frame);
-    let mesh = gibench_harness::reference::frame_mesh(&scene, &frame);
+    let frame = gibench_harness::scene::anim::FrameClock::new(&desc).frame(args.frame);
+    let mesh = gibench_harness::cpu::reference::frame_mesh(&scene, &frame);
     // Triangles per material (a triangle's material is its first vertex's), each with its
     // own compact vertex list.
     let mut groups: Vec<Group> = (0..scene.materials.len())

@@ -219,7 +219,7 @@ fn write_baseline(
     let json = serde_json::json!({
         "valgrind": valgrind,
         "rustc": rustc,
-        "git_commit": gibench_harness::runner::git_commit(),
+        "git_commit": gibench_harness::run::runner::git_commit(),
         "kernels": counts,
     });
     let bytes = serde_json::to_vec_pretty(&json).map_err(|e| Error::Invalid(e.to_string()))?;

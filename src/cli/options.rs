@@ -4,8 +4,8 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use gibench_harness::quality::ReferenceCache;
-use gibench_harness::reference::ReferenceSettings;
+use gibench_harness::cpu::reference::ReferenceSettings;
+use gibench_harness::run::quality::ReferenceCache;
 use gibench_harness::{Error, Result};
 
 #[derive(Args, Clone)]

@@ -1,10 +1,10 @@
-//! The HTML page a command writes with `--html` ([`gibench_harness::html`]): its command line,
+//! The HTML page a command writes with `--html` ([`gibench_harness::report::html`]): its command line,
 //! the runs with their folders, and the line pointing the user at it.
 
 use std::path::{Path, PathBuf};
 
+use gibench_harness::measure::results::RunResult;
 use gibench_harness::report;
-use gibench_harness::results::RunResult;
 use gibench_harness::Result;
 
 /// The runs paired with the folder they were written to.
@@ -24,7 +24,7 @@ pub(crate) fn command_line() -> String {
         .join(" ")
 }
 
-/// Writes an HTML page ([`gibench_harness::html`]) with this process's command line.
+/// Writes an HTML page ([`gibench_harness::report::html`]) with this process's command line.
 pub(crate) fn write_page(
     path: &Path,
     title: String,
@@ -32,7 +32,7 @@ pub(crate) fn write_page(
     figures: Vec<PathBuf>,
     runs: Vec<(PathBuf, RunResult)>,
 ) -> Result<()> {
-    gibench_harness::html::Page {
+    gibench_harness::report::html::Page {
         title,
         command: command_line(),
         tables,

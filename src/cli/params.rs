@@ -1,7 +1,7 @@
 //! Parsing and checking option values several commands share: `--resolution`, frame numbers,
 //! and the assignment of `--param name=value` to the selected techniques.
 
-use gibench_harness::technique::{Params, TechniqueInfo};
+use gibench_harness::kit::technique::{Params, TechniqueInfo};
 use gibench_harness::{Error, Result};
 
 /// `--resolution WIDTHxHEIGHT` as `[width, height]`.
@@ -95,9 +95,9 @@ pub(crate) fn assign_params(techniques: &[&TechniqueInfo], raw: &[String]) -> Re
 }
 
 /// Checks a frame number or count given as option `option` against the limit every command
-/// shares ([`gibench_harness::runner::MAX_FRAMES`]).
+/// shares ([`gibench_harness::run::runner::MAX_FRAMES`]).
 pub(crate) fn check_frame_number(option: &str, frame: u32) -> Result<()> {
-    let max = gibench_harness::runner::MAX_FRAMES;
+    let max = gibench_harness::run::runner::MAX_FRAMES;
     if frame > max {
         return Err(Error::param(
             option,

@@ -2,9 +2,9 @@
 //! reproduce all`'s ([`Bars`]); and the typed runs executed under them.
 
 use gibench_harness::gpu::GpuContext;
+use gibench_harness::measure::results::RunResult;
 use gibench_harness::report;
-use gibench_harness::results::RunResult;
-use gibench_harness::session::{self, Progress, RunSpec};
+use gibench_harness::run::session::{self, Progress, RunSpec};
 use gibench_harness::Result;
 
 use super::reproduce;

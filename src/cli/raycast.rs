@@ -5,11 +5,11 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use gibench_harness::anim::FrameClock;
-use gibench_harness::assets::AssetPaths;
-use gibench_harness::calibrate::timed;
+use gibench_harness::cpu::reference::ReferenceTracer;
+use gibench_harness::measure::calibrate::timed;
 use gibench_harness::output::OutputSet;
-use gibench_harness::reference::ReferenceTracer;
+use gibench_harness::scene::anim::FrameClock;
+use gibench_harness::scene::assets::AssetPaths;
 use gibench_harness::scene::{Scene, SceneDescriptor};
 use gibench_harness::{Error, Result};
 use rayon::prelude::*;
@@ -150,7 +150,7 @@ pub(crate) fn exec(args: &RaycastArgs) -> Result<()> {
     let s_bytes: Vec<u8> = s.iter().map(|&b| b as u8).collect();
     gibench_harness::output::write_atomic(&args.out.join("shadow-hit.bin"), &s_bytes)?;
     let json = serde_json::json!({
-        "scene": desc.name, "frame": frame_index, "git_commit": gibench_harness::runner::git_commit(),
+        "scene": desc.name, "frame": frame_index, "git_commit": gibench_harness::run::runner::git_commit(),
         "threads": rayon::current_num_threads(),
         "tree_triangles": bvh.tree_triangle_count(), "bvh_build_wall_s": build_wall,
         "closest_rays": closest.len(), "closest_hits": t.iter().filter(|x| x.is_finite()).count(),

@@ -4,9 +4,9 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use gibench_harness::assets::AssetPaths;
+use gibench_harness::cpu::reference::ReferenceSettings;
 use gibench_harness::output::OutputSet;
-use gibench_harness::reference::ReferenceSettings;
+use gibench_harness::scene::assets::AssetPaths;
 use gibench_harness::scene::{Scene, SceneDescriptor};
 use gibench_harness::{Error, Result};
 
@@ -61,7 +61,7 @@ pub(crate) struct ReferencePlan {
 /// Checks a reference render's arguments and loads its scene.
 pub(crate) fn reference_plan(args: &ReferenceArgs) -> Result<ReferencePlan> {
     let resolution = parse_resolution(&args.resolution)?;
-    gibench_harness::runner::check_resolution(resolution)?;
+    gibench_harness::run::runner::check_resolution(resolution)?;
     check_frame_number("frame", args.frame)?;
     let settings = args.reference.settings()?;
     let desc = SceneDescriptor::resolve(&args.scene)?;
@@ -92,7 +92,7 @@ pub(crate) fn reference_planned(
         scene,
     } = planned;
     let (resolution, settings) = (*resolution, *settings);
-    let frame = gibench_harness::anim::FrameClock::new(desc).frame(args.frame);
+    let frame = gibench_harness::scene::anim::FrameClock::new(desc).frame(args.frame);
     let cache = args.reference.cache();
     bars.note(&format!(
         "gibench: reference for '{}' frame {} at {}x{}: {} spp, {} bounces, seed {}",
@@ -105,8 +105,9 @@ pub(crate) fn reference_planned(
         settings.seed
     ));
     // Wall and all-thread CPU of the call (BVH build included; `setup` has its share).
-    let (r, seconds, cpu_seconds) =
-        gibench_harness::calibrate::timed(|| cache.get_timed(scene, &frame, resolution, &settings));
+    let (r, seconds, cpu_seconds) = gibench_harness::measure::calibrate::timed(|| {
+        cache.get_timed(scene, &frame, resolution, &settings)
+    });
     let (r, setup) = r?;
     let mut estimate = None;
     if args.error_estimate {
@@ -115,9 +116,13 @@ pub(crate) fn reference_planned(
             ..settings
         };
         let r2 = cache.get(scene, &frame, resolution, &other)?;
-        let one = gibench_harness::metrics::relative_mse(&r.one_bounce, &r2.one_bounce, &r.hit);
-        let multi =
-            gibench_harness::metrics::relative_mse(&r.multi_bounce, &r2.multi_bounce, &r.hit);
+        let one =
+            gibench_harness::measure::metrics::relative_mse(&r.one_bounce, &r2.one_bounce, &r.hit);
+        let multi = gibench_harness::measure::metrics::relative_mse(
+            &r.multi_bounce,
+            &r2.multi_bounce,
+            &r.hit,
+        );
         bars.note(&format!(
             "relative MSE between seeds {} and {}: one-bounce {one:.5}, multi-bounce {multi:.5}",
             settings.seed, other.seed
@@ -130,28 +135,36 @@ pub(crate) fn reference_planned(
     let out = |suffix: &str| args.out.join(format!("{stem}{suffix}"));
     let arr =
         |v: &[gibench_harness::glam::Vec3]| v.iter().map(|c| c.to_array()).collect::<Vec<_>>();
-    gibench_harness::image_io::write_exr(&out("-direct.exr"), resolution, &arr(&r.direct))?;
-    gibench_harness::image_io::write_exr(&out("-one-bounce.exr"), resolution, &arr(&r.one_bounce))?;
-    gibench_harness::image_io::write_exr(
+    gibench_harness::gpu::image_io::write_exr(&out("-direct.exr"), resolution, &arr(&r.direct))?;
+    gibench_harness::gpu::image_io::write_exr(
+        &out("-one-bounce.exr"),
+        resolution,
+        &arr(&r.one_bounce),
+    )?;
+    gibench_harness::gpu::image_io::write_exr(
         &out("-multi-bounce.exr"),
         resolution,
         &arr(&r.multi_bounce),
     )?;
-    gibench_harness::image_io::write_exr(&out("-radiance.exr"), resolution, &arr(&r.radiance))?;
+    gibench_harness::gpu::image_io::write_exr(
+        &out("-radiance.exr"),
+        resolution,
+        &arr(&r.radiance),
+    )?;
     let exposure = desc.settings.exposure;
     let png = |radiance: &[gibench_harness::glam::Vec3]| -> Vec<u8> {
-        gibench_harness::metrics::tonemap_srgb8(radiance, exposure)
+        gibench_harness::measure::metrics::tonemap_srgb8(radiance, exposure)
             .chunks_exact(3)
             .flat_map(|p| [p[0], p[1], p[2], 255])
             .collect()
     };
-    gibench_harness::image_io::write_png(&out(".png"), resolution, &png(&r.radiance))?;
-    gibench_harness::image_io::write_png(
+    gibench_harness::gpu::image_io::write_png(&out(".png"), resolution, &png(&r.radiance))?;
+    gibench_harness::gpu::image_io::write_png(
         &out("-one-bounce.png"),
         resolution,
         &png(&r.radiance_with(&r.one_bounce)),
     )?;
-    gibench_harness::image_io::write_png(
+    gibench_harness::gpu::image_io::write_png(
         &out("-direct.png"),
         resolution,
         &png(&r.radiance_with(&vec![Default::default(); r.direct.len()])),
@@ -162,8 +175,8 @@ pub(crate) fn reference_planned(
         "cpu_seconds": cpu_seconds,
         "bvh_build_seconds": setup.map(|t| t.seconds),
         "bvh_build_cpu_seconds": setup.and_then(|t| t.cpu_seconds),
-        "reference_version": gibench_harness::reference::REFERENCE_VERSION,
-        "git_commit": gibench_harness::runner::git_commit(), "error_estimate": estimate,
+        "reference_version": gibench_harness::cpu::reference::REFERENCE_VERSION,
+        "git_commit": gibench_harness::run::runner::git_commit(), "error_estimate": estimate,
     });
     let json = serde_json::to_vec_pretty(&info).map_err(|e| Error::Invalid(e.to_string()))?;
     gibench_harness::output::write_atomic(&out(".json"), &json)?;

@@ -4,9 +4,9 @@
 use std::path::PathBuf;
 
 use clap::Args;
+use gibench_harness::measure::results::RunResult;
 use gibench_harness::output::OutputSet;
 use gibench_harness::report;
-use gibench_harness::results::RunResult;
 use gibench_harness::Result;
 
 use super::files::check_stem;

@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use gibench_harness::results::RunResult;
+use gibench_harness::measure::results::RunResult;
 use gibench_harness::{Error, Result};
 
 /// The results files given (or found in the given folders), without their folders.

@@ -4,15 +4,15 @@
 use std::path::PathBuf;
 
 use clap::{Args, Parser};
-use gibench_harness::assets::AssetPaths;
 use gibench_harness::gpu::{GpuContext, GpuOptions};
+use gibench_harness::kit::technique::{Params, TechniqueInfo};
 use gibench_harness::output::OutputSet;
-use gibench_harness::quality::{IndirectComponent, QualityConfig};
 use gibench_harness::report;
-use gibench_harness::runner::{RunConfig, TimingMode};
+use gibench_harness::run::quality::{IndirectComponent, QualityConfig};
+use gibench_harness::run::runner::{RunConfig, TimingMode};
+use gibench_harness::run::session::{RunSpec, TechniqueRun};
+use gibench_harness::scene::assets::AssetPaths;
 use gibench_harness::scene::{Scene, SceneDescriptor};
-use gibench_harness::session::{RunSpec, TechniqueRun};
-use gibench_harness::technique::{Params, TechniqueInfo};
 use gibench_harness::{Error, Result};
 
 use super::files::{file_name, writable_dir};

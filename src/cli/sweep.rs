@@ -5,11 +5,11 @@ use std::path::{Path, PathBuf};
 
 use clap::Args;
 use gibench_harness::gpu::GpuContext;
+use gibench_harness::kit::technique::{Params, TechniqueInfo};
+use gibench_harness::measure::results::RunResult;
 use gibench_harness::output::OutputSet;
 use gibench_harness::report;
-use gibench_harness::results::RunResult;
-use gibench_harness::session::{RunSpec, TechniqueRun};
-use gibench_harness::technique::{Params, TechniqueInfo};
+use gibench_harness::run::session::{RunSpec, TechniqueRun};
 use gibench_harness::{Error, Result};
 
 use super::page::{page_line, with_folder, write_page};

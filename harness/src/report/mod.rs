@@ -13,7 +13,7 @@
 //! * [`stage_table_detailed`]: one run, one row per stage, with median/mean/p5/p95/min/max of both
 //!   the GPU timestamp and the wall-clock timings (`gibench report --detailed`);
 //! * [`roofline_table`]: one run, one row per GPU stage, its achieved fractions of the device's
-//!   measured bandwidth and arithmetic rate ([`crate::roofline`]; also `--detailed`).
+//!   measured bandwidth and arithmetic rate ([`crate::measure::roofline`]; also `--detailed`).
 //!
 //! and rendered by
 //!
@@ -46,8 +46,13 @@
 //!   count, VPL count, ...), categorical x axis in the given order.
 //!
 //! A stage keeps its colour within a plot; colours follow the stage order of the plot's runs.
+//!
+//! [`RunResult`]: crate::measure::results::RunResult
+//! [`StageResult::best_ms`]: crate::measure::results::StageResult::best_ms
 
+pub mod compare;
 mod csv;
+pub mod html;
 mod latex;
 mod markdown;
 mod pareto;

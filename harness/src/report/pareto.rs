@@ -1,7 +1,7 @@
 //! The time-versus-error points of runs with quality data and their Pareto front.
 
 use super::runs::stage_ms;
-use crate::results::RunResult;
+use crate::measure::results::RunResult;
 
 /// "technique" plus the parameters whose values differ between runs of that technique in
 /// `all` (e.g. "laine clamp=3"), to tell sweep points apart.

@@ -3,8 +3,8 @@
 
 use super::runs::{run_label, stage_ms};
 use super::table::{Cell, Table};
-use crate::results::{RunResult, StageKind};
-use crate::roofline::{roofline, Binding, BoundTimer};
+use crate::measure::results::{RunResult, StageKind};
+use crate::measure::roofline::{roofline, Binding, BoundTimer};
 
 /// One row per GPU stage: its time ("ms", the tables' median), its declared bytes read and
 /// written ("MB") and operations ("Mop"), the achieved GB/s and Gop/s and their fractions of the

@@ -1,7 +1,7 @@
 //! What the tables and plots read from a run: its label, its stages' names and times.
 
 use super::table::finite;
-use crate::results::{RunResult, StageResult};
+use crate::measure::results::{RunResult, StageResult};
 
 /// "technique @ scene", the label of a run in plots and notes.
 pub(super) fn run_label(r: &RunResult) -> String {

@@ -3,8 +3,8 @@
 
 use super::runs::{run_label, stage_ms, stage_names, stage_sum};
 use super::table::{Cell, Table};
-use crate::results::{RunResult, StageKind};
-use crate::stats::Stats;
+use crate::measure::results::{RunResult, StageKind};
+use crate::measure::stats::Stats;
 
 /// The device as one phrase: "adapter (backend, device type; driver ...)".
 fn device_text(r: &RunResult) -> String {

@@ -4,10 +4,10 @@ use std::collections::BTreeMap;
 
 use super::latex::latex_escape;
 use super::*;
-use crate::results::{
+use crate::measure::results::{
     DeviceInfo, FrameRange, FrameResult, RunResult, StageKind, StageResult, SCHEMA_VERSION,
 };
-use crate::stats::Stats;
+use crate::measure::stats::Stats;
 use crate::Error;
 
 /// The front keeps exactly the points nothing beats in both time and error.

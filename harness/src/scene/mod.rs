@@ -9,6 +9,8 @@
 //! Vertices are never shared between materials, so a triangle's material is the material of
 //! any of its vertices.
 
+pub mod anim;
+pub mod assets;
 pub mod barczak;
 pub mod charts;
 pub mod cornell;
@@ -21,7 +23,7 @@ use std::path::Path;
 
 use glam::{Vec2, Vec3};
 
-use crate::assets::AssetPaths;
+use crate::scene::assets::AssetPaths;
 use crate::Result;
 
 pub use descriptor::SceneDescriptor;
@@ -218,7 +220,7 @@ pub enum PunctualKind {
 
 /// A dynamic object: a mesh in its own local space, already scaled by the descriptor's
 /// `scale`, and the index of its path in the descriptor (`descriptor.movers[i]`). Its
-/// per-frame transform (rigid: translation and rotation about +Y) comes from [`crate::anim`].
+/// per-frame transform (rigid: translation and rotation about +Y) comes from [`crate::scene::anim`].
 #[derive(Clone, Debug)]
 pub struct Mover {
     pub name: String,
@@ -241,7 +243,7 @@ pub struct SceneExtent {
     /// 10⁻⁴ × the diagonal, or 10⁻⁶ for an empty or degenerate mesh.
     pub ray_epsilon: f32,
     /// Total area of the mesh's triangles (at least 10⁻¹²): what the VPL irradiance clamp
-    /// spreads the VPLs' flux over ([`crate::ir::accumulate`]).
+    /// spreads the VPLs' flux over ([`crate::kit::ir::accumulate`]).
     pub surface_area: f32,
 }
 

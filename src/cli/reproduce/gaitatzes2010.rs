@@ -20,14 +20,14 @@
 //! on the resolution).
 
 use gibench_gaitatzes::{STAGE_PROPAGATION, STAGE_RECONSTRUCTION, STAGE_VOXELIZATION};
+use gibench_harness::cpu::reference::ReferenceSettings;
 use gibench_harness::gpu::GpuContext;
-use gibench_harness::quality::{IndirectComponent, QualityConfig};
-use gibench_harness::reference::ReferenceSettings;
+use gibench_harness::kit::technique::TechniqueInfo;
+use gibench_harness::measure::results::RunResult;
 use gibench_harness::report::{self, Cell, Table};
-use gibench_harness::results::RunResult;
+use gibench_harness::run::quality::{IndirectComponent, QualityConfig};
+use gibench_harness::run::session::{RunSpec, TechniqueRun};
 use gibench_harness::scene::Scene;
-use gibench_harness::session::{RunSpec, TechniqueRun};
-use gibench_harness::technique::TechniqueInfo;
 use gibench_harness::{Error, Result};
 
 use super::{device_note, load_scene, ms, PaperModule, ReproduceArgs, Reproduced};

@@ -17,12 +17,12 @@
 //! but takes 256 VPLs (4x4 tiles) with 64² maps at 256x192, so that the classic maps finish on a
 //! CPU adapter.
 
-use gibench_harness::ir::gather::{COMMON_STAGES, STAGE_FILTER, STAGE_VPL_SHADOW_MAPS};
+use gibench_harness::kit::ir::gather::{COMMON_STAGES, STAGE_FILTER, STAGE_VPL_SHADOW_MAPS};
+use gibench_harness::kit::technique::TechniqueInfo;
+use gibench_harness::measure::results::RunResult;
 use gibench_harness::report::{self, Cell, Table};
-use gibench_harness::results::RunResult;
-use gibench_harness::runner::{RunConfig, TimingMode};
-use gibench_harness::session::{RunSpec, TechniqueRun};
-use gibench_harness::technique::TechniqueInfo;
+use gibench_harness::run::runner::{RunConfig, TimingMode};
+use gibench_harness::run::session::{RunSpec, TechniqueRun};
 use gibench_harness::{Error, Result};
 use gibench_ism::{STAGE_POINT_SPLAT, STAGE_PULL_PUSH, STAGE_RSM, STAGE_VPL_SAMPLING};
 use gibench_keller::STAGE_VPL_GENERATION;

@@ -3,7 +3,7 @@
 
 use clap::Parser;
 use gibench_harness::gpu::GpuContext;
-use gibench_harness::session::RunSpec;
+use gibench_harness::run::session::RunSpec;
 use gibench_harness::{Error, Result};
 
 use crate::cli::progress::Bars;

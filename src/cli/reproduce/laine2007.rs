@@ -19,14 +19,14 @@
 //! `--quick`, so the files `reproduce all --quick` writes are the ones their own commands
 //! write.
 
-use gibench_harness::ir::gather::{COMMON_STAGES, STAGE_VPL_SHADOW_MAPS};
+use gibench_harness::kit::ir::gather::{COMMON_STAGES, STAGE_VPL_SHADOW_MAPS};
+use gibench_harness::kit::technique::TechniqueInfo;
+use gibench_harness::measure::results::RunResult;
 use gibench_harness::report::{self, Cell, Table};
-use gibench_harness::results::RunResult;
-use gibench_harness::runner::{
+use gibench_harness::run::runner::{
     RunConfig, TimingMode, STAGE_DIRECT_LIGHT, STAGE_DIRECT_SHADOW_MAP, STAGE_GBUFFER,
 };
-use gibench_harness::session::{RunSpec, TechniqueRun};
-use gibench_harness::technique::TechniqueInfo;
+use gibench_harness::run::session::{RunSpec, TechniqueRun};
 use gibench_harness::{Error, Result};
 
 use super::{
@@ -471,7 +471,7 @@ fn cpu_scene(
 ) -> Result<(
     String,
     gibench_harness::scene::Scene,
-    gibench_harness::bvh::SceneBvh,
+    gibench_harness::cpu::bvh::SceneBvh,
 )> {
     let name = args
         .scenes
@@ -479,7 +479,7 @@ fn cpu_scene(
         .cloned()
         .unwrap_or_else(|| default.to_string());
     let scene = load_scene(&name, args)?;
-    let bvh = gibench_harness::bvh::SceneBvh::new(&scene.mesh);
+    let bvh = gibench_harness::cpu::bvh::SceneBvh::new(&scene.mesh);
     Ok((name, scene, bvh))
 }
 
@@ -487,17 +487,17 @@ fn cpu_scene(
 fn clock_with_light(
     scene: &gibench_harness::scene::Scene,
     kind: gibench_harness::scene::descriptor::LightKind,
-) -> gibench_harness::anim::FrameClock {
+) -> gibench_harness::scene::anim::FrameClock {
     let mut d = scene.descriptor.clone();
     d.light.kind = kind;
-    gibench_harness::anim::FrameClock::new(&d)
+    gibench_harness::scene::anim::FrameClock::new(&d)
 }
 
 /// VPL management cost per frame on the CPU (spot and omni, 256 and 1024 VPLs) on Sibenik's
 /// animation: a CPU-only run of the `laine` manager.
 fn management(args: &ReproduceArgs) -> Result<Table> {
+    use gibench_harness::measure::stats::Stats;
     use gibench_harness::scene::descriptor::LightKind;
-    use gibench_harness::stats::Stats;
     let frames = management_frames(args);
     let (name, scene, bvh) = cpu_scene(args, "sibenik")?;
     let paper = paper()?;
@@ -582,7 +582,7 @@ fn management(args: &ReproduceArgs) -> Result<Table> {
     }
     let json = serde_json::json!({
         "scene": name, "frames": frames, "passes": MANAGEMENT_PASSES,
-        "git_commit": gibench_harness::runner::git_commit(),
+        "git_commit": gibench_harness::run::runner::git_commit(),
         "cpu_threads": std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1),
         "per_frame_ms": records,
     });
@@ -623,11 +623,11 @@ fn management(args: &ReproduceArgs) -> Result<Table> {
 /// configuration's measurements.
 fn measure_management(
     scene: &gibench_harness::scene::Scene,
-    bvh: &gibench_harness::bvh::SceneBvh,
+    bvh: &gibench_harness::cpu::bvh::SceneBvh,
     configs: &[(gibench_harness::scene::descriptor::LightKind, u32)],
     frames: u32,
 ) -> Vec<ManagementPasses> {
-    use gibench_harness::stats::Stats;
+    use gibench_harness::measure::stats::Stats;
     let mut measured: Vec<ManagementPasses> = configs.iter().map(|_| Default::default()).collect();
     for _ in 0..MANAGEMENT_PASSES {
         for (&(kind, vpls), acc) in configs.iter().zip(&mut measured) {
@@ -638,7 +638,7 @@ fn measure_management(
             let mut step = |f: u32| {
                 let light = clock.frame(f).light;
                 let (s, wall, cpu) =
-                    gibench_harness::calibrate::timed(|| m.step(scene, bvh, light));
+                    gibench_harness::measure::calibrate::timed(|| m.step(scene, bvh, light));
                 if f > 0 {
                     acc.used.push(m.vpls().len() as f64);
                     acc.rebuilt += s.rebuilt as u32;
@@ -665,8 +665,8 @@ fn measure_management(
 /// largest empty circle), spot and omni, with the light moving along the scene's path and with
 /// it still at frame 0's pose: a table of statistics, a JSON of every frame and an SVG plot.
 fn dispersion(args: &ReproduceArgs) -> Result<Table> {
+    use gibench_harness::measure::stats::Stats;
     use gibench_harness::scene::descriptor::LightKind;
-    use gibench_harness::stats::Stats;
     let frames = dispersion_frames(args)?;
     let (name, scene, bvh) = cpu_scene(args, "cornell")?;
     let mut lines = Vec::new();
@@ -703,7 +703,7 @@ fn dispersion(args: &ReproduceArgs) -> Result<Table> {
     }
     let json = serde_json::json!({
         "scene": name, "frames": frames, "vpls": 256, "recalc_min": 4, "recalc_max": 8,
-        "git_commit": gibench_harness::runner::git_commit(), "dispersion_per_frame_after_the_first": records,
+        "git_commit": gibench_harness::run::runner::git_commit(), "dispersion_per_frame_after_the_first": records,
     });
     let bytes = serde_json::to_vec_pretty(&json).map_err(|e| Error::Invalid(e.to_string()))?;
     gibench_harness::output::write_atomic(&out(args).join("laine-dispersion.json"), &bytes)?;

@@ -1,5 +1,5 @@
 //! `gibench reproduce TARGET`: regenerate a paper's tables, one module per paper over the typed
-//! run API ([`gibench_harness::session`]), with the paper's published figures read from
+//! run API ([`gibench_harness::run::session`]), with the paper's published figures read from
 //! `results/papers/<paper>.json` and printed beside ours, each labelled with its source.
 //!
 //! * [`laine2007`]: Laine et al. 2007, Tables 1 and 2, VPL management, dispersion.
@@ -24,10 +24,10 @@ pub mod laine2007;
 use std::path::PathBuf;
 
 use clap::Args;
-use gibench_harness::assets::AssetPaths;
 use gibench_harness::gpu::{GpuContext, GpuOptions};
+use gibench_harness::measure::results::RunResult;
 use gibench_harness::report::{Cell, Table};
-use gibench_harness::results::RunResult;
+use gibench_harness::scene::assets::AssetPaths;
 use gibench_harness::scene::{Scene, SceneDescriptor};
 use gibench_harness::{Error, Result};
 
@@ -181,7 +181,7 @@ pub fn gpu_or_open<'a>(
 /// Validates every spec, then runs them one after another on `gpu` (or the adapter `args` asks
 /// for) under `bars`: a paper target's runs, all checked before any starts.
 pub fn run_specs(
-    specs: &[gibench_harness::session::RunSpec],
+    specs: &[gibench_harness::run::session::RunSpec],
     args: &ReproduceArgs,
     gpu: Option<&GpuContext>,
     bars: &Bars,
@@ -207,8 +207,8 @@ pub fn paper_config(
     frames: u32,
     warmup: u32,
     compared: bool,
-) -> gibench_harness::runner::RunConfig {
-    use gibench_harness::runner::{RunConfig, TimingMode};
+) -> gibench_harness::run::runner::RunConfig {
+    use gibench_harness::run::runner::{RunConfig, TimingMode};
     RunConfig {
         resolution,
         frames,

@@ -45,7 +45,7 @@
 //!   full resolution where the kit's `EdgeMask` finds edges (written as depth, as the thesis).
 //!
 //! The shadow maps are the shared atlas's octahedral kind (§4.2.1,
-//! `gibench_harness::ir::atlas::MapKind::Octahedral`).
+//! `gibench_harness::kit::ir::atlas::MapKind::Octahedral`).
 //!
 //! **As a technique** ([`INFO`], `barczak`): the output is the irradiance of one light-sample
 //! set — `set=indirect` (default: the random-walk samples, compared with the multi-bounce
@@ -77,10 +77,10 @@ pub mod visibility;
 
 pub use params::BarczakParams;
 
-use gibench_harness::quality::IndirectComponent;
-use gibench_harness::technique::{
+use gibench_harness::kit::technique::{
     Conformance, FrameContext, Params, PrepareContext, Prepared, Technique, TechniqueInfo,
 };
+use gibench_harness::run::quality::IndirectComponent;
 use gibench_harness::{wgpu, Error, Result};
 
 use params::PARAMS;

@@ -25,9 +25,9 @@ use std::sync::Arc;
 
 use bytemuck::{Pod, Zeroable};
 use gibench_harness::gpu::GpuContext;
-use gibench_harness::ir::atlas::ShadowAtlas;
-use gibench_harness::ir::store::VplStore;
-use gibench_harness::passes::{
+use gibench_harness::kit::ir::atlas::ShadowAtlas;
+use gibench_harness::kit::ir::store::VplStore;
+use gibench_harness::kit::passes::{
     bind_buffer, dynamic_storage_entry, read_storage_entry, shader_module, FrameUniforms, GBuffer,
     CAMERA_SLOT,
 };

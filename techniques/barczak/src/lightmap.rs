@@ -16,7 +16,7 @@
 //! A light's irradiance at x with normal n: a light sample with normal N emits Φ/π · cos θ
 //! (an omni light Φ/4π), so E = I(θ) · max(0, n·ω) / r², ω the unit direction to the light.
 
-use gibench_harness::light::point_irradiance;
+use gibench_harness::cpu::light::point_irradiance;
 use glam::Vec3;
 
 use crate::database::{LightMapChange, ReceiverShape, VisibilityDatabase};

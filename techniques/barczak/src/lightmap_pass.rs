@@ -11,7 +11,7 @@
 
 use bytemuck::{Pod, Zeroable};
 use gibench_harness::gpu::GpuContext;
-use gibench_harness::passes::{
+use gibench_harness::kit::passes::{
     bind_buffer, params_entry, read_storage_entry, shader_module, FrameUniforms, GBuffer,
     CAMERA_SLOT, HDR_FORMAT,
 };
@@ -256,7 +256,7 @@ impl LightMapPass {
         let params = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("barczak light-map params"),
             size: 16,
-            usage: gibench_harness::passes::PARAMS_USAGE,
+            usage: gibench_harness::kit::passes::PARAMS_USAGE,
             mapped_at_creation: false,
         });
         gpu.queue

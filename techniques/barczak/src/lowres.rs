@@ -18,8 +18,8 @@
 
 use bytemuck::{Pod, Zeroable};
 use gibench_harness::gpu::GpuContext;
-use gibench_harness::ir::edges::{EdgeMask, EdgeSettings};
-use gibench_harness::passes::{
+use gibench_harness::kit::ir::edges::{EdgeMask, EdgeSettings};
+use gibench_harness::kit::passes::{
     bind_buffer, fullscreen_pipeline_with, params_buffer, params_entry, render_target,
     shader_module, texture_entry, GBuffer, HDR_FORMAT,
 };

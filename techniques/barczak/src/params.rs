@@ -1,7 +1,7 @@
 //! The parameters of `barczak`: their declarations (names, ranges, defaults, documentation)
 //! and [`BarczakParams`], the typed values read from them once for a resolution.
 
-use gibench_harness::technique::{ParamKind, ParamSpec, Params};
+use gibench_harness::kit::technique::{ParamKind, ParamSpec, Params};
 use gibench_harness::{Error, Result};
 
 use crate::renderer::{Optimisation, RendererSettings};

@@ -19,9 +19,9 @@
 //! object are blurred); the basis truncation smooths a point light's cosine (tested bounds).
 //! The thesis used the DirectX SDK's PRT simulator and D3DX's projection; these are our own.
 
-use gibench_harness::bvh::SceneBvh;
+use gibench_harness::cpu::bvh::SceneBvh;
+use gibench_harness::cpu::vpl::{fibonacci_sphere, Vpl};
 use gibench_harness::scene::Mesh;
-use gibench_harness::vpl::{fibonacci_sphere, Vpl};
 use glam::Vec3;
 
 /// Coefficients of 5th-order SH: (4 + 1)².

@@ -7,7 +7,7 @@
 //! interpolated. One draw per mover.
 
 use gibench_harness::gpu::GpuContext;
-use gibench_harness::passes::{
+use gibench_harness::kit::passes::{
     bind_buffer, read_storage_entry, shader_module, FrameUniforms, GBuffer, GpuScene, Vertex,
     CAMERA_SLOT, HDR_FORMAT,
 };

@@ -18,19 +18,19 @@
 
 use std::sync::Arc;
 
-use gibench_harness::anim::FrameState;
-use gibench_harness::bvh::SceneBvh;
+use gibench_harness::cpu::bvh::SceneBvh;
+use gibench_harness::cpu::vpl::Vpl;
 use gibench_harness::gpu::GpuContext;
-use gibench_harness::ir::atlas::{AtlasFormat, AtlasSettings, MapKind, ShadowAtlas};
-use gibench_harness::ir::edges::EdgeSettings;
-use gibench_harness::ir::face_cull::Occluders;
-use gibench_harness::ir::raster::{AtlasClear, AtlasRasteriser};
-use gibench_harness::ir::store::VplStore;
-use gibench_harness::passes::{
+use gibench_harness::kit::ir::atlas::{AtlasFormat, AtlasSettings, MapKind, ShadowAtlas};
+use gibench_harness::kit::ir::edges::EdgeSettings;
+use gibench_harness::kit::ir::face_cull::Occluders;
+use gibench_harness::kit::ir::raster::{AtlasClear, AtlasRasteriser};
+use gibench_harness::kit::ir::store::VplStore;
+use gibench_harness::kit::passes::{
     render_target, DrawSet, FrameUniforms, GBuffer, GpuScene, HDR_FORMAT,
 };
+use gibench_harness::scene::anim::FrameState;
 use gibench_harness::scene::Scene;
-use gibench_harness::vpl::Vpl;
 use gibench_harness::{wgpu, Error, Result};
 use glam::{Mat3, Mat4};
 

@@ -12,16 +12,16 @@
 //!   to `bounces`, each carrying Φ times the albedos along its path; walks are started until
 //!   there are `indirect` samples (the last walk's extra hits are dropped) and every sample is
 //!   divided by the number of walks started. This is the shared Keller path tracer
-//!   (`gibench_harness::vpl::generate_at_least`) with no fractional absorption (ρ̄ = 1: every
+//!   (`gibench_harness::cpu::vpl::generate_at_least`) with no fractional absorption (ρ̄ = 1: every
 //!   walk runs to the bounce limit, as the thesis' do), on Halton numbers as Keller's.
 //!
 //! The VPL count in the shared sense (the VPLs lighting the frame) is `direct + indirect`.
 
-use gibench_harness::anim::LightPose;
-use gibench_harness::bvh::SceneBvh;
+use gibench_harness::cpu::bvh::SceneBvh;
+use gibench_harness::cpu::vpl::{self, halton, Vpl};
+use gibench_harness::scene::anim::LightPose;
 use gibench_harness::scene::descriptor::LightKind;
 use gibench_harness::scene::Scene;
-use gibench_harness::vpl::{self, halton, Vpl};
 use gibench_harness::{Error, Result};
 use glam::Vec3;
 

@@ -17,8 +17,8 @@
 //!   receiver (lit by PRT) and a sphere blocker; mover k is object `first_mover_object + k`.
 //! * The light samples are oriented point lights at the sample positions.
 
-use gibench_harness::anim::{FrameState, LightPose};
-use gibench_harness::bvh::SceneBvh;
+use gibench_harness::cpu::bvh::SceneBvh;
+use gibench_harness::scene::anim::{FrameState, LightPose};
 use gibench_harness::scene::Scene;
 use gibench_harness::Result;
 use glam::{Mat4, Vec3};

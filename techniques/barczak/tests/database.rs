@@ -193,8 +193,8 @@ fn the_blocker_index_leaves_every_state_unchanged() {
         check(&db, &format!("room after move {step}"));
     }
     let scene = gibench_test_support::load("cornell-gltf");
-    let bvh = gibench_harness::bvh::SceneBvh::new(&scene.mesh);
-    let frame = gibench_harness::anim::FrameClock::new(&scene.descriptor).frame(0);
+    let bvh = gibench_harness::cpu::bvh::SceneBvh::new(&scene.mesh);
+    let frame = gibench_harness::scene::anim::FrameClock::new(&scene.descriptor).frame(0);
     let settings = gibench_barczak::samples::SampleSettings {
         direct: 0,
         indirect: 32,

@@ -13,12 +13,12 @@ use gibench_barczak::lightmap_pass::{Leaves, LightMapPass};
 use gibench_barczak::samples::SampleSettings;
 use gibench_barczak::visibility::LightState;
 use gibench_harness::glam::Vec3;
-use gibench_harness::ir::accumulate::{Accumulation, IrradianceClamp};
-use gibench_harness::ir::atlas::{AtlasFormat, AtlasSettings, MapKind, ShadowAtlas};
-use gibench_harness::ir::interleave::{FilterSettings, Interleave};
-use gibench_harness::ir::raster::{AtlasClear, AtlasRasteriser};
-use gibench_harness::ir::store::VplStore;
-use gibench_harness::passes::{render_target, DrawSet, HDR_FORMAT};
+use gibench_harness::kit::ir::accumulate::{Accumulation, IrradianceClamp};
+use gibench_harness::kit::ir::atlas::{AtlasFormat, AtlasSettings, MapKind, ShadowAtlas};
+use gibench_harness::kit::ir::interleave::{FilterSettings, Interleave};
+use gibench_harness::kit::ir::raster::{AtlasClear, AtlasRasteriser};
+use gibench_harness::kit::ir::store::VplStore;
+use gibench_harness::kit::passes::{render_target, DrawSet, HDR_FORMAT};
 
 mod support;
 
@@ -109,10 +109,10 @@ fn light_maps_minus_occluded_partials_equal_the_brute_force_gather() {
             }
             subtract.encode(&mut enc, &harness.uniforms, &atlas, &view);
             gpu.queue.submit([enc.finish()]);
-            images.push(gibench_harness::image_io::read_rgb_f32(gpu, &t).unwrap());
+            images.push(gibench_harness::gpu::image_io::read_rgb_f32(gpu, &t).unwrap());
         }
         // The kit's gather of every light with the same maps (1x1 tiles, no filtering, no clamp).
-        let output = gibench_harness::passes::indirect_target(&gpu.device, [W, H], true);
+        let output = gibench_harness::kit::passes::indirect_target(&gpu.device, [W, H], true);
         let interleave = Interleave::new(
             gpu,
             &harness.gbuffer,
@@ -132,7 +132,7 @@ fn light_maps_minus_occluded_partials_equal_the_brute_force_gather() {
         interleave.encode_combine(&mut enc);
         interleave.encode_filter(&mut enc);
         gpu.queue.submit([enc.finish()]);
-        let naive = gibench_harness::image_io::read_rgb_f32(gpu, &output).unwrap();
+        let naive = gibench_harness::gpu::image_io::read_rgb_f32(gpu, &output).unwrap();
 
         let (opt, plain) = (&images[0], &images[1]);
         assert!(

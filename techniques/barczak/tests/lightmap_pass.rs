@@ -5,7 +5,7 @@
 use gibench_barczak::lightmap_pass::{Leaves, LightMapPass};
 use gibench_barczak::samples::SampleSettings;
 use gibench_harness::glam::Vec3;
-use gibench_harness::passes::{render_target, HDR_FORMAT};
+use gibench_harness::kit::passes::{render_target, HDR_FORMAT};
 
 mod support;
 
@@ -42,7 +42,7 @@ fn light_map_pass_draws_the_cpu_light_maps() {
             .encode(&mut enc, &harness.gpu_scene, &harness.uniforms);
         assert_eq!(pass.encode(&mut enc, &harness.uniforms, &view), 1);
         gpu.queue.submit([enc.finish()]);
-        let gpu_e = gibench_harness::image_io::read_rgb_f32(gpu, &target).unwrap();
+        let gpu_e = gibench_harness::gpu::image_io::read_rgb_f32(gpu, &target).unwrap();
         let g = harness.gbuffer.export(gpu).unwrap();
         let (mut checked, mut agree, mut mover, mut mover_zero) = (0, 0, 0, 0);
         for (i, p) in g.positions.iter().enumerate() {

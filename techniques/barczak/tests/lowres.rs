@@ -63,7 +63,7 @@ fn the_low_resolution_pass_interpolates_off_edges_and_redraws_them() {
         let (_, vd_image, vd_counts) = render(Optimisation::Vd);
         let (_, full_image, _) = render(Optimisation::Full);
         let lowres = lp.lowres().expect("VD+LP has the low-resolution pass");
-        let low = gibench_harness::image_io::read_rgb_f32(gpu, lowres.low_texture()).unwrap();
+        let low = gibench_harness::gpu::image_io::read_rgb_f32(gpu, lowres.low_texture()).unwrap();
         let mask = lowres.edges().read(gpu).unwrap();
         let top = vd_image
             .iter()

@@ -3,10 +3,10 @@
 //! irradiance through lighting · transfer.
 
 use gibench_barczak::prt::{basis, irradiance, lighting, transfer, COEFFS};
-use gibench_harness::bvh::SceneBvh;
+use gibench_harness::cpu::bvh::SceneBvh;
+use gibench_harness::cpu::vpl::{fibonacci_sphere, Vpl};
 use gibench_harness::glam::{Mat3, Vec3};
 use gibench_harness::scene::Mesh;
-use gibench_harness::vpl::{fibonacci_sphere, Vpl};
 
 use gibench_test_support::quad;
 

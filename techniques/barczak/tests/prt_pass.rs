@@ -5,9 +5,9 @@
 use gibench_barczak::prt::{self, COEFFS};
 use gibench_barczak::prt_pass::PrtPass;
 use gibench_barczak::samples::SampleSettings;
-use gibench_harness::bvh::SceneBvh;
+use gibench_harness::cpu::bvh::SceneBvh;
 use gibench_harness::glam::{Mat3, Vec3};
-use gibench_harness::passes::{render_target, HDR_FORMAT};
+use gibench_harness::kit::passes::{render_target, HDR_FORMAT};
 use gibench_harness::wgpu;
 
 mod support;
@@ -97,7 +97,7 @@ fn prt_draw_interpolates_the_cpu_vertex_irradiance() {
             1
         );
         gpu.queue.submit([enc.finish()]);
-        let gpu_e = gibench_harness::image_io::read_rgb_f32(gpu, &target).unwrap();
+        let gpu_e = gibench_harness::gpu::image_io::read_rgb_f32(gpu, &target).unwrap();
         let g = harness.gbuffer.export(gpu).unwrap();
         // Per vertex, posed.
         let vertex_e: Vec<Vec3> = transfer

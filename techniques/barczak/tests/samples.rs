@@ -2,9 +2,9 @@
 //! to the bounce limit and are normalised by the walks started.
 
 use gibench_barczak::samples::{generate, SampleSettings};
-use gibench_harness::anim::LightPose;
-use gibench_harness::bvh::SceneBvh;
+use gibench_harness::cpu::bvh::SceneBvh;
 use gibench_harness::glam::Vec3;
+use gibench_harness::scene::anim::LightPose;
 use gibench_harness::scene::descriptor::LightKind;
 use gibench_harness::scene::Scene;
 

@@ -7,9 +7,9 @@ use gibench_barczak::lightmap::{contribution, texel_position};
 use gibench_barczak::samples::SampleSettings;
 use gibench_barczak::setup::{prepare, CHART_LEVELS, MAX_CHARTS};
 use gibench_barczak::visibility::LightState;
-use gibench_harness::anim::FrameClock;
-use gibench_harness::bvh::SceneBvh;
+use gibench_harness::cpu::bvh::SceneBvh;
 use gibench_harness::glam::Vec3;
+use gibench_harness::scene::anim::FrameClock;
 
 const RES: u32 = 3;
 

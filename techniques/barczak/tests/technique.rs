@@ -2,10 +2,10 @@
 //! reference's direct light of the area light (soft shadows) on the Cornell box; bad parameters
 //! are refused by name before any preparation.
 
+use gibench_harness::cpu::reference::{render_reference, ReferenceSettings};
+use gibench_harness::gpu::profiler::{ProfileMode, Profiler};
 use gibench_harness::gpu::{GpuContext, GpuOptions};
-use gibench_harness::profiler::{ProfileMode, Profiler};
-use gibench_harness::reference::{render_reference, ReferenceSettings};
-use gibench_harness::runner::{Harness, RunConfig};
+use gibench_harness::run::runner::{Harness, RunConfig};
 use gibench_test_support::kv;
 
 const SIZE: [u32; 2] = [96, 72];

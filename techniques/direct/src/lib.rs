@@ -6,7 +6,7 @@
 
 mod params;
 
-use gibench_harness::technique::{
+use gibench_harness::kit::technique::{
     prepare_nothing, Conformance, FrameContext, Params, PrepareContext, Prepared, Technique,
     TechniqueInfo,
 };
@@ -22,7 +22,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     params: &[PARAMS],
     required_features: wgpu::Features::empty(),
     required_limits: wgpu::Limits::downlevel_webgl2_defaults,
-    reference: gibench_harness::technique::one_bounce,
+    reference: gibench_harness::kit::technique::one_bounce,
     // No indirect light at all: the mean ratio must be exactly zero.
     conformance: Conformance {
         max_relative_l1: 1.0,
@@ -39,7 +39,8 @@ pub struct Direct {
 
 fn create(_params: &Params, ctx: &PrepareContext, _: &Prepared) -> Result<Box<dyn Technique>> {
     // Zero-initialised by wgpu and never written: the indirect irradiance is zero.
-    let texture = gibench_harness::passes::indirect_target(&ctx.gpu.device, ctx.resolution, false);
+    let texture =
+        gibench_harness::kit::passes::indirect_target(&ctx.gpu.device, ctx.resolution, false);
     Ok(Box::new(Direct {
         view: texture.create_view(&Default::default()),
     }))

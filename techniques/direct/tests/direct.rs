@@ -4,7 +4,7 @@
 //! under an omni light as the light model's closed form says, E = Φ/(4π) · cos θ / r².
 
 use gibench_harness::glam::Vec3;
-use gibench_harness::runner::{
+use gibench_harness::run::runner::{
     Harness, STAGE_COMPOSE, STAGE_DIRECT_LIGHT, STAGE_DIRECT_SHADOW_MAP, STAGE_GBUFFER,
 };
 use gibench_harness::scene::{Material, Mesh, Scene};

@@ -40,7 +40,7 @@ fn main() {
          |---|---|---|---|---|---|---|---|---|\n",
         adapter.name,
         adapter.backend,
-        gibench_harness::runner::git_commit()
+        gibench_harness::run::runner::git_commit()
     );
     let mut row = |scene: &str, s: Slabs| {
         let converged = model(&s, 4000);

@@ -54,13 +54,13 @@ pub mod volume;
 
 pub use params::GaitatzesParams;
 
-use gibench_harness::technique::{
+use gibench_harness::kit::technique::{
     prepare_nothing, Conformance, FrameContext, Params, PrepareContext, Prepared, Technique,
     TechniqueInfo,
 };
 use gibench_harness::{wgpu, Result};
 
-use gibench_harness::roofline::StageCost;
+use gibench_harness::measure::roofline::StageCost;
 use params::PARAMS;
 use volume::{Grid, Mode, Propagation, Reconstruction, Volumes, Voxelizer, CELL_BYTES};
 
@@ -78,7 +78,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     params: &[PARAMS],
     required_features: wgpu::Features::empty(),
     required_limits: wgpu::Limits::downlevel_defaults,
-    reference: gibench_harness::technique::multi_bounce,
+    reference: gibench_harness::kit::technique::multi_bounce,
     // On the Cornell boxes against the multi-bounce reference at the defaults (32³, 12
     // iterations, `transport=cosine`), measured (tests/conformance.rs, 96x72): mean ratio 0.315
     // (spot), 0.322 (area), 0.321 (omni), 0.570 (sun); relative L1 0.72, 0.72, 0.94, 0.77. The
@@ -108,7 +108,7 @@ pub struct Gaitatzes {
     costs: Costs,
 }
 
-/// The stages' declared minimum costs ([`gibench_harness::roofline`]), computed once. Cells:
+/// The stages' declared minimum costs ([`gibench_harness::measure::roofline`]), computed once. Cells:
 /// `grid`³; a cell of the voxel buffer or of an SH buffer is [`CELL_BYTES`] (three vec4s).
 struct Costs {
     voxelization: StageCost,
@@ -180,7 +180,7 @@ fn create(params: &Params, ctx: &PrepareContext, _: &Prepared) -> Result<Box<dyn
         &volumes,
     )?;
     let propagation = Propagation::new(gpu, &grid, &volumes)?;
-    let output = gibench_harness::passes::indirect_target(&gpu.device, ctx.resolution, true);
+    let output = gibench_harness::kit::passes::indirect_target(&gpu.device, ctx.resolution, true);
     let view = output.create_view(&Default::default());
     let reconstruction = Reconstruction::new(gpu, &grid, ctx.gbuffer, &volumes, &view)?;
     Ok(Box::new(Gaitatzes {

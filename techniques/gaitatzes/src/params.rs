@@ -1,7 +1,7 @@
 //! The parameters of `gaitatzes`: their declarations (names, ranges, defaults, documentation)
 //! and [`GaitatzesParams`], the typed values read from them once.
 
-use gibench_harness::technique::{ParamKind, ParamSpec, Params};
+use gibench_harness::kit::technique::{ParamKind, ParamSpec, Params};
 use gibench_harness::{Error, Result};
 
 use crate::volume::{Mode, Transport};

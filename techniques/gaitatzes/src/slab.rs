@@ -341,7 +341,7 @@ pub fn measure(gpu: &GpuContext, s: &Slabs, n: u32, iterations: u32) -> Result<I
 
 fn read(gpu: &GpuContext, buffer: &wgpu::Buffer) -> Result<Vec<f32>> {
     Ok(bytemuck::pod_collect_to_vec(
-        &gibench_harness::image_io::read_buffer(gpu, buffer)?,
+        &gibench_harness::gpu::image_io::read_buffer(gpu, buffer)?,
     ))
 }
 

@@ -15,7 +15,7 @@
 
 use gibench_harness::glam::{Mat4, Vec3, Vec4};
 use gibench_harness::gpu::GpuContext;
-use gibench_harness::passes::{
+use gibench_harness::kit::passes::{
     bind_buffer, compute_pipeline, shader_module, storage_entry, storage_texture_entry,
     texture_entry, uniform_entry, DirectLight, DrawSet, FrameUniforms, GBuffer, GpuScene, Vertex,
     HDR_FORMAT,
@@ -420,7 +420,7 @@ fn voxelize_pipeline(
 ) -> wgpu::RenderPipeline {
     let source = format!(
         "{}\n{}\n{}",
-        gibench_harness::passes::MESH_WGSL,
+        gibench_harness::kit::passes::MESH_WGSL,
         DirectLight::wgsl(3),
         include_str!("shaders/voxelize.wgsl")
     );

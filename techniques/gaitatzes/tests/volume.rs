@@ -9,7 +9,7 @@ use gibench_gaitatzes::volume::{
 };
 use gibench_harness::glam::{Vec2, Vec3};
 use gibench_harness::gpu::GpuContext;
-use gibench_harness::runner::Harness;
+use gibench_harness::run::runner::Harness;
 use gibench_harness::scene::{Material, Mesh};
 use gibench_test_support::{gpus, read_f32, run_config, scene_from_json};
 

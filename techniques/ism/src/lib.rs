@@ -21,7 +21,7 @@
 //! — every triangle of the scene's shadow-caster copy (tessellated where the scene has one, as
 //! paraboloid maps need: `keller-full` and `laine` draw the same) and of the movers rasterised
 //! into each VPL's paraboloid map
-//! (the kit's [`AtlasRasteriser`](gibench_harness::ir::raster::AtlasRasteriser), views written
+//! (the kit's [`AtlasRasteriser`](gibench_harness::kit::ir::raster::AtlasRasteriser), views written
 //! from the GPU store), 32-bit depth, as the `vpl-shadow-maps` stage.
 //!
 //! Deviations (docs/deviations.md): points are splatted with a storage-buffer atomic, one
@@ -37,15 +37,15 @@ mod params;
 pub use params::IsmParams;
 
 use gibench_harness::glam::Mat4;
-use gibench_harness::ir::gather::VplGather;
-use gibench_harness::ir::points::{self, PoolPoint};
-use gibench_harness::ir::pullpush::PullPush;
-use gibench_harness::ir::raster::StoreViews;
-use gibench_harness::ir::rsm::ReflectiveShadowMap;
-use gibench_harness::ir::splat::PointSplat;
-use gibench_harness::ir::vpl_sample::{RsmTexels, VplSampler};
-use gibench_harness::passes::DrawSet;
-use gibench_harness::technique::{
+use gibench_harness::kit::ir::gather::VplGather;
+use gibench_harness::kit::ir::points::{self, PoolPoint};
+use gibench_harness::kit::ir::pullpush::PullPush;
+use gibench_harness::kit::ir::raster::StoreViews;
+use gibench_harness::kit::ir::rsm::ReflectiveShadowMap;
+use gibench_harness::kit::ir::splat::PointSplat;
+use gibench_harness::kit::ir::vpl_sample::{RsmTexels, VplSampler};
+use gibench_harness::kit::passes::DrawSet;
+use gibench_harness::kit::technique::{
     Conformance, FrameContext, Params, PrepareContext, Prepared, Technique, TechniqueInfo,
 };
 use gibench_harness::{wgpu, Error, Result};
@@ -69,7 +69,7 @@ pub const INFO_CLASSIC: TechniqueInfo = TechniqueInfo {
     params: &[CLASSIC_PARAMS, GATHER],
     required_features: wgpu::Features::empty(),
     required_limits: wgpu::Limits::downlevel_defaults,
-    reference: gibench_harness::technique::one_bounce,
+    reference: gibench_harness::kit::technique::one_bounce,
     // The same bound as `ism`: the VPLs are the same; only the maps differ.
     conformance: Conformance {
         max_relative_l1: 0.8,
@@ -87,7 +87,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     params: &[OWN_PARAMS, GATHER],
     required_features: wgpu::Features::empty(),
     required_limits: wgpu::Limits::downlevel_defaults,
-    reference: gibench_harness::technique::one_bounce,
+    reference: gibench_harness::kit::technique::one_bounce,
     // On the Cornell boxes against the one-bounce reference (64 VPLs, 1024 points each, 4x4
     // tiles, 3 pull-push levels): measured relative L1 0.34–0.69 and mean ratio 0.93–0.94 on
     // the spot, area and omni boxes, 1.14 on the sun box, where light leaks through holes the

@@ -2,10 +2,10 @@
 //! documentation) and [`IsmParams`], the typed values read from them once and checked against
 //! the device.
 
-use gibench_harness::ir::atlas::{AtlasFormat, MapKind};
-use gibench_harness::ir::gather::{GatherParams, GATHER_PARAMS};
-use gibench_harness::ir::vpl_sample::VplWarp;
-use gibench_harness::technique::{ParamKind, ParamSpec, Params};
+use gibench_harness::kit::ir::atlas::{AtlasFormat, MapKind};
+use gibench_harness::kit::ir::gather::{GatherParams, GATHER_PARAMS};
+use gibench_harness::kit::ir::vpl_sample::VplWarp;
+use gibench_harness::kit::technique::{ParamKind, ParamSpec, Params};
 use gibench_harness::{Error, Result};
 
 /// `ism`'s own parameters (the kit's gather parameters [`GATHER`] follow them).

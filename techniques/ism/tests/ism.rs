@@ -6,12 +6,12 @@
 //! reference's one-bounce light); and the pull-push closes the holes of sparse point splats
 //! (its image approaches the classic maps' where without it light leaks).
 
+use gibench_harness::cpu::reference::{render_reference, ReferenceSettings};
 use gibench_harness::glam::Vec3;
-use gibench_harness::ir::atlas::{AtlasFormat, MapKind};
-use gibench_harness::ir::vpl_sample::VplWarp;
-use gibench_harness::reference::{render_reference, ReferenceSettings};
-use gibench_harness::runner::Harness;
-use gibench_harness::technique::TechniqueInfo;
+use gibench_harness::kit::ir::atlas::{AtlasFormat, MapKind};
+use gibench_harness::kit::ir::vpl_sample::VplWarp;
+use gibench_harness::kit::technique::TechniqueInfo;
+use gibench_harness::run::runner::Harness;
 use gibench_ism::{IsmParams, INFO, INFO_CLASSIC};
 use gibench_test_support::{each_backend, gpus, kv, load, run_config, Rendered};
 
@@ -275,7 +275,7 @@ fn identical_runs_agree_bit_for_bit_and_the_warp_reaches_the_sampler() {
 fn the_vpls_carry_the_first_bounce() {
     for name in ["cornell", "cornell-sun"] {
         let scene = load(name);
-        let frame = gibench_harness::anim::FrameClock::new(&scene.descriptor).frame(1);
+        let frame = gibench_harness::scene::anim::FrameClock::new(&scene.descriptor).frame(1);
         let settings = ReferenceSettings {
             spp: 64,
             bounces: 1,

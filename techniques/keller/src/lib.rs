@@ -33,14 +33,14 @@ mod ring;
 pub use params::KellerParams;
 pub use ring::PathRing;
 
-use gibench_harness::ir::gather::{VplGather, GATHER_PARAMS};
-use gibench_harness::ir::raster::AtlasClear;
-use gibench_harness::passes::DrawSet;
-use gibench_harness::quality::IndirectComponent;
-use gibench_harness::technique::{
+use gibench_harness::cpu::vpl::{self, Vpl};
+use gibench_harness::kit::ir::gather::{VplGather, GATHER_PARAMS};
+use gibench_harness::kit::ir::raster::AtlasClear;
+use gibench_harness::kit::passes::DrawSet;
+use gibench_harness::kit::technique::{
     Conformance, FrameContext, Params, PrepareContext, Prepared, Technique, TechniqueInfo,
 };
-use gibench_harness::vpl::{self, Vpl};
+use gibench_harness::run::quality::IndirectComponent;
 use gibench_harness::{wgpu, Error, Result};
 
 use params::{FULL_OWN, INCREMENTAL_OWN};

@@ -1,8 +1,8 @@
 //! The parameters of `keller-full` and `keller-incremental`: their declarations (names, ranges,
 //! defaults, documentation) and [`KellerParams`], the typed values read from them once.
 
-use gibench_harness::ir::gather::GatherParams;
-use gibench_harness::technique::{ParamKind, ParamSpec, Params};
+use gibench_harness::kit::ir::gather::GatherParams;
+use gibench_harness::kit::technique::{ParamKind, ParamSpec, Params};
 use gibench_harness::Result;
 
 /// Both techniques' path length.

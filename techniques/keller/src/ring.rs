@@ -1,10 +1,10 @@
 //! [`PathRing`]: the light paths `keller-incremental` keeps, refilled oldest first, and the
 //! VPLs they hold with their shadow-map slots.
 
-use gibench_harness::anim::LightPose;
-use gibench_harness::bvh::SceneBvh;
+use gibench_harness::cpu::bvh::SceneBvh;
+use gibench_harness::cpu::vpl::{self, Vpl, VplSettings};
+use gibench_harness::scene::anim::LightPose;
 use gibench_harness::scene::Scene;
-use gibench_harness::vpl::{self, Vpl, VplSettings};
 
 /// The ring of `keller-incremental`: N path slots, each holding the VPLs of one light path; the
 /// path with Halton index h lives in slot h mod N. Refilled oldest first with consecutive

@@ -2,12 +2,12 @@
 //! `keller-full`'s paths (fractional absorption by the path's place among the N, weights
 //! N / ⌊ρ̄^(j−1) N⌋ by the actual count), and `keller-full` traces until it has its VPL count.
 
-use gibench_harness::anim::{FrameClock, LightPose};
-use gibench_harness::bvh::SceneBvh;
+use gibench_harness::cpu::bvh::SceneBvh;
+use gibench_harness::cpu::vpl::{self, Vpl, VplSettings};
 use gibench_harness::glam::Vec3;
+use gibench_harness::scene::anim::{FrameClock, LightPose};
 use gibench_harness::scene::descriptor::{LightKind, SceneDescriptor};
 use gibench_harness::scene::{Material, Mesh, Scene};
-use gibench_harness::vpl::{self, Vpl, VplSettings};
 use gibench_keller::PathRing;
 use gibench_test_support::{load, quad, scene_with};
 

@@ -46,16 +46,16 @@ pub use manager::{Manager, Step, StepTimes};
 pub use params::LaineParams;
 
 use domain::SamplingDomain;
-use gibench_harness::anim::LightPose;
+use gibench_harness::cpu::vpl::Vpl;
 use gibench_harness::glam::Vec3;
-use gibench_harness::ir::gather::{VplGather, GATHER_PARAMS};
-use gibench_harness::ir::raster::AtlasClear;
-use gibench_harness::passes::DrawSet;
-use gibench_harness::technique::{
+use gibench_harness::kit::ir::gather::{VplGather, GATHER_PARAMS};
+use gibench_harness::kit::ir::raster::AtlasClear;
+use gibench_harness::kit::passes::DrawSet;
+use gibench_harness::kit::technique::{
     prepare_nothing, Conformance, FrameContext, Params, PrepareContext, Prepared, Technique,
     TechniqueInfo,
 };
-use gibench_harness::vpl::Vpl;
+use gibench_harness::scene::anim::LightPose;
 use gibench_harness::{wgpu, Result};
 use manager::domain_kind;
 use params::OWN_PARAMS;
@@ -70,7 +70,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     params: &[OWN_PARAMS, GATHER_PARAMS],
     required_features: wgpu::Features::empty(),
     required_limits: wgpu::Limits::downlevel_defaults,
-    reference: gibench_harness::technique::one_bounce,
+    reference: gibench_harness::kit::technique::one_bounce,
     // On the Cornell boxes against the one-bounce reference (64 VPLs, 4x4 tiles): measured
     // relative L1 0.33–0.71 and mean ratio 0.94–1.04 (the same VPL count as keller-*).
     conformance: Conformance {

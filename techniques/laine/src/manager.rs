@@ -1,12 +1,12 @@
 //! Laine's VPL management (§4) on the CPU: the managed VPLs and sampling points, and each
 //! frame's step (validity, domain update, deletion, creation, intensities) in named phases.
 
-use gibench_harness::anim::LightPose;
-use gibench_harness::bvh::SceneBvh;
+use gibench_harness::cpu::bvh::SceneBvh;
+use gibench_harness::cpu::light::SampleDomain;
+use gibench_harness::cpu::vpl::{self, Vpl};
 use gibench_harness::glam::Vec3;
-use gibench_harness::light::SampleDomain;
+use gibench_harness::scene::anim::LightPose;
 use gibench_harness::scene::{Scene, SceneExtent};
-use gibench_harness::vpl::{self, Vpl};
 use rayon::prelude::*;
 
 use crate::domain::{DomainKind, SamplingDomain};

@@ -1,8 +1,8 @@
 //! `laine`'s parameters: their specs (name, range, default, doc) and the typed struct read
 //! from them.
 
-use gibench_harness::ir::gather::GatherParams;
-use gibench_harness::technique::{ParamKind, ParamSpec, Params};
+use gibench_harness::kit::ir::gather::GatherParams;
+use gibench_harness::kit::technique::{ParamKind, ParamSpec, Params};
 use gibench_harness::{Error, Result};
 
 pub(crate) const OWN_PARAMS: &[ParamSpec] = &[

@@ -1,9 +1,9 @@
 //! Laine's VPL management on the Cornell box (CPU only): invariants every frame, and the
 //! dispersion of the sampling points under a still light.
 
-use gibench_harness::anim::FrameClock;
-use gibench_harness::assets::AssetPaths;
-use gibench_harness::bvh::SceneBvh;
+use gibench_harness::cpu::bvh::SceneBvh;
+use gibench_harness::scene::anim::FrameClock;
+use gibench_harness::scene::assets::AssetPaths;
 use gibench_harness::scene::descriptor::LightKind;
 use gibench_harness::scene::Scene;
 use gibench_laine::Manager;
@@ -89,11 +89,11 @@ fn management_invariants_while_the_light_moves() {
             // Intensities are Voronoi shares of the power times the albedo (§4.7): the total
             // estimates the same first-bounce flux as 1024 Halton light paths do.
             let halton: gibench_harness::glam::Vec3 =
-                gibench_harness::vpl::total_flux(&gibench_harness::vpl::generate(
+                gibench_harness::cpu::vpl::total_flux(&gibench_harness::cpu::vpl::generate(
                     &scene,
                     &bvh,
                     &light,
-                    &gibench_harness::vpl::VplSettings::new(1024),
+                    &gibench_harness::cpu::vpl::VplSettings::new(1024),
                 ));
             for c in 0..3 {
                 assert!(

@@ -2,7 +2,7 @@
 //! each for a scene; the run settings tests use.
 
 use gibench_harness::gpu::{backend_context, backends_for, GpuContext};
-use gibench_harness::runner::{Harness, RunConfig, TimingMode};
+use gibench_harness::run::runner::{Harness, RunConfig, TimingMode};
 use gibench_harness::scene::Scene;
 
 /// A context on each portable backend present, with its name; `check` names the test in the

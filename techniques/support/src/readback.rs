@@ -6,7 +6,7 @@ use gibench_harness::wgpu;
 
 /// The bytes of `buffer` (COPY_SRC), after every submitted command.
 pub fn read_bytes(gpu: &GpuContext, buffer: &wgpu::Buffer) -> Vec<u8> {
-    gibench_harness::image_io::read_buffer(gpu, buffer).expect("buffer read-back")
+    gibench_harness::gpu::image_io::read_buffer(gpu, buffer).expect("buffer read-back")
 }
 
 /// The floats of `buffer` (COPY_SRC), after every submitted command.
@@ -16,7 +16,7 @@ pub fn read_f32(gpu: &GpuContext, buffer: &wgpu::Buffer) -> Vec<f32> {
 
 /// The RGB of every texel of `texture`, row by row.
 pub fn read_rgb(gpu: &GpuContext, texture: &wgpu::Texture) -> Vec<Vec3> {
-    gibench_harness::image_io::read_rgb_f32(gpu, texture)
+    gibench_harness::gpu::image_io::read_rgb_f32(gpu, texture)
         .unwrap()
         .into_iter()
         .map(Vec3::from)

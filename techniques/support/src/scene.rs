@@ -1,8 +1,8 @@
 //! Scenes for tests: a named scene of `scenes/`, or one built in code (quads, closed boxes) with
 //! a descriptor's camera, light and settings.
 
-use gibench_harness::assets::AssetPaths;
 use gibench_harness::glam::{Vec2, Vec3};
+use gibench_harness::scene::assets::AssetPaths;
 use gibench_harness::scene::descriptor::SceneDescriptor;
 use gibench_harness::scene::{Material, Mesh, Scene, SceneExtent};
 

@@ -5,9 +5,9 @@
 use std::collections::BTreeMap;
 
 use gibench_harness::glam::Vec3;
-use gibench_harness::profiler::{ProfileMode, Profiler};
-use gibench_harness::runner::{Harness, RunConfig};
-use gibench_harness::technique::{Params, TechniqueInfo};
+use gibench_harness::gpu::profiler::{ProfileMode, Profiler};
+use gibench_harness::kit::technique::{Params, TechniqueInfo};
+use gibench_harness::run::runner::{Harness, RunConfig};
 use gibench_harness::Result;
 
 /// `-p name=value` pairs as the registry's parser takes them.

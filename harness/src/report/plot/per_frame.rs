@@ -4,8 +4,8 @@
 use std::path::Path;
 
 use super::lines_svg;
+use crate::measure::results::RunResult;
 use crate::report::runs::run_label;
-use crate::results::RunResult;
 use crate::{Error, Result};
 
 /// The metrics [`per_frame_lines`] and [`quality_over_frames_svg`] take.
@@ -30,7 +30,7 @@ pub type Line = (String, Vec<(f64, f64)>);
 /// points, labelled "technique @ scene"; results without any are left out.
 pub fn per_frame_lines(results: &[RunResult], metric: &str) -> Result<Vec<Line>> {
     check_per_frame_metric(metric)?;
-    let pick = |f: &crate::metrics::FrameQuality| -> Option<f64> {
+    let pick = |f: &crate::measure::metrics::FrameQuality| -> Option<f64> {
         match metric {
             "rmse" => Some(f.rmse),
             "rel_mse" => Some(f.rel_mse),

@@ -7,9 +7,9 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use super::{axis_max, category, chart_svg, label_width, stage_color, Axis, Categories};
 use super::{CategoryAxis, ChartFrame, Mark, FONT, LEGEND_W};
+use crate::measure::results::RunResult;
 use crate::report::runs::{run_label, stage_ms, stage_names};
 use crate::report::Cell;
-use crate::results::RunResult;
 use crate::{Error, Result};
 
 /// One horizontal bar per run ("technique @ scene", first run on top), stacked by stage in

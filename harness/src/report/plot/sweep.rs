@@ -7,8 +7,8 @@ use plotters::prelude::*;
 
 use super::{axis_max, category, chart_svg, stage_color, Axis, Categories, CategoryAxis};
 use super::{ChartFrame, Mark, PlotResult, LEGEND_W};
+use crate::measure::results::RunResult;
 use crate::report::runs::{stage_ms, stage_names, stage_sum};
-use crate::results::RunResult;
 use crate::{Error, Result};
 
 /// Per-stage median times (one coloured line each: flushed wall time, else GPU timestamps)

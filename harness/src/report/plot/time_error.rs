@@ -5,8 +5,8 @@ use std::path::Path;
 use plotters::prelude::*;
 
 use super::{axis_max, chart_svg, stage_color, ChartFrame, Mark};
+use crate::measure::results::RunResult;
 use crate::report::pareto::{pareto_front, time_error_points};
-use crate::results::RunResult;
 use crate::{Error, Result};
 
 /// Time versus error: one point per run with quality (technique and setting), the Pareto

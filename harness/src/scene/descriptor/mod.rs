@@ -104,7 +104,7 @@ pub enum LightKind {
     /// One-sided Lambertian rectangle of `size`, facing its target.
     Area,
     /// Directional light (the sun): parallel rays along position → target; `power` is the
-    /// irradiance E⊥ it gives a surface facing it (see [`crate::light`]).
+    /// irradiance E⊥ it gives a surface facing it (see [`crate::cpu::light`]).
     Sun,
 }
 

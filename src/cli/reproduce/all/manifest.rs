@@ -146,7 +146,7 @@ impl Manifest {
             mode: mode.to_string(),
             adapter: adapter.to_string(),
             driver: gpu.map(|g| g.info.driver.clone()).unwrap_or_default(),
-            git_commit: gibench_harness::runner::git_commit(),
+            git_commit: gibench_harness::run::runner::git_commit(),
             cpu_threads: std::thread::available_parallelism()
                 .map(|n| n.get())
                 .unwrap_or(1),
@@ -303,10 +303,10 @@ impl Manifest {
 
     /// `reproduce-all.html`: every target with its pages, tables and figures.
     pub(super) fn write_index(&self, root: &Path) -> Result<()> {
-        let entries: Vec<gibench_harness::html::IndexEntry> = self
+        let entries: Vec<gibench_harness::report::html::IndexEntry> = self
             .targets
             .iter()
-            .map(|r| gibench_harness::html::IndexEntry {
+            .map(|r| gibench_harness::report::html::IndexEntry {
                 name: r.name.clone(),
                 what: r.what.clone(),
                 time: match (r.seconds, &r.carried_from) {
@@ -320,7 +320,7 @@ impl Manifest {
                 files: r.files.clone(),
             })
             .collect();
-        gibench_harness::html::write_index(
+        gibench_harness::report::html::write_index(
             &root.join(format!("{MANIFEST}.html")),
             &format!(
                 "gibench reproduce all ({} sizes) on {}",

@@ -4,8 +4,8 @@
 use std::path::Path;
 
 use gibench_barczak::{STAGES, STAGE_SHADOW_MAPS, STAGE_VISIBILITY};
+use gibench_harness::measure::results::RunResult;
 use gibench_harness::report::{self, Cell, Table};
-use gibench_harness::results::RunResult;
 use gibench_harness::Result;
 
 use super::super::{device_note, ms, sum_ms};

@@ -32,12 +32,12 @@ mod figures;
 
 use std::path::PathBuf;
 
+use gibench_harness::cpu::reference::ReferenceSettings;
 use gibench_harness::gpu::GpuContext;
-use gibench_harness::quality::{IndirectComponent, QualityConfig};
-use gibench_harness::reference::ReferenceSettings;
+use gibench_harness::kit::technique::TechniqueInfo;
+use gibench_harness::run::quality::{IndirectComponent, QualityConfig};
+use gibench_harness::run::session::{RunSpec, TechniqueRun};
 use gibench_harness::scene::{Scene, SceneDescriptor};
-use gibench_harness::session::{RunSpec, TechniqueRun};
-use gibench_harness::technique::TechniqueInfo;
 use gibench_harness::{Error, Result};
 
 use super::{PaperModule, ReproduceArgs, Reproduced};
@@ -308,7 +308,7 @@ fn spec<'s>(args: &ReproduceArgs, scene: &'s Scene, set: Set) -> Result<RunSpec<
 fn load(desc: &SceneDescriptor, args: &ReproduceArgs) -> Result<Scene> {
     Scene::load(
         desc,
-        &gibench_harness::assets::AssetPaths::standard(args.assets.as_deref()),
+        &gibench_harness::scene::assets::AssetPaths::standard(args.assets.as_deref()),
     )
 }
 

@@ -6,7 +6,7 @@
 use gibench_barczak::database::{Receiver, ReceiverShape, VisibilityDatabase};
 use gibench_barczak::visibility::{Blocker, PatchTree, PointLight, Shape};
 use gibench_harness::gpu::GpuContext;
-use gibench_harness::runner::Harness;
+use gibench_harness::run::runner::Harness;
 use gibench_harness::scene::Scene;
 use glam::Vec3;
 
@@ -229,7 +229,7 @@ pub fn render_frame(
         .unwrap();
     gpu.queue.submit([enc.finish()]);
     (
-        gibench_harness::image_io::read_rgb_f32(gpu, r.output()).unwrap(),
+        gibench_harness::gpu::image_io::read_rgb_f32(gpu, r.output()).unwrap(),
         counts,
     )
 }
@@ -238,8 +238,8 @@ pub fn render_frame(
 /// the default chart limit.
 pub fn prepared(
     scene: &Scene,
-    bvh: &gibench_harness::bvh::SceneBvh,
-    frame: &gibench_harness::anim::FrameState,
+    bvh: &gibench_harness::cpu::bvh::SceneBvh,
+    frame: &gibench_harness::scene::anim::FrameState,
     settings: gibench_barczak::samples::SampleSettings,
     res: u32,
 ) -> gibench_barczak::setup::BarczakScene {

@@ -6,7 +6,7 @@
 //! query), built at once from a list of sites ([`SamplingDomain::from_sites`], a bulk load), or
 //! moved to new points ([`SamplingDomain::update_sites`]: what the management does each frame,
 //! when every point has moved with the light). Points use
-//! the convention of [`gibench_harness::vpl::Vpl::sample`]:
+//! the convention of [`gibench_harness::cpu::vpl::Vpl::sample`]:
 //!
 //! * [`DomainKind::Disc`] (spot lights, Figure 3a/b): `(x, y, 0)` on the unit disc;
 //! * [`DomainKind::Sphere`] (omni lights, Figure 3c): a unit direction.

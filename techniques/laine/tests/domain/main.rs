@@ -6,8 +6,8 @@ mod maintenance;
 
 use std::f64::consts::PI;
 
+use gibench_harness::cpu::vpl::radical_inverse;
 use gibench_harness::rng::SplitMix64 as Rng;
-use gibench_harness::vpl::radical_inverse;
 use gibench_laine::domain::{DomainKind, SamplingDomain};
 use glam::DVec3;
 

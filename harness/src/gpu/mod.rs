@@ -1,0 +1,387 @@
+//! Headless wgpu context: adapter choice, device creation with optional features, and an error
+//! sink so that GPU validation errors become [`Error::Gpu`] instead of panics.
+//!
+//! Adapter choice: `--backend` (vulkan, gl, metal, dx12) restricts the backends;
+//! `--adapter NAME` keeps adapters whose name contains NAME (case-insensitive). Among what is
+//! left the harness prefers a hardware adapter (discrete, integrated, virtual), then a CPU Vulkan
+//! adapter (Mesa lavapipe), then GL (Mesa llvmpipe), then anything else.
+
+pub mod image_io;
+pub mod profiler;
+
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+use crate::measure::results::DeviceInfo;
+use crate::{Error, Result};
+
+/// How to choose the adapter.
+#[derive(Clone, Debug, Default)]
+pub struct GpuOptions {
+    /// `vulkan`, `gl`, `metal`, `dx12`, or `None` for all.
+    pub backend: Option<String>,
+    /// Case-insensitive substring of the adapter name.
+    pub adapter: Option<String>,
+    /// The longest one wait for the GPU may last before it fails, seconds (`--gpu-timeout`);
+    /// `None` waits as long as the work takes.
+    pub gpu_timeout: Option<f64>,
+}
+
+/// One blocking wait is at most this long and is then renewed: wgpu's GL backend caps a fence
+/// wait at `u32::MAX` nanoseconds (about 4.3 s) and reports a timeout past it even when asked to
+/// wait indefinitely, while one submission on a CPU driver (llvmpipe) can take longer than that.
+const WAIT_SLICE: Duration = Duration::from_secs(1);
+
+/// After this long waiting for one submission, a line on standard error says so (once).
+const WAIT_NOTICE: Duration = Duration::from_secs(30);
+
+/// Optional features the harness uses when the adapter has them.
+const OPTIONAL_FEATURES: wgpu::Features =
+    wgpu::Features::TIMESTAMP_QUERY.union(wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS);
+
+/// The device and what it can do.
+pub struct GpuContext {
+    pub instance: wgpu::Instance,
+    pub adapter: wgpu::Adapter,
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+    pub info: DeviceInfo,
+    /// Timestamp queries can be written between passes (`write_timestamp` on encoders).
+    pub timestamps: bool,
+    errors: Arc<Mutex<Vec<String>>>,
+    wait_limit: Option<Duration>,
+}
+
+/// The environment variable the command line reads `--backend` from when it is not given.
+pub const BACKEND_ENV: &str = "GIBENCH_BACKEND";
+
+impl GpuOptions {
+    /// Checks what needs no adapter (the backend's name), so that a bad one is refused before
+    /// any work.
+    pub fn validate(&self) -> Result<()> {
+        if let Some(b) = &self.backend {
+            parse_backend(b)?;
+        }
+        self.wait_limit()?;
+        Ok(())
+    }
+
+    /// `gpu_timeout` as a duration; refused unless a number of seconds in (0, 1e6].
+    fn wait_limit(&self) -> Result<Option<Duration>> {
+        match self.gpu_timeout {
+            None => Ok(None),
+            Some(s) if s.is_finite() && s > 0.0 && s <= 1e6 => Ok(Some(Duration::from_secs_f64(s))),
+            Some(s) => Err(Error::param(
+                "gpu-timeout",
+                format!("expected a number of seconds above 0 and at most 1e6 (got {s})"),
+            )),
+        }
+    }
+}
+
+/// The backends `name` selects. An unknown name is refused naming `--backend`, or
+/// [`BACKEND_ENV`] when that is where the name came from.
+fn parse_backend(name: &str) -> Result<wgpu::Backends> {
+    Ok(match name.to_ascii_lowercase().as_str() {
+        "vulkan" | "vk" => wgpu::Backends::VULKAN,
+        "gl" | "gles" | "opengl" => wgpu::Backends::GL,
+        "metal" => wgpu::Backends::METAL,
+        "dx12" | "d3d12" => wgpu::Backends::DX12,
+        "all" | "" => wgpu::Backends::all(),
+        other => {
+            let expected = "expected one of vulkan, gl, metal, dx12";
+            if std::env::var(BACKEND_ENV).is_ok_and(|v| v == name) {
+                return Err(Error::Invalid(format!(
+                    "environment variable {BACKEND_ENV}: unknown backend '{other}'; {expected} \
+                     (or unset it; --backend overrides it)"
+                )));
+            }
+            return Err(Error::param(
+                "backend",
+                format!("unknown backend '{other}'; {expected}"),
+            ));
+        }
+    })
+}
+
+/// Lower is better: hardware, then CPU Vulkan, then GL, then the rest.
+fn preference(info: &wgpu::AdapterInfo) -> u32 {
+    use wgpu::{Backend, DeviceType};
+    match (info.backend, info.device_type) {
+        (Backend::Gl, _) => 2,
+        (_, DeviceType::DiscreteGpu) => 0,
+        (_, DeviceType::IntegratedGpu | DeviceType::VirtualGpu) => 0,
+        (Backend::Vulkan, DeviceType::Cpu) => 1,
+        _ => 3,
+    }
+}
+
+const NO_ADAPTER_HELP: &str = "no GPU adapter found. gibench needs a Vulkan driver or OpenGL; \
+on a machine without a GPU install Mesa's CPU drivers (Debian/Ubuntu: \
+`apt-get install mesa-vulkan-drivers` for lavapipe; llvmpipe GL comes with libgl1-mesa-dri)";
+
+/// The portable backends (`vulkan`, `gl`) that offer an adapter on this machine, in that order:
+/// tests that compare backends run on the ones present and say which are absent.
+pub fn available_backends() -> Vec<&'static str> {
+    ["vulkan", "gl"]
+        .into_iter()
+        .filter(|b| {
+            GpuContext::new(&GpuOptions {
+                backend: Some(b.to_string()),
+                ..Default::default()
+            })
+            .is_ok()
+        })
+        .collect()
+}
+
+/// The portable backends present ([`available_backends`]) for a check that must hold on each
+/// (the tests' backend loop): at least one, else it panics; when only one is, `check` says so
+/// past the test harness's capture, so that a machine without the other is never silent.
+pub fn backends_for(check: &str) -> Vec<&'static str> {
+    let present = available_backends();
+    assert!(!present.is_empty(), "{check}: no Vulkan or GL adapter");
+    if present.len() < 2 {
+        say_uncaptured(&format!(
+            "{check}: only {present:?} present on this machine"
+        ));
+    }
+    present
+}
+
+/// A context on `backend`, one of [`available_backends`].
+pub fn backend_context(backend: &str) -> GpuContext {
+    GpuContext::new(&GpuOptions {
+        backend: Some(backend.into()),
+        ..Default::default()
+    })
+    .unwrap_or_else(|e| panic!("a {backend} adapter: {e}"))
+}
+
+/// Writes `message` to the process's standard error directly, past the test harness's output
+/// capture: for a test that must say plainly what it could not check on this machine.
+pub fn say_uncaptured(message: &str) {
+    use std::io::Write;
+    let _ = writeln!(std::io::stderr(), "note: {message}");
+}
+
+impl GpuContext {
+    /// The largest buffer this device can create and bind whole as storage, bytes (the
+    /// smaller of the two limits): what every storage buffer sized by a parameter is checked
+    /// against before it is made.
+    pub fn max_storage_buffer(&self) -> u64 {
+        let limits = self.device.limits();
+        limits
+            .max_storage_buffer_binding_size
+            .min(limits.max_buffer_size)
+    }
+
+    /// Picks an adapter and creates the device.
+    pub fn new(opts: &GpuOptions) -> Result<GpuContext> {
+        let wait_limit = opts.wait_limit()?;
+        let backends = match &opts.backend {
+            Some(b) => parse_backend(b)?,
+            None => wgpu::Backends::all(),
+        };
+        let wants_named = |a: &wgpu::Adapter| match &opts.adapter {
+            Some(sub) => a
+                .get_info()
+                .name
+                .to_lowercase()
+                .contains(&sub.to_lowercase()),
+            None => true,
+        };
+        let open = |b: wgpu::Backends| {
+            let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
+            desc.backends = b;
+            let instance = wgpu::Instance::new(desc);
+            let adapters = pollster::block_on(instance.enumerate_adapters(b));
+            (instance, adapters)
+        };
+        // GL is initialised only when no other backend offers a matching adapter (or when it is
+        // the backend asked for): probing EGL prints noise on headless machines.
+        let others = backends - wgpu::Backends::GL;
+        let (mut instance, mut adapters) = if others.is_empty() {
+            open(backends)
+        } else {
+            open(others)
+        };
+        if backends.contains(wgpu::Backends::GL)
+            && !others.is_empty()
+            && !adapters.iter().any(wants_named)
+        {
+            (instance, adapters) = open(backends);
+        }
+        if adapters.is_empty() {
+            let which = opts
+                .backend
+                .as_deref()
+                .map(|b| format!(" for backend '{b}'"))
+                .unwrap_or_default();
+            return Err(Error::Gpu(format!("{NO_ADAPTER_HELP}{which}")));
+        }
+        let names: Vec<String> = adapters
+            .iter()
+            .map(|a| format!("{} ({:?})", a.get_info().name, a.get_info().backend))
+            .collect();
+        let mut candidates: Vec<wgpu::Adapter> = adapters.into_iter().filter(wants_named).collect();
+        if candidates.is_empty() {
+            return Err(Error::param(
+                "adapter",
+                format!(
+                    "no adapter name contains '{}'; available: {}",
+                    opts.adapter.as_deref().unwrap_or(""),
+                    names.join(", ")
+                ),
+            ));
+        }
+        candidates.sort_by_key(|a| preference(&a.get_info()));
+        let adapter = candidates.remove(0);
+        let ai = adapter.get_info();
+        let features = adapter.features() & OPTIONAL_FEATURES;
+        let timestamps = features.contains(OPTIONAL_FEATURES);
+        let features = if timestamps {
+            features
+        } else {
+            wgpu::Features::empty()
+        };
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("gibench"),
+            required_features: features,
+            required_limits: adapter.limits(),
+            ..Default::default()
+        }))
+        .map_err(|e| Error::Gpu(format!("could not create a device on '{}': {e}", ai.name)))?;
+        let errors = Arc::new(Mutex::new(Vec::new()));
+        let sink = errors.clone();
+        device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
+            if let Ok(mut v) = sink.lock() {
+                v.push(e.to_string());
+            }
+        }));
+        let period = if timestamps {
+            queue.get_timestamp_period()
+        } else {
+            0.0
+        };
+        let info = DeviceInfo {
+            adapter: ai.name.clone(),
+            backend: format!("{:?}", ai.backend).to_lowercase(),
+            device_type: format!("{:?}", ai.device_type),
+            driver: ai.driver.clone(),
+            driver_info: ai.driver_info.clone(),
+            timestamp_queries: timestamps,
+            timestamp_period_ns: period,
+        };
+        Ok(GpuContext {
+            instance,
+            adapter,
+            device,
+            queue,
+            info,
+            timestamps,
+            errors,
+            wait_limit,
+        })
+    }
+
+    /// Blocks until all submitted GPU work has finished. Only the profiler and explicit
+    /// readbacks call this.
+    pub fn flush(&self) -> Result<()> {
+        self.wait(None)?;
+        self.check_errors()
+    }
+
+    /// Blocks until the given submission has finished.
+    pub fn wait_for(&self, index: wgpu::SubmissionIndex) -> Result<()> {
+        self.wait(Some(index))
+    }
+
+    /// Waits for `index` (the latest submission when `None`) in slices of [`WAIT_SLICE`], as
+    /// long as the work takes or up to the user's `--gpu-timeout`; a long wait is announced
+    /// once on standard error.
+    fn wait(&self, index: Option<wgpu::SubmissionIndex>) -> Result<()> {
+        let start = Instant::now();
+        let mut announced = false;
+        loop {
+            let poll = wgpu::PollType::Wait {
+                submission_index: index.clone(),
+                timeout: Some(WAIT_SLICE),
+            };
+            match self.device.poll(poll) {
+                Ok(_) => return Ok(()),
+                Err(wgpu::PollError::Timeout) => {
+                    let waited = start.elapsed();
+                    if let Some(limit) = self.wait_limit.filter(|l| waited >= *l) {
+                        return Err(Error::param(
+                            "gpu-timeout",
+                            format!(
+                                "the GPU ({}) did not finish one submission within {:.1} s",
+                                self.info.adapter,
+                                limit.as_secs_f64()
+                            ),
+                        ));
+                    }
+                    if !announced && waited >= WAIT_NOTICE {
+                        announced = true;
+                        eprintln!(
+                            "note: still waiting for the GPU ({}) after {:.0} s on one submission; \
+                             gibench waits as long as it takes (--gpu-timeout sets a limit)",
+                            self.info.adapter,
+                            waited.as_secs_f64()
+                        );
+                    }
+                }
+                Err(e) => return Err(Error::Gpu(format!("waiting for the GPU failed: {e}"))),
+            }
+        }
+    }
+
+    /// Turns GPU validation errors collected so far into an error.
+    pub fn check_errors(&self) -> Result<()> {
+        let mut v = self
+            .errors
+            .lock()
+            .map_err(|_| Error::Gpu("error sink poisoned".into()))?;
+        if v.is_empty() {
+            Ok(())
+        } else {
+            let msg = v.join("; ");
+            v.clear();
+            Err(Error::Gpu(msg))
+        }
+    }
+
+    /// Whether the device has `features` and at least `limits`; the error names what is missing.
+    pub fn check_requirements(
+        &self,
+        who: &str,
+        features: wgpu::Features,
+        limits: &wgpu::Limits,
+    ) -> Result<()> {
+        let missing = features - self.device.features();
+        if !missing.is_empty() {
+            return Err(Error::Gpu(format!(
+                "{who} needs GPU features {missing:?} which '{}' lacks",
+                self.info.adapter
+            )));
+        }
+        let mut failed = Vec::new();
+        limits.check_limits_with_fail_fn(&self.device.limits(), false, |name, want, have| {
+            failed.push(format!("{name} (needs {want}, has {have})"))
+        });
+        if !failed.is_empty() {
+            return Err(Error::Gpu(format!(
+                "{who} needs limits that '{}' lacks: {}",
+                self.info.adapter,
+                failed.join(", ")
+            )));
+        }
+        Ok(())
+    }
+
+    /// The largest square 2D texture the device supports.
+    pub fn max_texture_2d(&self) -> u32 {
+        self.device.limits().max_texture_dimension_2d
+    }
+}

@@ -1,0 +1,151 @@
+//! **Accumulation**: the irradiance of a [`VplStore`]'s VPLs, with visibility from a
+//! [`ShadowAtlas`], gathered into the interleaved split G-buffer.
+//!
+//! Reads: [`Interleave`]'s split position and normal, the VPL store, the atlas (any format:
+//! rasterised depth or a float atlas written by another pass).
+//! Writes: `split_irradiance`. The VPL in slot k lights the split tile `k mod T` (T = n·m
+//! tiles; Laine et al. 2007 §5.1), scaled by T; its contribution to a receiver is
+//! E = Φ/π · cos θ_v cos θ_r / r² · V.
+//!
+//! **Clamp** (Laine et al. 2007 §5.2, after Keller): the irradiance a single VPL may give a
+//! receiver is bounded — against the 1/r² singularity — by E_max = k · Ē, where Ē = ΣΦ / A
+//! is the mean irradiance all the store's VPLs together would give if their flux were spread
+//! evenly over the scene's surfaces (A, [`SceneExtent::surface_area`]; per channel) and k is
+//! the technique's `clamp` parameter (0: no clamp). A contribution over the bound in any
+//! channel is scaled as a whole down to it, keeping its colour. E_max does not depend on the
+//! scene's units or the light's power, and with more VPLs each carries less flux and fewer
+//! are clamped, so the bias shrinks with the VPL count as with the paper's fixed bound.
+//!
+//! [`SceneExtent::surface_area`]: crate::scene::SceneExtent::surface_area
+
+use bytemuck::{Pod, Zeroable};
+
+use super::atlas::ShadowAtlas;
+use super::interleave::{Interleave, INTERLEAVE_WGSL};
+use super::store::VplStore;
+use crate::gpu::GpuContext;
+use crate::kit::passes::{bind_buffer, compute_pipeline, params_entry, PARAMS_USAGE};
+use crate::Result;
+
+/// GPU layout of `AccumulateParams` in `accumulate.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct ParamsData {
+    /// x: k / A (0: no clamp).
+    clamp: [f32; 4],
+}
+
+/// The clamp of one VPL's irradiance (see the module docs).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct IrradianceClamp {
+    /// k: E_max in units of the mean irradiance ΣΦ / A; 0 (or less) turns the clamp off.
+    pub factor: f32,
+    /// A: the scene's surface area.
+    pub surface_area: f32,
+}
+
+impl IrradianceClamp {
+    /// No clamp.
+    pub const OFF: IrradianceClamp = IrradianceClamp {
+        factor: 0.0,
+        surface_area: 1.0,
+    };
+
+    /// E_max per channel for VPLs whose summed flux is `flux` (`None` with no clamp).
+    pub fn max_irradiance(&self, flux: glam::Vec3) -> Option<glam::Vec3> {
+        (self.factor > 0.0).then(|| self.per_flux() * flux)
+    }
+
+    /// k / A, what the shader multiplies the store's summed flux by (0 with no clamp).
+    fn per_flux(&self) -> f32 {
+        if self.factor > 0.0 && self.surface_area > 0.0 {
+            self.factor / self.surface_area
+        } else {
+            0.0
+        }
+    }
+}
+
+/// The accumulate pass over one store and one atlas (see the module docs).
+pub struct Accumulation {
+    pipeline: wgpu::ComputePipeline,
+    group: wgpu::BindGroup,
+    /// Kept alive for the bind group.
+    _params: wgpu::Buffer,
+}
+
+impl Accumulation {
+    /// Builds the pass for `store` and `atlas` over `interleave`'s split buffers, with `clamp`
+    /// on each VPL's irradiance.
+    pub fn new(
+        gpu: &GpuContext,
+        interleave: &Interleave,
+        store: &VplStore,
+        atlas: &ShadowAtlas,
+        clamp: IrradianceClamp,
+    ) -> Result<Accumulation> {
+        let device = &gpu.device;
+        let params = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("accumulate params"),
+            size: std::mem::size_of::<ParamsData>() as u64,
+            usage: PARAMS_USAGE,
+            mapped_at_creation: false,
+        });
+        gpu.queue.write_buffer(
+            &params,
+            0,
+            bytemuck::bytes_of(&ParamsData {
+                clamp: [clamp.per_flux(), 0.0, 0.0, 0.0],
+            }),
+        );
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("accumulate"),
+            entries: &[
+                VplStore::layout_entry(0, false),
+                params_entry(1, wgpu::ShaderStages::COMPUTE),
+            ],
+        });
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("accumulate"),
+            layout: &layout,
+            entries: &[bind_buffer(0, store.buffer()), bind_buffer(1, &params)],
+        });
+        let source = format!(
+            "{INTERLEAVE_WGSL}\n{}\n{}\n{}",
+            VplStore::wgsl(1, 0, false),
+            ShadowAtlas::wgsl(2),
+            include_str!("shaders/accumulate.wgsl")
+        );
+        let pipeline = compute_pipeline(
+            device,
+            "vpl accumulate",
+            &source,
+            &[interleave.split_layout(), &layout, atlas.layout()],
+            "accumulate",
+        );
+        gpu.check_errors()?;
+        Ok(Accumulation {
+            pipeline,
+            group,
+            _params: params,
+        })
+    }
+
+    /// Records the accumulation (the atlas must be the one this pass was built with).
+    pub fn encode(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        interleave: &Interleave,
+        atlas: &ShadowAtlas,
+    ) {
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("accumulate"),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, interleave.split_group(), &[]);
+        pass.set_bind_group(1, &self.group, &[]);
+        pass.set_bind_group(2, atlas.group(), &[]);
+        interleave.dispatch_split_size(&mut pass);
+    }
+}

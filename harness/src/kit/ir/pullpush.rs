@@ -1,0 +1,199 @@
+//! **Pull-push**: fills the holes of every imperfect shadow map at once, in texture space
+//! (Ritschel et al. 2008; the pull-push of Grossman and Dally 1998), and writes the maps into
+//! the atlas.
+//!
+//! Reads: [`PointSplat`]'s imperfect depth buffer (level 0).
+//! Writes (owns): a pyramid of `levels` coarser levels of every map, (mean reversed depth,
+//! weight) per texel; the float ([`AtlasFormat::Float32`]) [`ShadowAtlas`] — every slot's
+//! paraboloid block.
+//!
+//! Pull: each texel of level k + 1 is the mean of the valid depths among its 2×2 children,
+//! with weight min(1, Σ child weights) (0 when none is valid). Push, from level `levels` − 1
+//! down to 1: a texel of weight w < 1 becomes w · itself + (1 − w) · its parent. The last push
+//! writes level 0 into the atlas: a texel a point landed on keeps its depth exactly; a hole
+//! takes its parent's depth, or stays empty (0) where no point landed within 2^`levels` texels
+//! — so large empty regions (no geometry behind a VPL's horizon) are not closed up. `levels` 0
+//! copies the splats unfilled (the paper's "depth map without pull-push", with its leaks).
+//!
+//! Deviation: the push takes the parent texel (nearest), not a bilinear mix of four parents.
+
+use bytemuck::{Pod, Zeroable};
+
+use super::atlas::{AtlasFormat, ShadowAtlas};
+use super::splat::{texel_buffer_size, PointSplat};
+use crate::gpu::GpuContext;
+use crate::kit::passes::{
+    bind_buffer, compute_pipeline, params_entry, storage_entry, storage_texture_entry, PARAMS_USAGE,
+};
+use crate::{Error, Result};
+
+/// GPU layout of `PullPushParams` in `pullpush.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct ParamsData {
+    counts: [u32; 4],
+    offsets: [u32; 4],
+}
+
+/// One dispatch: its pipeline, bind group and the texels of a map at its level.
+struct Pass {
+    pipeline: usize,
+    group: wgpu::BindGroup,
+    _params: wgpu::Buffer,
+    texels: u32,
+}
+
+/// The pull-push passes (see the module docs).
+pub struct PullPush {
+    /// pull, push, store.
+    pipelines: [wgpu::ComputePipeline; 3],
+    passes: Vec<Pass>,
+    _pyramid: wgpu::Buffer,
+    slots: u32,
+    levels: u32,
+}
+
+const NO_SOURCE: u32 = u32::MAX;
+
+impl PullPush {
+    /// The passes over `splat`'s depth buffer into `atlas` (a float atlas of the same slots
+    /// and map size), pulling `levels` levels (at most log2 of the map size).
+    pub fn new(
+        gpu: &GpuContext,
+        splat: &PointSplat,
+        atlas: &ShadowAtlas,
+        levels: u32,
+    ) -> Result<PullPush> {
+        let device = &gpu.device;
+        let (slots, size) = splat.layout();
+        if atlas.settings.format != AtlasFormat::Float32 || atlas.settings.size != size {
+            return Err(Error::Invalid(
+                "pull-push writes a float atlas of the splat's map size".into(),
+            ));
+        }
+        let levels = levels.min(size.trailing_zeros());
+        // Offsets of levels 1..=levels in the pyramid (items).
+        let mut offsets = vec![0u32; levels as usize + 2];
+        let mut items = 0u64;
+        for k in 1..=levels {
+            offsets[k as usize] = items as u32;
+            let s = (size >> k) as u64;
+            items += slots as u64 * s * s;
+        }
+        let bytes = texel_buffer_size(
+            gpu,
+            items.max(1) * 2,
+            "the pull-push pyramid",
+            "vpl-map-size",
+        )?;
+        let pyramid = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("pull-push pyramid"),
+            size: bytes,
+            usage: wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        });
+        let base = [
+            params_entry(0, wgpu::ShaderStages::COMPUTE),
+            storage_entry(1, true),
+            storage_entry(2, false),
+        ];
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("pull-push"),
+            entries: &base,
+        });
+        let mut with_atlas = base.to_vec();
+        with_atlas.push(storage_texture_entry(3, wgpu::TextureFormat::R32Float));
+        let store_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("pull-push store"),
+            entries: &with_atlas,
+        });
+        let common = include_str!("shaders/pullpush.wgsl");
+        let pipeline = |layout: &wgpu::BindGroupLayout, source: String, entry: &str| {
+            compute_pipeline(device, entry, &source, &[layout], entry)
+        };
+        let pipelines = [
+            pipeline(&layout, common.to_string(), "pull"),
+            pipeline(&layout, common.to_string(), "push"),
+            pipeline(
+                &store_layout,
+                format!("{common}\n{}", include_str!("shaders/pullpush_store.wgsl")),
+                "store",
+            ),
+        ];
+        let atlas_view = atlas.texture().create_view(&Default::default());
+        let columns = atlas.columns();
+        let pass = |kind: usize, level: u32, source: u32| -> Pass {
+            let s = size >> level;
+            let params = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("pull-push params"),
+                size: std::mem::size_of::<ParamsData>() as u64,
+                usage: PARAMS_USAGE,
+                mapped_at_creation: false,
+            });
+            gpu.queue.write_buffer(
+                &params,
+                0,
+                bytemuck::bytes_of(&ParamsData {
+                    counts: [level, s, slots, columns],
+                    offsets: [offsets[level as usize], source, 0, 0],
+                }),
+            );
+            let mut entries = vec![
+                bind_buffer(0, &params),
+                bind_buffer(1, splat.depth()),
+                bind_buffer(2, &pyramid),
+            ];
+            if kind == 2 {
+                entries.push(wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: wgpu::BindingResource::TextureView(&atlas_view),
+                });
+            }
+            let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("pull-push"),
+                layout: if kind == 2 { &store_layout } else { &layout },
+                entries: &entries,
+            });
+            Pass {
+                pipeline: kind,
+                group,
+                _params: params,
+                texels: s * s,
+            }
+        };
+        let mut passes = Vec::new();
+        for k in 1..=levels {
+            passes.push(pass(0, k, if k > 1 { offsets[k as usize - 1] } else { 0 }));
+        }
+        for k in (1..levels).rev() {
+            passes.push(pass(1, k, offsets[k as usize + 1]));
+        }
+        passes.push(pass(2, 0, if levels > 0 { offsets[1] } else { NO_SOURCE }));
+        gpu.check_errors()?;
+        Ok(PullPush {
+            pipelines,
+            passes,
+            _pyramid: pyramid,
+            slots,
+            levels,
+        })
+    }
+
+    /// Levels pulled (the requested number, at most log2 of the map size).
+    pub fn levels(&self) -> u32 {
+        self.levels
+    }
+
+    /// Records pull, push and the store into the atlas, one dispatch per level for all maps.
+    pub fn encode(&self, encoder: &mut wgpu::CommandEncoder) {
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("pull-push"),
+            timestamp_writes: None,
+        });
+        for p in &self.passes {
+            pass.set_pipeline(&self.pipelines[p.pipeline]);
+            pass.set_bind_group(0, &p.group, &[]);
+            pass.dispatch_workgroups(p.texels.div_ceil(64), self.slots, 1);
+        }
+    }
+}

@@ -1,0 +1,221 @@
+//! **Reflective shadow map**: the scene seen from the primary light — surface positions,
+//! normals and the flux each texel's patch reflects — as the texels the
+//! [`super::vpl_sample::VplSampler`] reads (imperfect shadow maps' first step, Ritschel et al.
+//! 2008; reflective shadow maps, Dachsbacher and Stamminger 2005).
+//!
+//! Reads: the scene (static meshes and movers, through [`scene_pipeline`] with the G-buffer's
+//! fragment shader: textured albedo, normal facing the viewer), the light's views (slots
+//! 1..=6 of the frame's [`crate::kit::passes::ViewSet`]: the cube faces around a spot, omni or area
+//! light, or the sun's one orthographic map), the `Light` block.
+//! Writes (owns): a 3×2 atlas of `size`² faces (depth, normal, albedo), and three storage
+//! buffers of 6·`size`² texels: position (w = 1 where a surface was seen), normal, reflected
+//! flux = albedo × the light's flux through the texel (I(ω)·Ω for a light at a point, E⊥·A for
+//! the sun). The texels of all faces together carry the flux the first bounce reflects, which
+//! is what the VPLs sampled from them share.
+//!
+//! An area light is seen from its centre with its cosine intensity, as the harness's direct
+//! pass treats it (README, deviations).
+
+use super::splat::texel_buffer_size;
+use crate::gpu::GpuContext;
+use crate::kit::passes::{
+    begin_gbuffer_pass, bind_buffer, compute_pipeline, draw_light_faces, params_entry,
+    render_target, scene_pipeline, storage_entry, texture_entry, uniform_entry, FrameUniforms,
+    GpuScene, ALBEDO_FORMAT, DEPTH_FORMAT, NORMAL_FORMAT, PARAMS_USAGE,
+};
+use crate::Result;
+
+/// The map, its render pipeline and its export pass (see the module docs).
+pub struct ReflectiveShadowMap {
+    size: u32,
+    depth_view: wgpu::TextureView,
+    normal_view: wgpu::TextureView,
+    albedo_view: wgpu::TextureView,
+    pipeline: wgpu::RenderPipeline,
+    export: wgpu::ComputePipeline,
+    group: wgpu::BindGroup,
+    faces_group: wgpu::BindGroup,
+    params: wgpu::Buffer,
+    buffers: [wgpu::Buffer; 3],
+    _textures: [wgpu::Texture; 3],
+}
+
+impl ReflectiveShadowMap {
+    /// A map of `size`² per face for the scene drawn by `scene` with `uniforms`' light views.
+    pub fn new(
+        gpu: &GpuContext,
+        scene: &GpuScene,
+        uniforms: &FrameUniforms,
+        size: u32,
+    ) -> Result<ReflectiveShadowMap> {
+        let device = &gpu.device;
+        let extent = [3 * size, 2 * size];
+        let depth = render_target(device, "rsm depth", extent, DEPTH_FORMAT);
+        let normal = render_target(device, "rsm normal", extent, NORMAL_FORMAT);
+        let albedo = render_target(device, "rsm albedo", extent, ALBEDO_FORMAT);
+        let view = |t: &wgpu::Texture| t.create_view(&Default::default());
+        let (depth_view, normal_view, albedo_view) = (view(&depth), view(&normal), view(&albedo));
+        let pipeline = scene_pipeline(
+            device,
+            "rsm",
+            scene,
+            uniforms,
+            "vs_main",
+            Some(("fs_gbuffer", &[NORMAL_FORMAT, ALBEDO_FORMAT])),
+        );
+        let texels = 6 * size as u64 * size as u64;
+        let bytes = texel_buffer_size(
+            gpu,
+            texels * 4,
+            "the reflective shadow map's texels",
+            "rsm-size",
+        )?;
+        let buffer = |label: &str| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: bytes,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            })
+        };
+        let buffers = [
+            buffer("rsm position"),
+            buffer("rsm normal"),
+            buffer("rsm flux"),
+        ];
+        let params = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("rsm params"),
+            size: 16,
+            usage: PARAMS_USAGE,
+            mapped_at_creation: false,
+        });
+        let c = wgpu::ShaderStages::COMPUTE;
+        let unfilterable = wgpu::TextureSampleType::Float { filterable: false };
+        let d2 = wgpu::TextureViewDimension::D2;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("rsm export"),
+            entries: &[
+                params_entry(0, c),
+                params_entry(1, c),
+                texture_entry(2, c, unfilterable, d2),
+                texture_entry(3, c, unfilterable, d2),
+                texture_entry(4, c, unfilterable, d2),
+                storage_entry(5, false),
+                storage_entry(6, false),
+                storage_entry(7, false),
+            ],
+        });
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("rsm export"),
+            layout: &layout,
+            entries: &[
+                bind_buffer(0, &params),
+                bind_buffer(1, &uniforms.light_buffer),
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: wgpu::BindingResource::TextureView(&depth_view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: wgpu::BindingResource::TextureView(&normal_view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: wgpu::BindingResource::TextureView(&albedo_view),
+                },
+                bind_buffer(5, &buffers[0]),
+                bind_buffer(6, &buffers[1]),
+                bind_buffer(7, &buffers[2]),
+            ],
+        });
+        let face_entries: Vec<wgpu::BindGroupLayoutEntry> =
+            (0..6).map(|f| uniform_entry(f, c, false)).collect();
+        let faces_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("rsm faces"),
+            entries: &face_entries,
+        });
+        let faces_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("rsm faces"),
+            layout: &faces_layout,
+            entries: &(0..6)
+                .map(|f| wgpu::BindGroupEntry {
+                    binding: f,
+                    resource: uniforms.views.binding(1 + f as usize),
+                })
+                .collect::<Vec<_>>(),
+        });
+        let export = compute_pipeline(
+            device,
+            "rsm export",
+            include_str!("shaders/rsm_export.wgsl"),
+            &[&layout, &faces_layout],
+            "export_texels",
+        );
+        gpu.check_errors()?;
+        Ok(ReflectiveShadowMap {
+            size,
+            depth_view,
+            normal_view,
+            albedo_view,
+            pipeline,
+            export,
+            group,
+            faces_group,
+            params,
+            buffers,
+            _textures: [depth, normal, albedo],
+        })
+    }
+
+    /// Edge of each face, texels (the texel buffers' rows are this long).
+    pub fn size(&self) -> u32 {
+        self.size
+    }
+
+    /// Texels of all faces (6 · size²).
+    pub fn texels(&self) -> u32 {
+        6 * self.size * self.size
+    }
+
+    /// Position, normal and reflected-flux buffers (see the module docs).
+    pub fn buffers(&self) -> [&wgpu::Buffer; 3] {
+        [&self.buffers[0], &self.buffers[1], &self.buffers[2]]
+    }
+
+    /// Records the faces `faces` lists (the sun: face 0 only) and the export of every texel.
+    /// `directional`: whether the light is the sun (one orthographic map).
+    pub fn encode(
+        &self,
+        gpu: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        scene: &GpuScene,
+        uniforms: &FrameUniforms,
+        directional: bool,
+    ) {
+        let faces = if directional { 1u32 } else { 6 };
+        gpu.queue.write_buffer(
+            &self.params,
+            0,
+            bytemuck::bytes_of(&[self.size, faces, 0, 0]),
+        );
+        {
+            let mut pass = begin_gbuffer_pass(
+                encoder,
+                "rsm",
+                &self.normal_view,
+                &self.albedo_view,
+                &self.depth_view,
+            );
+            pass.set_pipeline(&self.pipeline);
+            draw_light_faces(&mut pass, scene, uniforms, self.size, 0..faces as usize);
+        }
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("rsm export"),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(&self.export);
+        pass.set_bind_group(0, &self.group, &[]);
+        pass.set_bind_group(1, &self.faces_group, &[]);
+        pass.dispatch_workgroups((self.size * self.size).div_ceil(64), 6, 1);
+    }
+}

@@ -1,0 +1,388 @@
+//! The technique interface: plain structs built from named, typed parameters (in the spirit of
+//! Mitsuba's plugin properties: a parameter nobody declared is an error that names it; each
+//! technique reads them once into its own typed settings struct), that declare the GPU
+//! features and limits they need, the reference component they approximate and their
+//! conformance bounds, prepare once per scene, and then each frame record named stages and
+//! return the indirect irradiance texture.
+
+use std::collections::BTreeMap;
+
+use serde_json::Value;
+
+use crate::cpu::bvh::SceneBvh;
+use crate::cpu::reference::IndirectComponent;
+use crate::gpu::profiler::Profiler;
+use crate::gpu::GpuContext;
+use crate::kit::passes::{DirectLight, FrameUniforms, GBuffer, GpuScene};
+use crate::scene::anim::FrameState;
+use crate::scene::Scene;
+use crate::{Error, Result};
+
+/// The type of a parameter, with its valid range.
+#[derive(Clone, Copy, Debug)]
+pub enum ParamKind {
+    /// An integer in `[min, max]`.
+    Int { min: i64, max: i64 },
+    /// A finite number in `[min, max]`.
+    Float { min: f64, max: f64 },
+    /// `true` / `false`.
+    Bool,
+    /// A tile layout `NxM`, each in `[1, 64]`.
+    Tiles,
+    /// One of the given words.
+    Choice(&'static [&'static str]),
+}
+
+/// One declared parameter.
+#[derive(Clone, Copy, Debug)]
+pub struct ParamSpec {
+    pub name: &'static str,
+    pub kind: ParamKind,
+    /// The default, written as on the command line.
+    pub default: &'static str,
+    pub doc: &'static str,
+}
+
+/// Parsed parameter values (defaults applied), keyed by name.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Params {
+    values: BTreeMap<String, Value>,
+}
+
+fn parse_value(technique: &str, spec: &ParamSpec, raw: &str) -> Result<Value> {
+    let bad = |what: String| {
+        Error::param(
+            format!("{technique}.{}", spec.name),
+            format!("{what} (got '{raw}')"),
+        )
+    };
+    let raw = raw.trim();
+    Ok(match spec.kind {
+        ParamKind::Int { min, max } => {
+            let v: i64 = raw.parse().map_err(|_| bad("expected an integer".into()))?;
+            if v < min || v > max {
+                return Err(bad(format!("expected an integer in [{min}, {max}]")));
+            }
+            Value::from(v)
+        }
+        ParamKind::Float { min, max } => {
+            let v: f64 = raw.parse().map_err(|_| bad("expected a number".into()))?;
+            if !v.is_finite() || v < min || v > max {
+                return Err(bad(format!("expected a number in [{min}, {max}]")));
+            }
+            Value::from(v)
+        }
+        ParamKind::Bool => Value::from(match raw {
+            "true" | "1" | "yes" | "on" => true,
+            "false" | "0" | "no" | "off" => false,
+            _ => return Err(bad("expected true or false".into())),
+        }),
+        ParamKind::Tiles => {
+            let (n, m) = parse_tiles(raw)
+                .ok_or_else(|| bad("expected tiles as NxM with N, M in [1, 64]".into()))?;
+            Value::from(format!("{n}x{m}"))
+        }
+        ParamKind::Choice(words) => {
+            if !words.contains(&raw) {
+                return Err(bad(format!("expected one of {}", words.join(", "))));
+            }
+            Value::from(raw)
+        }
+    })
+}
+
+/// Parses `NxM` (N, M in 1..=64).
+pub fn parse_tiles(s: &str) -> Option<(u32, u32)> {
+    let (a, b) = s.split_once(['x', 'X'])?;
+    let (n, m): (u32, u32) = (a.trim().parse().ok()?, b.trim().parse().ok()?);
+    ((1..=64).contains(&n) && (1..=64).contains(&m)).then_some((n, m))
+}
+
+impl Params {
+    /// Parses `key=value` pairs for `technique` against its declared `specs`. Every key must be
+    /// declared (otherwise the error names the key and lists the declared ones); missing keys
+    /// take their defaults.
+    pub fn parse(
+        technique: &str,
+        specs: &[ParamSpec],
+        given: &[(String, String)],
+    ) -> Result<Params> {
+        let mut values = BTreeMap::new();
+        for spec in specs {
+            values.insert(
+                spec.name.to_string(),
+                parse_value(technique, spec, spec.default)?,
+            );
+        }
+        for (k, v) in given {
+            let spec = specs.iter().find(|s| s.name == k).ok_or_else(|| {
+                let known: Vec<&str> = specs.iter().map(|s| s.name).collect();
+                Error::param(
+                    k.clone(),
+                    format!(
+                        "technique '{technique}' has no such parameter; it has: {}",
+                        if known.is_empty() {
+                            "none".to_string()
+                        } else {
+                            known.join(", ")
+                        }
+                    ),
+                )
+            })?;
+            values.insert(k.clone(), parse_value(technique, spec, v)?);
+        }
+        Ok(Params { values })
+    }
+
+    /// All values, for the results file.
+    pub fn to_map(&self) -> BTreeMap<String, Value> {
+        self.values.clone()
+    }
+
+    /// Whether `name` was declared.
+    pub fn has(&self, name: &str) -> bool {
+        self.values.contains_key(name)
+    }
+
+    fn get(&self, name: &str) -> &Value {
+        self.values
+            .get(name)
+            .unwrap_or_else(|| panic!("parameter '{name}' was not declared by the technique"))
+    }
+    /// An integer parameter (declared with [`ParamKind::Int`]).
+    pub fn int(&self, name: &str) -> i64 {
+        self.get(name).as_i64().expect("declared as Int")
+    }
+    /// A number parameter (declared with [`ParamKind::Float`]).
+    pub fn float(&self, name: &str) -> f64 {
+        self.get(name).as_f64().expect("declared as Float")
+    }
+    /// A boolean parameter.
+    pub fn bool(&self, name: &str) -> bool {
+        self.get(name).as_bool().expect("declared as Bool")
+    }
+    /// A tiles parameter as (columns, rows).
+    pub fn tiles(&self, name: &str) -> (u32, u32) {
+        parse_tiles(self.get(name).as_str().expect("declared as Tiles")).expect("validated")
+    }
+    /// A choice parameter.
+    pub fn choice(&self, name: &str) -> &str {
+        self.get(name).as_str().expect("declared as Choice")
+    }
+}
+
+/// What every technique call sees of the scene and the shared passes (the fields
+/// [`PrepareContext`] and [`FrameContext`] share; both deref to it).
+#[derive(Clone, Copy)]
+pub struct SceneContext<'a> {
+    pub gpu: &'a GpuContext,
+    /// The scene, with its per-scene constants in [`Scene::extent`].
+    pub scene: &'a Scene,
+    /// CPU ray casts over the static mesh.
+    pub bvh: &'a SceneBvh,
+    pub gpu_scene: &'a GpuScene,
+    pub gbuffer: &'a GBuffer,
+    pub uniforms: &'a FrameUniforms,
+    /// The primary light's shadow map and direct irradiance ([`DirectLight::wgsl`] and
+    /// [`DirectLight::light_group`] give technique shaders the same lookup).
+    pub direct: &'a DirectLight,
+}
+
+/// What a technique gets once per scene and when it is built.
+pub struct PrepareContext<'a> {
+    pub base: SceneContext<'a>,
+    pub resolution: [u32; 2],
+    pub seed: u64,
+    /// The first animation frame the technique will render (warm-up included).
+    pub first_frame: FrameState,
+}
+
+impl<'a> std::ops::Deref for PrepareContext<'a> {
+    type Target = SceneContext<'a>;
+    fn deref(&self) -> &SceneContext<'a> {
+        &self.base
+    }
+}
+
+/// What a technique gets every frame.
+pub struct FrameContext<'a> {
+    pub base: SceneContext<'a>,
+    pub frame: &'a FrameState,
+    /// Record stages through this: `profiler.gpu_stage(gpu, "name", |encoder| ...)` and
+    /// `profiler.cpu_stage("name", || ...)`.
+    pub profiler: &'a mut Profiler,
+}
+
+impl<'a> std::ops::Deref for FrameContext<'a> {
+    type Target = SceneContext<'a>;
+    fn deref(&self) -> &SceneContext<'a> {
+        &self.base
+    }
+}
+
+/// A real-time indirect-illumination technique.
+pub trait Technique {
+    /// Records this frame's stages. The indirect irradiance (see the harness's radiometric
+    /// convention) must be in [`Technique::output`] once the recorded stages have run.
+    fn render(&mut self, ctx: &mut FrameContext) -> Result<()>;
+    /// Full-resolution `Rgba16Float` indirect irradiance.
+    fn output(&self) -> &wgpu::TextureView;
+}
+
+/// What a technique prepares once per scene (PRT transfer, point sets, voxel tables, …): made
+/// by [`TechniqueInfo::prepare`], shared by both timing passes and the quality pass, and timed
+/// as its own figure (`prepare_ms` in the results).
+pub type Prepared = Box<dyn std::any::Any + Send + Sync>;
+
+/// A technique whose output approximates one bounce of indirect light whatever its parameters.
+pub fn one_bounce(_: &Params) -> IndirectComponent {
+    IndirectComponent::OneBounce
+}
+
+/// A technique whose output approximates every bounce of indirect light whatever its parameters.
+pub fn multi_bounce(_: &Params) -> IndirectComponent {
+    IndirectComponent::MultiBounce
+}
+
+/// The `prepare` of a technique that prepares nothing.
+pub fn prepare_nothing(_: &Params, _: &PrepareContext) -> Result<Prepared> {
+    Ok(Box::new(()))
+}
+
+/// What the conformance test (`tests/conformance.rs`) demands of a technique on the Cornell box
+/// under each kind of light (defaults, 96x72, after three frames),
+/// beyond finite output, zero where no geometry is hit and identical output from two builds:
+/// its indirect irradiance against its [`TechniqueInfo::reference`] component.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Conformance {
+    /// Largest relative L1 error: Σ|t − r| / Σr over pixels that hit geometry (an all-zero
+    /// output scores 1; less dominated by VPL hot spots and dark pixels than a relative MSE).
+    pub max_relative_l1: f64,
+    /// Range of the mean indirect irradiance relative to the reference's.
+    pub mean_ratio: (f64, f64),
+}
+
+/// A registry entry: how to list and build a technique.
+pub struct TechniqueInfo {
+    pub name: &'static str,
+    pub description: &'static str,
+    /// Declared parameters, composed from shared sets (e.g. the kit's gather parameters) and
+    /// the technique's own; names are unique across the groups.
+    pub params: &'static [&'static [ParamSpec]],
+    /// GPU features the technique cannot run without.
+    pub required_features: wgpu::Features,
+    /// Limits the technique needs (checked before it is built).
+    pub required_limits: fn() -> wgpu::Limits,
+    /// The reference component its indirect irradiance approximates with these parameters
+    /// (`keller-full bounces=3` computes several bounces, `barczak set=direct` the direct
+    /// light): `--quality` compares with it unless `--quality-reference` overrides.
+    pub reference: fn(&Params) -> IndirectComponent,
+    /// Its conformance bounds.
+    pub conformance: Conformance,
+    /// Per-scene preparation, once per scene and parameter set ([`prepare_nothing`] if none).
+    pub prepare: fn(&Params, &PrepareContext) -> Result<Prepared>,
+    /// Builds the technique for one scene from what `prepare` made.
+    pub create: fn(&Params, &PrepareContext, &Prepared) -> Result<Box<dyn Technique>>,
+}
+
+impl TechniqueInfo {
+    /// Finds `name` in `registry`; the error lists the known names.
+    pub fn find<'r>(registry: &'r [TechniqueInfo], name: &str) -> Result<&'r TechniqueInfo> {
+        registry.iter().find(|t| t.name == name).ok_or_else(|| {
+            let known: Vec<&str> = registry.iter().map(|t| t.name).collect();
+            Error::Invalid(format!(
+                "unknown technique '{name}'; known techniques: {}",
+                known.join(", ")
+            ))
+        })
+    }
+
+    /// Every declared parameter, in declaration order.
+    pub fn param_specs(&self) -> impl Iterator<Item = &'static ParamSpec> + '_ {
+        self.params.iter().flat_map(|g| g.iter())
+    }
+
+    /// Parses `key=value` pairs against this technique's parameters (see [`Params::parse`]).
+    pub fn parse_params(&self, given: &[(String, String)]) -> Result<Params> {
+        let specs: Vec<ParamSpec> = self.param_specs().copied().collect();
+        Params::parse(self.name, &specs, given)
+    }
+
+    /// The reference component with its default parameters (what `gibench list` shows).
+    pub fn default_reference(&self) -> IndirectComponent {
+        let defaults = self
+            .parse_params(&[])
+            .expect("a technique's defaults parse (tested for every registered technique)");
+        (self.reference)(&defaults)
+    }
+
+    /// Whether it declares a parameter `name`.
+    pub fn has_param(&self, name: &str) -> bool {
+        self.param_specs().any(|p| p.name == name)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const SPECS: &[ParamSpec] = &[
+        ParamSpec {
+            name: "vpls",
+            kind: ParamKind::Int { min: 1, max: 4096 },
+            default: "256",
+            doc: "",
+        },
+        ParamSpec {
+            name: "tiles",
+            kind: ParamKind::Tiles,
+            default: "4x4",
+            doc: "",
+        },
+        ParamSpec {
+            name: "clamp",
+            kind: ParamKind::Float { min: 0.0, max: 1e9 },
+            default: "0.5",
+            doc: "",
+        },
+    ];
+
+    fn kv(k: &str, v: &str) -> (String, String) {
+        (k.into(), v.into())
+    }
+
+    #[test]
+    fn defaults_and_overrides() {
+        let p = Params::parse("t", SPECS, &[kv("vpls", "64")]).unwrap();
+        assert_eq!(p.int("vpls"), 64);
+        assert_eq!(p.tiles("tiles"), (4, 4));
+        assert_eq!(p.float("clamp"), 0.5);
+    }
+
+    #[test]
+    fn unknown_parameter_is_named() {
+        let e = Params::parse("t", SPECS, &[kv("vlps", "64")])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("vlps") && e.contains("vpls, tiles, clamp"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn bad_values_are_rejected() {
+        for (k, v) in [
+            ("vpls", "0"),
+            ("vpls", "x"),
+            ("tiles", "4x0"),
+            ("tiles", "44"),
+            ("clamp", "nan"),
+        ] {
+            let e = Params::parse("t", SPECS, &[kv(k, v)])
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains(k) && e.contains(v), "{e}");
+        }
+    }
+}

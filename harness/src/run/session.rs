@@ -1,0 +1,241 @@
+//! The typed run API: a [`RunSpec`] in (a loaded scene, techniques with parsed parameters,
+//! frame settings, optional quality, where the files go), [`RunResult`]s out. The CLI's `run`
+//! and `sweep` and every paper reproduction go through [`execute`]; nothing round-trips through
+//! command-line strings.
+//!
+//! Per technique: its preparation once ([`Harness::prepare`], timed as `prepare_ms`), the
+//! timing passes ([`Harness::run`]), the quality pass if asked ([`Harness::measure_quality`]),
+//! then its files in `out`: `{stem}.json` (written last, atomically), and unless `images` is off
+//! `{stem}.png`, `{stem}-indirect.exr`, `{stem}-direct.exr` (and with quality the images of
+//! [`QUALITY_IMAGES`]).
+
+use std::path::{Path, PathBuf};
+
+use crate::gpu::image_io::{write_exr, write_png};
+use crate::gpu::GpuContext;
+use crate::kit::technique::{Params, TechniqueInfo};
+use crate::measure::results::RunResult;
+use crate::run::quality::{QualityConfig, ReferenceCache};
+use crate::run::runner::{Harness, PreparedTechnique, RunConfig, TimingMode};
+use crate::scene::Scene;
+use crate::{Error, Result};
+
+/// The quality pass's images, by file-name suffix after the run's stem
+/// ([`crate::run::quality::QualityImages`]). Of the last compared frame: the technique's composed
+/// image, the reference's, the FLIP error map, and the indirect light alone of the technique
+/// and of the reference at one shared exposure. Then the film strips of every compared frame's
+/// indirect light, the technique's and the reference's, which the HTML page's player shows.
+pub const QUALITY_IMAGES: [&str; 7] = [
+    "-compared.png",
+    "-reference.png",
+    "-flip.png",
+    "-indirect.png",
+    "-reference-indirect.png",
+    "-frames.png",
+    "-reference-frames.png",
+];
+
+/// The run's own images, by file-name suffix after its stem: the composed image, the indirect
+/// and the direct light (HDR).
+pub const RUN_IMAGES: [&str; 3] = [".png", "-indirect.exr", "-direct.exr"];
+
+/// One technique of a run.
+pub struct TechniqueRun {
+    pub info: &'static TechniqueInfo,
+    pub params: Params,
+    /// File name stem of its outputs (unique within the run).
+    pub stem: String,
+}
+
+impl TechniqueRun {
+    /// `info` with `params` given as (name, value) pairs (defaults for the rest), its files
+    /// named `stem`.
+    pub fn new(
+        info: &'static TechniqueInfo,
+        params: &[(&str, &str)],
+        stem: impl Into<String>,
+    ) -> Result<TechniqueRun> {
+        let given: Vec<(String, String)> = params
+            .iter()
+            .map(|(k, v)| (k.to_string(), v.to_string()))
+            .collect();
+        Ok(TechniqueRun {
+            info,
+            params: info.parse_params(&given)?,
+            stem: stem.into(),
+        })
+    }
+}
+
+/// Everything a run needs (see the module docs).
+pub struct RunSpec<'s> {
+    pub scene: &'s Scene,
+    pub runs: Vec<TechniqueRun>,
+    pub config: RunConfig,
+    pub quality: Option<QualityConfig>,
+    pub cache: ReferenceCache,
+    /// Where results and images go.
+    pub out: PathBuf,
+    /// Write images (PNG, EXR) beside the results.
+    pub images: bool,
+}
+
+/// What [`execute`] reports as it goes.
+pub enum Progress<'a> {
+    /// A technique's pass starts (its name, and "(quality)" for the quality pass).
+    Technique(&'a str),
+    /// One frame was rendered.
+    Frame,
+}
+
+impl RunSpec<'_> {
+    /// Checks what needs no GPU: the settings and unique stems.
+    pub fn validate(&self) -> Result<()> {
+        self.config.validate()?;
+        for (i, r) in self.runs.iter().enumerate() {
+            if self.runs[..i].iter().any(|o| o.stem == r.stem) {
+                return Err(Error::Invalid(format!(
+                    "two runs would write the same files '{}'",
+                    r.stem
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// Frames [`execute`] renders in all (for progress bars).
+    pub fn total_frames(&self) -> u64 {
+        let passes = if self.config.timing == TimingMode::Both {
+            2
+        } else {
+            1
+        } + self.quality.is_some() as u64;
+        self.runs.len() as u64 * passes * (self.config.frames + self.config.warmup) as u64
+    }
+}
+
+fn file_name(p: &Path) -> String {
+    p.file_name()
+        .map(|f| f.to_string_lossy().into_owned())
+        .unwrap_or_default()
+}
+
+/// A technique left out of a run over every technique: it cannot take the scene or does not
+/// fit the device (what its preparation said).
+#[derive(Clone, Debug)]
+pub struct Skipped {
+    pub technique: String,
+    pub reason: String,
+}
+
+/// Runs every technique of `spec` on `gpu` and writes its files; returns the results in order.
+/// A technique that cannot be prepared fails the run before any frame.
+pub fn execute(
+    gpu: &GpuContext,
+    spec: &RunSpec,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<Vec<RunResult>> {
+    execute_skipping(gpu, spec, false, progress).map(|(results, _)| results)
+}
+
+/// [`execute`], except that with `skip_unfit` a technique whose preparation fails is left out
+/// (with its reason) instead of failing the run: for a run over every technique, which should
+/// not die for one that cannot take the scene. Skipped or not, it is found out before any
+/// frame runs.
+pub fn execute_skipping(
+    gpu: &GpuContext,
+    spec: &RunSpec,
+    skip_unfit: bool,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<(Vec<RunResult>, Vec<Skipped>)> {
+    spec.validate()?;
+    let harness = Harness::new(gpu, spec.scene, &spec.config)?;
+    // Every technique is prepared and built once before any frame runs, so that what does not
+    // fit the device (a VPL atlas, a buffer) is reported before the first technique's work.
+    let mut prepared = Vec::with_capacity(spec.runs.len());
+    let mut skipped = Vec::new();
+    for run in &spec.runs {
+        let ready = harness
+            .prepare(run.info, &run.params, &spec.config)
+            .and_then(|p| {
+                drop(harness.build(run.info, &run.params, &spec.config, &p)?);
+                Ok(p)
+            });
+        match ready {
+            Ok(p) => prepared.push((run, p)),
+            Err(e) if skip_unfit => skipped.push(Skipped {
+                technique: run.info.name.to_string(),
+                reason: e.to_string(),
+            }),
+            Err(e) => return Err(e),
+        }
+    }
+    let mut results = Vec::with_capacity(prepared.len());
+    for (run, p) in &prepared {
+        results.push(execute_one(&harness, spec, run, p, progress)?);
+    }
+    Ok((results, skipped))
+}
+
+fn execute_one(
+    harness: &Harness,
+    spec: &RunSpec,
+    run: &TechniqueRun,
+    prepared: &PreparedTechnique,
+    progress: &mut dyn FnMut(Progress),
+) -> Result<RunResult> {
+    let (info, params, config) = (run.info, &run.params, &spec.config);
+    let out = |suffix: &str| spec.out.join(format!("{}{suffix}", run.stem));
+    // Every image a run of this stem may write is replaced: one this run does not write
+    // (--no-images, no --quality) is not left from an earlier run beside this run's results.
+    for suffix in RUN_IMAGES.iter().chain(&QUALITY_IMAGES) {
+        crate::output::replace_in_open_set(&out(suffix))?;
+    }
+    progress(Progress::Technique(info.name));
+    let (mut result, images) = harness.run(info, params, config, prepared, &mut || {
+        progress(Progress::Frame)
+    })?;
+    let mut extra_images = Vec::new();
+    if let Some(q) = &spec.quality {
+        let label = format!("{} (quality)", info.name);
+        progress(Progress::Technique(&label));
+        let (summary, qimages) =
+            harness.measure_quality(info, params, config, prepared, q, &spec.cache, &mut || {
+                progress(Progress::Frame)
+            })?;
+        result.quality = Some(summary);
+        if spec.images {
+            for (suffix, rgba) in [
+                (QUALITY_IMAGES[0], &qimages.compared_display),
+                (QUALITY_IMAGES[1], &qimages.reference_display),
+                (QUALITY_IMAGES[2], &qimages.flip_map),
+                (QUALITY_IMAGES[3], &qimages.indirect_display),
+                (QUALITY_IMAGES[4], &qimages.reference_indirect_display),
+            ] {
+                let png = out(suffix);
+                write_png(&png, qimages.size, rgba)?;
+                extra_images.push(file_name(&png));
+            }
+            for (suffix, strip) in [
+                (QUALITY_IMAGES[5], &qimages.indirect_strip),
+                (QUALITY_IMAGES[6], &qimages.reference_indirect_strip),
+            ] {
+                let png = out(suffix);
+                write_png(&png, strip.size, &strip.rgba)?;
+                extra_images.push(file_name(&png));
+            }
+        }
+    }
+    if spec.images {
+        let png = out(RUN_IMAGES[0]);
+        write_png(&png, images.size, &images.display)?;
+        let exr = out(RUN_IMAGES[1]);
+        write_exr(&exr, images.size, &images.indirect)?;
+        let direct = out(RUN_IMAGES[2]);
+        write_exr(&direct, images.size, &images.direct)?;
+        result.images = vec![file_name(&png), file_name(&exr), file_name(&direct)];
+        result.images.extend(extra_images);
+    }
+    result.write(&out(".json"))?;
+    Ok(result)
+}

@@ -1,0 +1,135 @@
+//! The harness's folders form layers: each uses only the folders below it (the order in
+//! `harness/src/lib.rs`'s docs and in docs/architecture.md). This test reads every source file
+//! under `harness/src` and fails when a file names a folder above its own through a `crate::`
+//! path, which is how an import circle between folders would start (for example the results
+//! model in `measure/` reaching up into `report/`).
+
+use std::path::{Path, PathBuf};
+
+/// The folders from the bottom up; `error`, `output` and `rng` are the files every layer may use.
+const LAYERS: &[&[&str]] = &[
+    &["error", "output", "rng"],
+    &["measure"],
+    &["scene"],
+    &["cpu"],
+    &["gpu"],
+    &["kit"],
+    &["run"],
+    &["report"],
+];
+
+fn layer_of(module: &str) -> Option<usize> {
+    LAYERS.iter().position(|l| l.contains(&module))
+}
+
+fn sources(dir: &Path, out: &mut Vec<PathBuf>) {
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.is_dir() {
+            sources(&path, out);
+        } else if path.extension().is_some_and(|e| e == "rs") {
+            out.push(path);
+        }
+    }
+}
+
+/// The first path segment of every `crate::` path in `code` (comments already removed),
+/// including each item of a `crate::{a::X, b}` group.
+fn crate_modules(code: &str) -> Vec<String> {
+    let mut found = Vec::new();
+    let mut rest = code;
+    while let Some(i) = rest.find("crate::") {
+        let preceded = rest[..i].chars().next_back();
+        rest = &rest[i + "crate::".len()..];
+        if matches!(preceded, Some(c) if c == '$' || c == ':' || c.is_alphanumeric() || c == '_') {
+            continue;
+        }
+        if let Some(group) = rest.strip_prefix('{') {
+            // Items at the group's top level: split on commas outside nested braces.
+            let (mut depth, mut start) = (0, true);
+            for (k, c) in group.char_indices() {
+                match c {
+                    '{' => depth += 1,
+                    '}' if depth == 0 => break,
+                    '}' => depth -= 1,
+                    ',' if depth == 0 => start = true,
+                    c if start && !c.is_whitespace() => {
+                        start = false;
+                        found.push(ident(&group[k..]));
+                    }
+                    _ => {}
+                }
+            }
+        } else {
+            found.push(ident(rest));
+        }
+    }
+    found
+}
+
+fn ident(s: &str) -> String {
+    s.chars()
+        .take_while(|c| c.is_alphanumeric() || *c == '_')
+        .collect()
+}
+
+/// `code` without `//` comments (doc links may point anywhere; only code is a dependency).
+fn strip_comments(code: &str) -> String {
+    code.lines()
+        .map(|l| match l.find("//") {
+            Some(i) if !l[..i].contains('"') => &l[..i],
+            _ => l,
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+#[test]
+fn every_folder_uses_only_the_folders_below_it() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut files = Vec::new();
+    sources(&root, &mut files);
+    let mut wrong = Vec::new();
+    let mut checked = 0;
+    for file in &files {
+        let rel = file.strip_prefix(&root).unwrap();
+        let first = rel.iter().next().unwrap().to_string_lossy();
+        let own = first.strip_suffix(".rs").unwrap_or(&first).to_string();
+        if own == "lib" {
+            continue;
+        }
+        let Some(own_layer) = layer_of(&own) else {
+            wrong.push(format!(
+                "{}: `{own}` is in no layer of this test's LAYERS (add it where it belongs)",
+                rel.display()
+            ));
+            continue;
+        };
+        checked += 1;
+        let code = strip_comments(&std::fs::read_to_string(file).unwrap());
+        for module in crate_modules(&code) {
+            // `crate::Error` / `crate::Result` are lib.rs's re-exports of `error`.
+            let module = match module.as_str() {
+                "Error" | "Result" => "error".to_string(),
+                _ => module,
+            };
+            match layer_of(&module) {
+                Some(l) if l <= own_layer => {}
+                Some(_) => wrong.push(format!(
+                    "{}: uses `crate::{module}`, a layer above its own `{own}`",
+                    rel.display()
+                )),
+                None => wrong.push(format!(
+                    "{}: uses `crate::{module}`, which is in no layer",
+                    rel.display()
+                )),
+            }
+        }
+    }
+    assert!(
+        checked > 50,
+        "only {checked} source files found under {}",
+        root.display()
+    );
+    assert!(wrong.is_empty(), "layering broken:\n{}", wrong.join("\n"));
+}
