@@ -131,29 +131,19 @@ pub(crate) fn exec(args: &ExportResultsArgs) -> Result<()> {
 /// most 64 characters): adapter, backend and driver. `None` without runs; an error when the
 /// runs come from more than one (their histories must not mix).
 fn testbed(runs: &[RunResult]) -> Result<Option<String>> {
-    let name = |r: &RunResult| {
-        let d = &r.device;
-        let words = format!("{} {} {}", d.adapter, d.backend, d.driver);
-        let mut slug = String::new();
-        for c in words.chars() {
-            if c.is_ascii_alphanumeric() {
-                slug.push(c.to_ascii_lowercase());
-            } else if !slug.is_empty() && !slug.ends_with('-') {
-                slug.push('-');
-            }
-        }
-        let mut slug: String = slug.trim_end_matches('-').chars().take(64).collect();
-        while slug.ends_with('-') {
-            slug.pop();
-        }
-        slug
-    };
-    let mut names: Vec<String> = runs.iter().map(name).collect();
-    names.sort();
-    names.dedup();
-    match names.as_slice() {
+    // Devices are told apart by their whole names, not by their slugs, which may be cut.
+    let mut devices: Vec<String> = runs
+        .iter()
+        .map(|r| {
+            let d = &r.device;
+            format!("{} {} {}", d.adapter, d.backend, d.driver)
+        })
+        .collect();
+    devices.sort();
+    devices.dedup();
+    match devices.as_slice() {
         [] => Ok(None),
-        [one] if !one.is_empty() => Ok(Some(one.clone())),
+        [one] if one.chars().any(|c| c.is_ascii_alphanumeric()) => Ok(Some(slug(one))),
         [_] => Err(Error::param(
             "inputs",
             "the runs' device has no adapter, backend or driver name to name a testbed by",
@@ -164,10 +154,33 @@ fn testbed(runs: &[RunResult]) -> Result<Option<String>> {
                 "the runs come from {} devices ({}); export each device's runs on their own \
                  (one testbed per upload)",
                 many.len(),
-                many.join(", ")
+                many.iter().map(|d| slug(d)).collect::<Vec<_>>().join(", ")
             ),
         )),
     }
+}
+
+/// `words` as a Bencher slug: lower-case letters and digits, single dashes between words, at
+/// most 64 characters. A longer one keeps its first 55 characters and ends in 8 hex digits of
+/// a hash of the whole words (FNV-1a, stable across builds), so that two devices whose names
+/// differ only past the cut still get two testbeds.
+fn slug(words: &str) -> String {
+    let mut s = String::new();
+    for c in words.chars() {
+        if c.is_ascii_alphanumeric() {
+            s.push(c.to_ascii_lowercase());
+        } else if !s.is_empty() && !s.ends_with('-') {
+            s.push('-');
+        }
+    }
+    let s = s.trim_end_matches('-');
+    if s.len() <= 64 {
+        return s.to_string();
+    }
+    let hash = words.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
+    });
+    format!("{}-{:08x}", s[..55].trim_end_matches('-'), hash as u32)
 }
 
 /// The kernels' instruction counts in `path` (`{"kernels": {"NAME": COUNT, ...}}`).
@@ -332,8 +345,11 @@ mod tests {
                 && !t.ends_with('-'),
             "{t}"
         );
+        // Two devices whose names differ only past the cut: two testbeds, and refused together.
         let mut other = r.clone();
         other.device.backend = "gl".into();
+        let u = testbed(std::slice::from_ref(&other)).unwrap().unwrap();
+        assert!(u.len() <= 64 && u != t, "{t} / {u}");
         let e = testbed(&[r, other]).unwrap_err().to_string();
         assert!(e.contains("2 devices"), "{e}");
     }
