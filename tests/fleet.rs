@@ -499,3 +499,253 @@ fn bad_shards_and_budgets_are_refused_before_any_work() {
         assert!(!out.exists(), "{args:?} wrote {out:?}");
     }
 }
+
+/// `gibench run` on the Cornell box at 64x48, `frames` measured frames, no images, `extra`
+/// added, into `out` with `vars` as its job system's environment, started (not waited for).
+fn start_run(
+    techniques: &str,
+    frames: &str,
+    out: &Path,
+    vars: &[(&str, String)],
+    extra: &[&str],
+) -> Child {
+    let mut c: Command = support::gibench();
+    for v in SHARD_VARS {
+        c.env_remove(v);
+    }
+    c.args([
+        "run",
+        "--scene",
+        "cornell",
+        "--technique",
+        techniques,
+        "--frames",
+        frames,
+        "--warmup",
+        "1",
+        "--timing",
+        "stages",
+        "--resolution",
+        "64x48",
+        "--shadow-size",
+        "64",
+        "--no-images",
+        "--quiet",
+        "--out",
+    ])
+    .arg(out)
+    .args(extra)
+    .envs(vars.iter().map(|(k, v)| (*k, v.as_str())))
+    .stdout(Stdio::piped())
+    .stderr(Stdio::piped())
+    .spawn()
+    .expect("gibench starts")
+}
+
+/// The results files of a run folder (`*.json` but the shard record), sorted.
+fn results_files(dir: &Path) -> Vec<String> {
+    let mut f: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".json") && n != "gibench-shard.json")
+        .collect();
+    f.sort();
+    f
+}
+
+/// `gibench merge DIRS --out OUT`: its exit status and standard error.
+fn merge(dirs: &[PathBuf], out: &Path) -> (bool, String) {
+    let mut args: Vec<PathBuf> = vec!["merge".into()];
+    args.extend(dirs.iter().cloned());
+    args.extend(["--out".into(), out.to_path_buf()]);
+    let o = support::run(&args);
+    (
+        o.status.success(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+/// `gibench sweep` of laine's tiles over three points at 64x48, two frames, into `out` with
+/// `extra` added: its exit status and standard error.
+fn sweep(out: &Path, extra: &[&str]) -> (bool, String) {
+    let mut c: Command = support::gibench();
+    for v in SHARD_VARS {
+        c.env_remove(v);
+    }
+    let o = c
+        .args([
+            "sweep",
+            "--technique",
+            "laine",
+            "--sweep",
+            "tiles=2x2,4x4,8x8",
+            "--frames",
+            "2",
+            "--warmup",
+            "1",
+            "--timing",
+            "stages",
+            "--resolution",
+            "64x48",
+            "--shadow-size",
+            "64",
+            "--no-images",
+            "--quiet",
+            "--out",
+        ])
+        .arg(out)
+        .args(extra)
+        .output()
+        .expect("gibench starts");
+    (
+        o.status.success(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+/// Catches: a `gibench sweep` shard that drops or repeats a point, or a merge that draws the
+/// sweep's table from anything but the pooled points in the sweep's order.
+#[test]
+fn sweep_shards_merge_to_the_unsharded_sweep() {
+    let tmp = tempfile::tempdir().unwrap();
+    let single = tmp.path().join("single");
+    let (ok, e) = sweep(&single, &[]);
+    assert!(ok, "the unsharded sweep failed: {e}");
+    let dirs: Vec<PathBuf> = (0..2)
+        .map(|i| tmp.path().join(format!("shard{i}")))
+        .collect();
+    for (i, d) in dirs.iter().enumerate() {
+        let (ok, e) = sweep(d, &["--shard", &format!("{i}/2")]);
+        assert!(ok, "shard {i} failed: {e}");
+    }
+    let mut all: Vec<String> = dirs.iter().flat_map(|d| results_files(d)).collect();
+    all.sort();
+    assert_eq!(all, results_files(&single), "the shards' points");
+    let merged = tmp.path().join("merged");
+    let (ok, e) = merge(&dirs, &merged);
+    assert!(ok, "merge failed: {e}");
+    assert_eq!(results_files(&merged), results_files(&single));
+    for f in [
+        "cornell-laine-sweep-tiles.md",
+        "cornell-laine-sweep-tiles.csv",
+    ] {
+        let read = |d: &Path| std::fs::read_to_string(d.join(f)).unwrap();
+        assert_eq!(
+            shape(&read(&single)),
+            shape(&read(&merged)),
+            "{f} differs beyond its numbers"
+        );
+    }
+    // The points in the sweep's order (the shape above hides the values).
+    let md = std::fs::read_to_string(merged.join("cornell-laine-sweep-tiles.md")).unwrap();
+    let at: Vec<usize> = ["| 2x2 |", "| 4x4 |", "| 8x8 |"]
+        .iter()
+        .map(|v| md.find(v).unwrap_or_else(|| panic!("no row {v}:\n{md}")))
+        .collect();
+    assert!(
+        at.windows(2).all(|w| w[0] < w[1]),
+        "rows out of order:\n{md}"
+    );
+}
+
+/// Catches: a `gibench run` shard that drops a technique or runs one another shard runs
+/// (the merged results differ from the unsharded run's), a Slurm environment not read by
+/// `run`, a merge that draws the summary table from anything but the pooled results in the
+/// run's order (its shape differs), or one that pools a shard twice, a unit twice, shards of
+/// other settings, or `run` shards with `reproduce all` folders, instead of refusing by name.
+#[test]
+fn run_shards_merge_to_the_unsharded_run() {
+    let tmp = tempfile::tempdir().unwrap();
+    let techniques = "direct,keller-full,laine";
+    let single = tmp.path().join("single");
+    let dirs: Vec<PathBuf> = (0..3)
+        .map(|i| tmp.path().join(format!("shard{i}")))
+        .collect();
+    let one = start_run(techniques, "2", &single, &[], &[]);
+    let shards: Vec<Child> = (dirs.iter().enumerate())
+        .map(|(i, d)| {
+            let vars = [
+                ("SLURM_ARRAY_TASK_ID", i.to_string()),
+                ("SLURM_ARRAY_TASK_COUNT", "3".to_string()),
+            ];
+            start_run(techniques, "2", d, &vars, &[])
+        })
+        .collect();
+    // A shard of other settings (three frames), for the refusal below.
+    let other = tmp.path().join("other");
+    let odd = start_run(techniques, "3", &other, &[], &["--shard", "2/3"]);
+    finish(one, "the unsharded run");
+    let logs: Vec<String> = (shards.into_iter().enumerate())
+        .map(|(i, c)| finish(c, &format!("shard {i}")))
+        .collect();
+    finish(odd, "the three-frame shard");
+    assert!(
+        logs[1].contains("shard 1/3") && logs[1].contains("SLURM_ARRAY_TASK_ID=1"),
+        "{}",
+        logs[1]
+    );
+    // Three techniques over three shards: one each, none twice.
+    let mut all: Vec<String> = dirs.iter().flat_map(|d| results_files(d)).collect();
+    for d in &dirs {
+        assert_eq!(results_files(d).len(), 1, "{d:?}: {:?}", results_files(d));
+    }
+    all.sort();
+    assert_eq!(all, results_files(&single));
+    let merged = tmp.path().join("merged");
+    let (ok, stderr) = merge(&dirs, &merged);
+    assert!(ok, "merge failed: {stderr}");
+    assert_eq!(results_files(&merged), results_files(&single));
+    for f in results_files(&single) {
+        let read = |d: &Path| -> serde_json::Value {
+            serde_json::from_slice(&std::fs::read(d.join(&f)).unwrap()).unwrap()
+        };
+        assert_eq!(
+            untimed(&read(&single)),
+            untimed(&read(&merged)),
+            "{f} differs beyond its timings"
+        );
+    }
+    for f in [
+        "cornell-summary.md",
+        "cornell-summary.csv",
+        "cornell-summary.tex",
+    ] {
+        let read = |d: &Path| std::fs::read_to_string(d.join(f)).unwrap();
+        assert_eq!(
+            shape(&read(&single)),
+            shape(&read(&merged)),
+            "{f} differs beyond its numbers"
+        );
+    }
+    assert!(merged.join("cornell-summary.svg").is_file());
+    // Refused by name, nothing written.
+    let dup = tmp.path().join("dup");
+    std::fs::create_dir_all(&dup).unwrap();
+    for f in std::fs::read_dir(&dirs[1]).unwrap().flatten() {
+        if f.file_type().unwrap().is_file() {
+            std::fs::copy(f.path(), dup.join(f.file_name())).unwrap();
+        }
+    }
+    let record = std::fs::read_to_string(dup.join("gibench-shard.json")).unwrap();
+    std::fs::write(
+        dup.join("gibench-shard.json"),
+        record.replace("\"1/3\"", "\"2/3\""),
+    )
+    .unwrap();
+    let plain = tmp.path().join("plain");
+    fake(&plain, "quick", "abc", &["keller-tiles"]);
+    let (s0, s1, s2) = (dirs[0].clone(), dirs[1].clone(), dirs[2].clone());
+    for (set, expect) in [
+        (vec![s0.clone(), s0.clone(), s1.clone()], "both shard 0/3"),
+        (vec![s0.clone(), s1.clone()], "shard 2/3 is missing"),
+        (vec![s0.clone(), s1.clone(), dup], "ran in both"),
+        (vec![s0.clone(), s1.clone(), other], "frames differs"),
+        (vec![s0, s1, s2, plain], "all of one kind"),
+    ] {
+        let out = tmp.path().join("bad-merge");
+        let (ok, stderr) = merge(&set, &out);
+        assert!(!ok && stderr.contains(expect), "{set:?}: {stderr}");
+        assert!(!out.exists(), "a refused merge wrote {out:?}");
+    }
+}

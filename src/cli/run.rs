@@ -1,11 +1,13 @@
 //! `gibench run` (and `gibench` with no arguments): its arguments, the plan checked before
 //! anything runs or is written, and the run itself with its tables, plots and page.
 
-use std::path::PathBuf;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
 
 use clap::{Args, Parser};
 use gibench_harness::gpu::{GpuContext, GpuOptions};
 use gibench_harness::kit::technique::{Params, TechniqueInfo};
+use gibench_harness::measure::results::RunResult;
 use gibench_harness::output::OutputSet;
 use gibench_harness::report;
 use gibench_harness::run::quality::{IndirectComponent, QualityConfig};
@@ -20,6 +22,7 @@ use super::options::{GpuArgs, ReferenceOpts};
 use super::page::{page_line, with_folder, write_page};
 use super::params::{assign_params, parse_resolution};
 use super::progress::{execute_skipping_with_bar, Bars};
+use super::shard::{own_units, ShardArgs, ShardRecord};
 use crate::registry;
 
 #[derive(Args, Clone)]
@@ -90,6 +93,8 @@ pub(crate) struct RunArgs {
     pub(crate) reference: ReferenceOpts,
     #[command(flatten)]
     pub(crate) gpu: GpuArgs,
+    #[command(flatten)]
+    pub(crate) shard: ShardArgs,
 }
 
 impl RunArgs {
@@ -305,22 +310,119 @@ pub(crate) fn open_gpu(args: &RunArgs) -> Result<GpuContext> {
     GpuContext::new(&gpu_options(args))
 }
 
-/// `gibench run`: plan, open the output set and the adapter, run, publish.
+/// `gibench run`: plan, open the output set and the adapter, run, publish. With a shard
+/// (`--shard`, or a job array's environment) only its part of the techniques runs, and a
+/// [`ShardRecord`] beside the results says which, for `gibench merge`.
 pub(crate) fn exec(args: &RunArgs) -> Result<()> {
     // Everything that can be checked without running is checked before anything is written.
-    let plan = plan(args, &[])?;
+    let mut plan = plan(args, &[])?;
     plan.spec(args).validate()?;
+    let shard = args.shard.resolve()?;
+    let record = match &shard {
+        Some(s) => {
+            eprintln!("gibench run: shard {s} (0-based), from {}", s.source);
+            let name = plan.desc.name.clone();
+            let units: Vec<String> = (plan.techniques.iter())
+                .map(|t| format!("{name}-{}", t.name))
+                .collect();
+            let mine = own_units(
+                &weigh_equally(&units),
+                s,
+                &|_| "1 unit".into(),
+                "equal weights (every technique runs the same size and frames), ties by name",
+            );
+            let mut k = mine.iter();
+            plan.techniques.retain(|_| *k.next().unwrap_or(&false));
+            let mut k = mine.iter();
+            plan.params.retain(|_| *k.next().unwrap_or(&false));
+            Some(ShardRecord {
+                command: "run".into(),
+                shard: s.to_string(),
+                source: s.source.clone(),
+                ran: Vec::new(),
+                settings: settings(args, &plan),
+                units,
+            })
+        }
+        None => None,
+    };
     let set = OutputSet::begin("out", &args.out)?;
     if args.technique.is_empty() {
         // A run over every technique says which it skipped; one that skipped none leaves no
         // earlier run's list behind.
         set.replace_files(&skipped_file(&plan.desc.name))?;
     }
+    if let Some(mut record) = record {
+        let name = plan.desc.name.clone();
+        let mut done = "this shard has no techniques to run".to_string();
+        if !plan.techniques.is_empty() {
+            let gpu = open_gpu(args)?;
+            let (line, skipped) = run_planned_skipping(args, &plan, &gpu, &Bars::Own(args.quiet))?;
+            done = line;
+            record.ran = (plan.techniques.iter())
+                .filter(|t| !skipped.iter().any(|s| s.technique == t.name))
+                .map(|t| {
+                    (
+                        format!("{name}-{}", t.name),
+                        format!("{name}-{}.json", t.name),
+                    )
+                })
+                .collect();
+            for s in &skipped {
+                let unit = format!("{name}-{}", s.technique);
+                record.ran.push((unit, format!("skipped: {}", s.reason)));
+            }
+        }
+        record.write(&args.out)?;
+        set.publish()?;
+        eprintln!("{done}");
+        return Ok(());
+    }
     let gpu = open_gpu(args)?;
     let done = run_planned(args, &plan, &gpu, &Bars::Own(args.quiet))?;
     set.publish()?;
     eprintln!("{done}");
     Ok(())
+}
+
+/// Units of equal weight (a run's or a sweep's units share one size and frame count).
+pub(crate) fn weigh_equally(units: &[String]) -> Vec<(&str, f64)> {
+    units.iter().map(|u| (u.as_str(), 1.0)).collect()
+}
+
+/// The settings every shard of one run must share, by name (`gibench merge` compares them).
+pub(crate) fn settings(args: &RunArgs, plan: &Plan) -> BTreeMap<String, String> {
+    let c = &plan.config;
+    let q = plan.quality.as_ref();
+    [
+        ("scene", plan.desc.name.clone()),
+        (
+            "resolution",
+            format!("{}x{}", c.resolution[0], c.resolution[1]),
+        ),
+        ("frames", c.frames.to_string()),
+        ("warmup", c.warmup.to_string()),
+        ("first-frame", c.first_frame.to_string()),
+        ("timing", c.timing.name().to_string()),
+        ("seed", c.seed.to_string()),
+        ("shadow-size", c.shadow_size.to_string()),
+        ("param", args.params.join(" ")),
+        ("images", (!args.no_images).to_string()),
+        ("quality", q.is_some().to_string()),
+        (
+            "quality-pairs",
+            q.map(|q| q.pairs.to_string()).unwrap_or_default(),
+        ),
+        ("quality-all", q.is_some_and(|q| q.all).to_string()),
+        (
+            "quality-reference",
+            args.quality_reference.clone().unwrap_or_default(),
+        ),
+        ("commit", gibench_harness::run::runner::git_commit()),
+    ]
+    .into_iter()
+    .map(|(k, v)| (k.to_string(), v))
+    .collect()
 }
 
 /// The file in which a run over every technique on `scene` lists those it skipped and why.
@@ -336,6 +438,16 @@ pub(crate) fn run_planned(
     gpu: &GpuContext,
     bars: &Bars,
 ) -> Result<String> {
+    run_planned_skipping(args, plan, gpu, bars).map(|(done, _)| done)
+}
+
+/// [`run_planned`], also returning the techniques a run over every technique left out.
+fn run_planned_skipping(
+    args: &RunArgs,
+    plan: &Plan,
+    gpu: &GpuContext,
+    bars: &Bars,
+) -> Result<(String, Vec<gibench_harness::run::session::Skipped>)> {
     let spec = plan.spec(args);
     bars.note(&announcement(plan, gpu));
     // A run over every technique leaves out one that cannot take the scene or the device; one
@@ -353,18 +465,12 @@ pub(crate) fn run_planned(
             reasons.join("; ")
         )));
     }
-    let mut table = report::stage_table(&results);
-    for s in &skipped {
-        table
-            .notes
-            .push(format!("Skipped {}: {}", s.technique, s.reason));
-    }
-    bars.table(&table);
-    let stem = format!("{name}-summary");
-    let mut written: Vec<String> = report::write_tables(&table, &args.out, &stem)?
-        .iter()
-        .map(|p| file_name(p))
+    let notes: Vec<(String, String)> = (skipped.iter())
+        .map(|s| (s.technique.clone(), s.reason.clone()))
         .collect();
+    let (table, mut written) =
+        write_summary(&results, &notes, &args.out, name, plan.quality.is_some())?;
+    bars.table(&table);
     if !skipped.is_empty() {
         let list: Vec<serde_json::Value> = (skipped.iter())
             .map(|s| serde_json::json!({ "technique": s.technique, "reason": s.reason }))
@@ -379,55 +485,6 @@ pub(crate) fn run_planned(
             serde_json::to_vec_pretty(&record).map_err(|e| Error::Invalid(e.to_string()))?;
         gibench_harness::output::write_atomic(&path, &bytes)?;
         written.push(file_name(&path));
-    }
-    report::stacked_bar_svg(
-        &results,
-        &args.out.join(format!("{stem}.svg")),
-        &format!("Per-stage times on {name}"),
-    )?;
-    written.push(format!("{stem}.svg"));
-    if plan.quality.is_some() {
-        // Per compared frame (every measured frame with --quality-all); flicker where a frame
-        // pair was compared.
-        let flicker = results.iter().any(|r| {
-            r.quality
-                .as_ref()
-                .is_some_and(|q| q.frames.iter().any(|f| f.temporal.is_some()))
-        });
-        for metric in ["rmse", "flicker"]
-            .into_iter()
-            .filter(|m| *m == "rmse" || flicker)
-        {
-            let svg = args.out.join(format!("{name}-{metric}-per-frame.svg"));
-            if report::per_frame_lines(&results, metric)?.is_empty() {
-                // Every value is not a number (each run's warnings say why): what is valid
-                // is still written.
-                eprintln!(
-                    "note: no {metric} value is a number; {} not drawn",
-                    file_name(&svg)
-                );
-                continue;
-            }
-            report::quality_over_frames_svg(
-                &results,
-                metric,
-                &svg,
-                &format!("{metric} against the reference on {name}"),
-            )?;
-            written.push(file_name(&svg));
-        }
-    }
-    if plan.quality.is_some() {
-        let svg = args.out.join(format!("{name}-time-vs-error.svg"));
-        if report::time_error_points(&results).is_empty() {
-            eprintln!(
-                "note: no run has an error that is a number; {} not drawn",
-                file_name(&svg)
-            );
-        } else {
-            report::time_vs_error_svg(&results, &svg, &format!("Time versus error on {name}"))?;
-            written.push(file_name(&svg));
-        }
     }
     let mut done = format!(
         "wrote {} results, images and {} to {}",
@@ -450,5 +507,77 @@ pub(crate) fn run_planned(
         )?;
         done.push_str(&page_line(&page));
     }
-    Ok(done)
+    Ok((done, skipped))
+}
+
+/// The tables and plots of a run on scene `name` from its `results` (and the techniques it
+/// `skipped`, with why): `{name}-summary.md/.csv/.tex/.svg` and with `quality` the error
+/// plots, into `out`. `gibench run` and `gibench merge` (pooling shards) both write them here.
+/// Returns the table and the files written.
+pub(crate) fn write_summary(
+    results: &[RunResult],
+    skipped: &[(String, String)],
+    out: &Path,
+    name: &str,
+    quality: bool,
+) -> Result<(report::Table, Vec<String>)> {
+    let mut table = report::stage_table(results);
+    for (technique, reason) in skipped {
+        table.notes.push(format!("Skipped {technique}: {reason}"));
+    }
+    let stem = format!("{name}-summary");
+    let mut written: Vec<String> = report::write_tables(&table, out, &stem)?
+        .iter()
+        .map(|p| file_name(p))
+        .collect();
+    report::stacked_bar_svg(
+        results,
+        &out.join(format!("{stem}.svg")),
+        &format!("Per-stage times on {name}"),
+    )?;
+    written.push(format!("{stem}.svg"));
+    if quality {
+        // Per compared frame (every measured frame with --quality-all); flicker where a frame
+        // pair was compared.
+        let flicker = results.iter().any(|r| {
+            r.quality
+                .as_ref()
+                .is_some_and(|q| q.frames.iter().any(|f| f.temporal.is_some()))
+        });
+        for metric in ["rmse", "flicker"]
+            .into_iter()
+            .filter(|m| *m == "rmse" || flicker)
+        {
+            let svg = out.join(format!("{name}-{metric}-per-frame.svg"));
+            if report::per_frame_lines(results, metric)?.is_empty() {
+                // Every value is not a number (each run's warnings say why): what is valid
+                // is still written.
+                eprintln!(
+                    "note: no {metric} value is a number; {} not drawn",
+                    file_name(&svg)
+                );
+                continue;
+            }
+            report::quality_over_frames_svg(
+                results,
+                metric,
+                &svg,
+                &format!("{metric} against the reference on {name}"),
+            )?;
+            written.push(file_name(&svg));
+        }
+    }
+    if quality {
+        let svg = out.join(format!("{name}-time-vs-error.svg"));
+        if report::time_error_points(results).is_empty() {
+            eprintln!(
+                "note: no run has an error that is a number; {} not drawn",
+                file_name(&svg)
+            );
+        } else {
+            report::time_vs_error_svg(results, &svg, &format!("Time versus error on {name}"))?;
+            written.push(file_name(&svg));
+        }
+    }
+    Ok((table, written))
 }

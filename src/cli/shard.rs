@@ -254,6 +254,81 @@ pub fn assign(units: &[(&str, f64)], count: usize) -> Vec<usize> {
     shard
 }
 
+/// This shard's part of `units` (name, estimate), split by [`assign`]: prints the whole split
+/// (every shard's units, `label` giving each unit's estimate in words, `basis` what the
+/// estimates are) and returns, in the order given, whether each unit is this shard's.
+pub fn own_units(
+    units: &[(&str, f64)],
+    s: &Shard,
+    label: &dyn Fn(f64) -> String,
+    basis: &str,
+) -> Vec<bool> {
+    let split = assign(units, s.count);
+    for k in 0..s.count {
+        let part: Vec<String> = units
+            .iter()
+            .zip(&split)
+            .filter(|(_, &i)| i == k)
+            .map(|(u, _)| format!("{} ({})", u.0, label(u.1)))
+            .collect();
+        eprintln!(
+            "  shard {k}/{}{}: {}",
+            s.count,
+            if k == s.index { " (this one)" } else { "" },
+            if part.is_empty() {
+                "nothing".to_string()
+            } else {
+                part.join(", ")
+            }
+        );
+    }
+    eprintln!("  (balanced by {basis})");
+    split.iter().map(|&k| k == s.index).collect()
+}
+
+/// The file a shard of `gibench run` or `gibench sweep` leaves beside its results, which
+/// `gibench merge` reads: [`ShardRecord`].
+pub const RECORD: &str = "gibench-shard.json";
+
+/// What a shard of `gibench run` / `gibench sweep` ran, out of what, with which settings.
+#[derive(serde::Serialize, serde::Deserialize, Clone, Debug)]
+pub struct ShardRecord {
+    /// `run` or `sweep`.
+    pub command: String,
+    /// `I/N`.
+    pub shard: String,
+    /// Where the shard came from (the flag or the job system's variables).
+    pub source: String,
+    /// Every unit of the whole selection, in the command's order (`SCENE-TECHNIQUE` for a
+    /// run, the swept value for a sweep).
+    pub units: Vec<String>,
+    /// This shard's units and each one's results file (relative to the folder).
+    pub ran: Vec<(String, String)>,
+    /// The settings every shard must share (frames, resolution, timing, seed, …, the commit):
+    /// name → value.
+    pub settings: std::collections::BTreeMap<String, String>,
+}
+
+impl ShardRecord {
+    /// Reads `dir`'s record, naming the file on error.
+    pub fn read(dir: &std::path::Path) -> Result<ShardRecord> {
+        let path = dir.join(RECORD);
+        let bytes = std::fs::read(&path).map_err(|e| Error::Io {
+            path: path.clone(),
+            source: e,
+        })?;
+        serde_json::from_slice(&bytes).map_err(|e| {
+            Error::bad_file(&path, format!("not a gibench run/sweep shard record: {e}"))
+        })
+    }
+
+    /// Writes the record into `dir` (inside the open output set).
+    pub fn write(&self, dir: &std::path::Path) -> Result<()> {
+        let bytes = serde_json::to_vec_pretty(self).map_err(|e| Error::Invalid(e.to_string()))?;
+        gibench_harness::output::write_atomic(&dir.join(RECORD), &bytes)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -15,7 +15,8 @@ use gibench_harness::{Error, Result};
 use super::page::{page_line, with_folder, write_page};
 use super::params::assign_params;
 use super::progress::{execute_with_bar, Bars};
-use super::run::{announcement, open_gpu, plan, Plan, RunArgs};
+use super::run::{announcement, open_gpu, plan, settings, weigh_equally, Plan, RunArgs};
+use super::shard::{own_units, ShardRecord};
 use crate::registry;
 
 #[derive(Args)]
@@ -27,15 +28,66 @@ pub(crate) struct SweepArgs {
     pub(crate) run: RunArgs,
 }
 
-/// `gibench sweep`: one technique, one parameter over a list of values.
+/// `gibench sweep`: one technique, one parameter over a list of values. With a shard
+/// (`--shard`, or a job array's environment) only its part of the points runs, and a
+/// [`ShardRecord`] beside the results says which, for `gibench merge`.
 pub(crate) fn exec(args: &SweepArgs) -> Result<()> {
-    let planned = sweep_plan(args)?;
+    let mut planned = sweep_plan(args)?;
+    let shard = args.run.shard.resolve()?;
+    let record = match &shard {
+        Some(s) => {
+            eprintln!("gibench sweep: shard {s} (0-based), from {}", s.source);
+            let units = planned.values.clone();
+            let mine = own_units(
+                &weigh_equally(&units),
+                s,
+                &|_| "1 point".into(),
+                "equal weights (every point runs the same size and frames), ties by value as text",
+            );
+            let mut settings = settings(&args.run, &planned.plans[0]);
+            settings.insert(
+                "technique".into(),
+                planned.plans[0].techniques[0].name.into(),
+            );
+            settings.insert("sweep".into(), planned.name.clone());
+            let mut k = mine.iter();
+            planned.values.retain(|_| *k.next().unwrap_or(&false));
+            let mut k = mine.iter();
+            planned.plans.retain(|_| *k.next().unwrap_or(&false));
+            Some(ShardRecord {
+                command: "sweep".into(),
+                shard: s.to_string(),
+                source: s.source.clone(),
+                ran: Vec::new(),
+                settings,
+                units,
+            })
+        }
+        None => None,
+    };
     let set = OutputSet::begin("out", &args.run.out)?;
     // The folder's points of this scene, technique and parameter are this sweep's alone: an
     // earlier sweep's points at values this one does not run are removed when it publishes
     // (they would otherwise sit beside its table as if part of it).
-    for stale in planned.earlier_points(&args.run.out) {
-        gibench_harness::output::replace_in_open_set(&stale)?;
+    if !planned.plans.is_empty() {
+        for stale in planned.earlier_points(&args.run.out) {
+            gibench_harness::output::replace_in_open_set(&stale)?;
+        }
+    }
+    if let Some(mut record) = record {
+        let mut done = "this shard has no points to run".to_string();
+        if !planned.plans.is_empty() {
+            let prefix = planned.point_prefix();
+            let gpu = open_gpu(&args.run)?;
+            done = sweep_planned(args, &planned, &gpu, &Bars::Own(args.run.quiet))?;
+            record.ran = (planned.values.iter())
+                .map(|v| (v.clone(), format!("{prefix}{v}.json")))
+                .collect();
+        }
+        record.write(&args.run.out)?;
+        set.publish()?;
+        eprintln!("{done}");
+        return Ok(());
     }
     let gpu = open_gpu(&args.run)?;
     let done = sweep_planned(args, &planned, &gpu, &Bars::Own(args.run.quiet))?;
@@ -214,41 +266,16 @@ pub(crate) fn sweep_planned(
     bars.note(&announcement(first, gpu));
     let runs = execute_with_bar(bars, gpu, &spec)?;
     let points: Vec<(String, RunResult)> = values.iter().cloned().zip(runs).collect();
-    let results: Vec<RunResult> = points.iter().map(|(_, r)| r.clone()).collect();
-    let mut table = report::stage_table(&results);
-    table.title = format!(
-        "{} on {}: per-stage time (median ms) against {name}",
-        info.name, first.desc.name
-    );
-    table.columns.insert(0, name.clone());
-    for (row, v) in table.rows.iter_mut().zip(&values) {
-        row.insert(0, report::Cell::text(v));
-    }
-    bars.table(&table);
-    let stem = format!("{}-{}-sweep-{name}", first.desc.name, info.name);
-    report::write_tables(&table, &args.run.out, &stem)?;
-    report::sweep_plot_svg(
+    let (table, figures, stem) = write_summary(
         &points,
-        &args.run.out.join(format!("{stem}.svg")),
-        &format!(
-            "{} on {}: stage times against {name}",
-            info.name, first.desc.name
-        ),
+        info.name,
+        &first.desc.name,
         &name,
+        &args.run.out,
+        first.quality.is_some(),
     )?;
-    let mut figures = vec![args.run.out.join(format!("{stem}.svg"))];
-    if first.quality.is_some() {
-        let svg = args.run.out.join(format!("{stem}-time-vs-error.svg"));
-        report::time_vs_error_svg(
-            &results,
-            &svg,
-            &format!(
-                "{} on {}: time versus error over {name}",
-                info.name, first.desc.name
-            ),
-        )?;
-        figures.push(svg);
-    }
+    bars.table(&table);
+    let results: Vec<RunResult> = points.iter().map(|(_, r)| r.clone()).collect();
     let mut done = format!(
         "wrote {} points and {stem}.md/.csv/.tex/.svg{} to {}",
         points.len(),
@@ -271,4 +298,44 @@ pub(crate) fn sweep_planned(
         done.push_str(&page_line(&page));
     }
     Ok(done)
+}
+
+/// The table and plots of a sweep of `technique` on `scene` over `name` from its `points`
+/// (value, results): `{scene}-{technique}-sweep-{name}.md/.csv/.tex/.svg` and with `quality`
+/// the time-versus-error plot, into `out`. `gibench sweep` and `gibench merge` (pooling
+/// shards) both write them here. Returns the table, the figures and the stem.
+pub(crate) fn write_summary(
+    points: &[(String, RunResult)],
+    technique: &str,
+    scene: &str,
+    name: &str,
+    out: &Path,
+    quality: bool,
+) -> Result<(report::Table, Vec<PathBuf>, String)> {
+    let results: Vec<RunResult> = points.iter().map(|(_, r)| r.clone()).collect();
+    let mut table = report::stage_table(&results);
+    table.title = format!("{technique} on {scene}: per-stage time (median ms) against {name}");
+    table.columns.insert(0, name.to_string());
+    for (row, (v, _)) in table.rows.iter_mut().zip(points) {
+        row.insert(0, report::Cell::text(v));
+    }
+    let stem = format!("{scene}-{technique}-sweep-{name}");
+    report::write_tables(&table, out, &stem)?;
+    report::sweep_plot_svg(
+        points,
+        &out.join(format!("{stem}.svg")),
+        &format!("{technique} on {scene}: stage times against {name}"),
+        name,
+    )?;
+    let mut figures = vec![out.join(format!("{stem}.svg"))];
+    if quality {
+        let svg = out.join(format!("{stem}-time-vs-error.svg"));
+        report::time_vs_error_svg(
+            &results,
+            &svg,
+            &format!("{technique} on {scene}: time versus error over {name}"),
+        )?;
+        figures.push(svg);
+    }
+    Ok((table, figures, stem))
 }

@@ -177,27 +177,8 @@ fn own_part(planned: Vec<Planned>, s: &crate::cli::shard::Shard) -> Vec<Planned>
         .zip(&timed)
         .map(|(p, t)| (p.target.name, t.unwrap_or(fallback)))
         .collect();
-    let split = crate::cli::shard::assign(&units, s.count);
-    for k in 0..s.count {
-        let part: Vec<String> = units
-            .iter()
-            .zip(&split)
-            .filter(|(_, &i)| i == k)
-            .map(|(u, _)| format!("{} ({})", u.0, duration(u.1)))
-            .collect();
-        eprintln!(
-            "  shard {k}/{}{}: {}",
-            s.count,
-            if k == s.index { " (this one)" } else { "" },
-            if part.is_empty() {
-                "nothing".to_string()
-            } else {
-                part.join(", ")
-            }
-        );
-    }
-    eprintln!(
-        "  (balanced by the estimates of {}{})",
+    let basis = format!(
+        "the estimates of {}{}",
         committed
             .as_ref()
             .map(|m| m.source.display().to_string())
@@ -208,10 +189,11 @@ fn own_part(planned: Vec<Planned>, s: &crate::cli::shard::Shard) -> Vec<Planned>
             ""
         }
     );
+    let mine = crate::cli::shard::own_units(&units, s, &|e| duration(e), &basis);
     planned
         .into_iter()
-        .zip(split)
-        .filter(|(_, k)| *k == s.index)
+        .zip(mine)
+        .filter(|(_, m)| *m)
         .map(|(p, _)| p)
         .collect()
 }
