@@ -500,7 +500,8 @@ fn bad_shards_and_budgets_are_refused_before_any_work() {
     }
 }
 
-/// `gibench run` on the Cornell box at 64x48, `frames` measured frames, no images, `extra`
+/// `gibench run` on the Cornell box and its omni-light variant (a scene whose name extends
+/// the other's: units `cornell-laine` and `cornell-omni-laine`) at 64x48, `frames` measured frames, no images, `extra`
 /// added, into `out` with `vars` as its job system's environment, started (not waited for).
 fn start_run(
     techniques: &str,
@@ -516,7 +517,7 @@ fn start_run(
     c.args([
         "run",
         "--scene",
-        "cornell",
+        "cornell,cornell-omni",
         "--technique",
         techniques,
         "--frames",
@@ -649,10 +650,11 @@ fn sweep_shards_merge_to_the_unsharded_sweep() {
     );
 }
 
-/// Catches: a `gibench run` shard that drops a technique or runs one another shard runs
-/// (the merged results differ from the unsharded run's), a Slurm environment not read by
-/// `run`, a merge that draws the summary table from anything but the pooled results in the
-/// run's order (its shape differs), or one that pools a shard twice, a unit twice, shards of
+/// Catches: a `gibench run` shard that drops a (scene, technique) unit or runs one another
+/// shard runs (the merged results differ from the unsharded run's), a Slurm environment not
+/// read by `run`, a merge that draws a scene's summary table from anything but that scene's
+/// pooled results in the run's order (its shape differs; tried: units split at the first
+/// scene prefix put cornell-omni's runs in cornell's table), or one that pools a shard twice, a unit twice, shards of
 /// other settings, or `run` shards with `reproduce all` folders, instead of refusing by name.
 #[test]
 fn run_shards_merge_to_the_unsharded_run() {
@@ -685,10 +687,10 @@ fn run_shards_merge_to_the_unsharded_run() {
         "{}",
         logs[1]
     );
-    // Three techniques over three shards: one each, none twice.
+    // Three techniques on two scenes over three shards: two each, none twice.
     let mut all: Vec<String> = dirs.iter().flat_map(|d| results_files(d)).collect();
     for d in &dirs {
-        assert_eq!(results_files(d).len(), 1, "{d:?}: {:?}", results_files(d));
+        assert_eq!(results_files(d).len(), 2, "{d:?}: {:?}", results_files(d));
     }
     all.sort();
     assert_eq!(all, results_files(&single));
@@ -710,6 +712,7 @@ fn run_shards_merge_to_the_unsharded_run() {
         "cornell-summary.md",
         "cornell-summary.csv",
         "cornell-summary.tex",
+        "cornell-omni-summary.md",
     ] {
         let read = |d: &Path| std::fs::read_to_string(d.join(f)).unwrap();
         assert_eq!(
@@ -719,6 +722,7 @@ fn run_shards_merge_to_the_unsharded_run() {
         );
     }
     assert!(merged.join("cornell-summary.svg").is_file());
+    assert!(merged.join("cornell-omni-summary.svg").is_file());
     // Refused by name, nothing written.
     let dup = tmp.path().join("dup");
     std::fs::create_dir_all(&dup).unwrap();

@@ -157,16 +157,28 @@ fn merge_shards(dirs: &[PathBuf], out: &Path) -> Result<()> {
             "merge: '{unit}' was selected but no shard ran it; expected every unit in some shard"
         )));
     }
-    // Read every result (in the selection's order) before anything is written.
+    // Read every result (in the selection's order) before anything is written. A run's unit
+    // is `SCENE-TECHNIQUE`; its scene is the one of the run's scenes it starts with whose
+    // remainder is a technique.
+    let setting = |k: &str| first.settings.get(k).cloned().unwrap_or_default();
+    let scenes: Vec<String> = setting("scene").split(',').map(String::from).collect();
+    let split_unit = |unit: &str| -> (String, String) {
+        for sc in &scenes {
+            if let Some(t) = unit.strip_prefix(&format!("{sc}-")) {
+                if crate::registry::all().iter().any(|i| i.name == t) {
+                    return (sc.clone(), t.to_string());
+                }
+            }
+        }
+        (scenes[0].clone(), unit.to_string())
+    };
     let mut results: Vec<(String, RunResult, Vec<PathBuf>)> = Vec::new();
-    let mut skipped: Vec<(String, String)> = Vec::new();
+    let mut skipped: Vec<(String, String, String)> = Vec::new();
     for unit in &first.units {
         let (i, file) = owner[unit.as_str()];
         if let Some(reason) = file.strip_prefix("skipped: ") {
-            let technique = unit
-                .strip_prefix(&format!("{}-", first.settings["scene"]))
-                .unwrap_or(unit);
-            skipped.push((technique.to_string(), reason.to_string()));
+            let (scene, technique) = split_unit(unit);
+            skipped.push((scene, technique, reason.to_string()));
             continue;
         }
         let path = dirs[i].join(file);
@@ -196,16 +208,14 @@ fn merge_shards(dirs: &[PathBuf], out: &Path) -> Result<()> {
             write_atomic(&to, &bytes)?;
         }
     }
-    let setting = |k: &str| first.settings.get(k).cloned().unwrap_or_default();
     let quality = setting("quality") == "true";
-    let scene = setting("scene");
     let written = if first.command == "sweep" {
         let points: Vec<(String, RunResult)> =
             results.into_iter().map(|(u, r, _)| (u, r)).collect();
         let (table, _, stem) = crate::cli::sweep::write_summary(
             &points,
             &setting("technique"),
-            &scene,
+            &scenes[0],
             &setting("sweep"),
             out,
             quality,
@@ -213,10 +223,26 @@ fn merge_shards(dirs: &[PathBuf], out: &Path) -> Result<()> {
         println!("{}", table.to_terminal());
         format!("{} points and {stem}.md/.csv/.tex/.svg", points.len())
     } else {
-        let runs: Vec<RunResult> = results.into_iter().map(|(_, r, _)| r).collect();
-        let (table, files) = crate::cli::run::write_summary(&runs, &skipped, out, &scene, quality)?;
-        println!("{}", table.to_terminal());
-        format!("{} results and {}", runs.len(), files.join(", "))
+        // One summary per scene, as `run` writes them.
+        let mut all: Vec<String> = Vec::new();
+        for scene in &scenes {
+            let runs: Vec<RunResult> = (results.iter())
+                .filter(|(u, _, _)| &split_unit(u).0 == scene)
+                .map(|(_, r, _)| r.clone())
+                .collect();
+            let notes: Vec<(String, String)> = (skipped.iter())
+                .filter(|s| &s.0 == scene)
+                .map(|s| (s.1.clone(), s.2.clone()))
+                .collect();
+            if runs.is_empty() {
+                continue;
+            }
+            let (table, files) =
+                crate::cli::run::write_summary(&runs, &notes, out, scene, quality)?;
+            println!("{}", table.to_terminal());
+            all.extend(files);
+        }
+        format!("{} results and {}", results.len(), all.join(", "))
     };
     set.publish()?;
     eprintln!(

@@ -27,7 +27,8 @@ use crate::registry;
 
 #[derive(Args, Clone)]
 pub(crate) struct RunArgs {
-    /// Scene: a built-in name (see `gibench list`) or a path to a descriptor JSON.
+    /// Scene: a built-in name (see `gibench list`) or a path to a descriptor JSON; `run` takes
+    /// several, comma-separated (one summary table each).
     #[arg(long, default_value = "cornell")]
     pub(crate) scene: String,
     /// Techniques, comma-separated (default: every registered technique).
@@ -310,37 +311,65 @@ pub(crate) fn open_gpu(args: &RunArgs) -> Result<GpuContext> {
     GpuContext::new(&gpu_options(args))
 }
 
-/// `gibench run`: plan, open the output set and the adapter, run, publish. With a shard
-/// (`--shard`, or a job array's environment) only its part of the techniques runs, and a
-/// [`ShardRecord`] beside the results says which, for `gibench merge`.
+/// `gibench run`: plan (every scene of `--scene a,b`), open the output set and the adapter,
+/// run, publish. With a shard (`--shard`, or a job array's environment) only its part of the
+/// (scene, technique) units runs, and a [`ShardRecord`] beside the results says which, for
+/// `gibench merge`.
 pub(crate) fn exec(args: &RunArgs) -> Result<()> {
     // Everything that can be checked without running is checked before anything is written.
-    let mut plan = plan(args, &[])?;
-    plan.spec(args).validate()?;
+    let names: Vec<&str> = args.scene.split(',').map(str::trim).collect();
+    for (i, n) in names.iter().enumerate() {
+        if n.is_empty() || names[..i].contains(n) {
+            return Err(Error::param(
+                "scene",
+                format!(
+                    "expected distinct scene names or descriptor files, comma-separated (got '{}')",
+                    args.scene
+                ),
+            ));
+        }
+    }
+    let mut plans: Vec<(RunArgs, Plan)> = Vec::new();
+    for n in &names {
+        let mut one = args.clone();
+        one.scene = n.to_string();
+        let p = plan(&one, &[])?;
+        p.spec(&one).validate()?;
+        plans.push((one, p));
+    }
     let shard = args.shard.resolve()?;
+    let unit = |p: &Plan, t: &TechniqueInfo| format!("{}-{}", p.desc.name, t.name);
     let record = match &shard {
         Some(s) => {
             eprintln!("gibench run: shard {s} (0-based), from {}", s.source);
-            let name = plan.desc.name.clone();
-            let units: Vec<String> = (plan.techniques.iter())
-                .map(|t| format!("{name}-{}", t.name))
+            let units: Vec<String> = (plans.iter())
+                .flat_map(|(_, p)| p.techniques.iter().map(|t| unit(p, t)))
                 .collect();
             let mine = own_units(
                 &weigh_equally(&units),
                 s,
                 &|_| "1 unit".into(),
-                "equal weights (every technique runs the same size and frames), ties by name",
+                "equal weights (every unit runs the same size and frames), ties by name",
             );
+            let mut settings = settings(args, &plans[0].1);
+            let scenes: Vec<&str> = plans.iter().map(|(_, p)| p.desc.name.as_str()).collect();
+            settings.insert("scene".into(), scenes.join(","));
             let mut k = mine.iter();
-            plan.techniques.retain(|_| *k.next().unwrap_or(&false));
-            let mut k = mine.iter();
-            plan.params.retain(|_| *k.next().unwrap_or(&false));
+            for (_, p) in plans.iter_mut() {
+                let keep: Vec<bool> = (p.techniques.iter())
+                    .map(|_| *k.next().unwrap_or(&false))
+                    .collect();
+                let mut it = keep.iter();
+                p.techniques.retain(|_| *it.next().unwrap_or(&false));
+                let mut it = keep.iter();
+                p.params.retain(|_| *it.next().unwrap_or(&false));
+            }
             Some(ShardRecord {
                 command: "run".into(),
                 shard: s.to_string(),
                 source: s.source.clone(),
                 ran: Vec::new(),
-                settings: settings(args, &plan),
+                settings,
                 units,
             })
         }
@@ -350,38 +379,41 @@ pub(crate) fn exec(args: &RunArgs) -> Result<()> {
     if args.technique.is_empty() {
         // A run over every technique says which it skipped; one that skipped none leaves no
         // earlier run's list behind.
-        set.replace_files(&skipped_file(&plan.desc.name))?;
+        for (_, p) in &plans {
+            set.replace_files(&skipped_file(&p.desc.name))?;
+        }
+    }
+    let mut ran: Vec<(String, String)> = Vec::new();
+    let mut lines: Vec<String> = Vec::new();
+    let mut gpu = None;
+    for (one, p) in &plans {
+        if p.techniques.is_empty() {
+            continue;
+        }
+        if gpu.is_none() {
+            gpu = Some(open_gpu(args)?);
+        }
+        let g = gpu.as_ref().expect("opened above");
+        let (line, skipped) = run_planned_skipping(one, p, g, &Bars::Own(args.quiet))?;
+        lines.push(line);
+        for t in &p.techniques {
+            let why = skipped.iter().find(|s| s.technique == t.name);
+            let file = match why {
+                Some(s) => format!("skipped: {}", s.reason),
+                None => format!("{}.json", unit(p, t)),
+            };
+            ran.push((unit(p, t), file));
+        }
     }
     if let Some(mut record) = record {
-        let name = plan.desc.name.clone();
-        let mut done = "this shard has no techniques to run".to_string();
-        if !plan.techniques.is_empty() {
-            let gpu = open_gpu(args)?;
-            let (line, skipped) = run_planned_skipping(args, &plan, &gpu, &Bars::Own(args.quiet))?;
-            done = line;
-            record.ran = (plan.techniques.iter())
-                .filter(|t| !skipped.iter().any(|s| s.technique == t.name))
-                .map(|t| {
-                    (
-                        format!("{name}-{}", t.name),
-                        format!("{name}-{}.json", t.name),
-                    )
-                })
-                .collect();
-            for s in &skipped {
-                let unit = format!("{name}-{}", s.technique);
-                record.ran.push((unit, format!("skipped: {}", s.reason)));
-            }
-        }
+        record.ran = ran;
         record.write(&args.out)?;
-        set.publish()?;
-        eprintln!("{done}");
-        return Ok(());
+        if lines.is_empty() {
+            lines.push("this shard has no techniques to run".into());
+        }
     }
-    let gpu = open_gpu(args)?;
-    let done = run_planned(args, &plan, &gpu, &Bars::Own(args.quiet))?;
     set.publish()?;
-    eprintln!("{done}");
+    eprintln!("{}", lines.join("\n"));
     Ok(())
 }
 

@@ -183,6 +183,15 @@ pub(crate) fn sweep_plan(args: &SweepArgs) -> Result<SweepPlan> {
             "a sweep runs exactly one technique",
         ));
     }
+    if args.run.scene.contains(',') {
+        return Err(Error::param(
+            "scene",
+            format!(
+                "a sweep runs on one scene (got '{}'); run one sweep per scene",
+                args.run.scene
+            ),
+        ));
+    }
     check_swept_not_given(&args.sweep, &name, &args.run.params)?;
     let info = TechniqueInfo::find(registry::all(), args.run.technique[0].trim())?;
     check_distinct_values(info, &name, &values)?;
