@@ -58,12 +58,8 @@ pub fn exec(args: &MergeArgs) -> Result<()> {
     ))
 }
 
-/// Pools the shard folders `dirs` of one `run` or `sweep` into `out`.
-fn merge_shards(dirs: &[PathBuf], out: &Path) -> Result<()> {
-    let records: Vec<ShardRecord> = dirs
-        .iter()
-        .map(|d| ShardRecord::read(d))
-        .collect::<Result<_>>()?;
+/// Refuses shards of different commands, settings or selections, naming the folders.
+fn check_one_run(dirs: &[PathBuf], records: &[ShardRecord]) -> Result<()> {
     let name = |i: usize| dirs[i].display().to_string();
     let first = &records[0];
     // One command, one selection, the same settings everywhere.
@@ -101,6 +97,12 @@ fn merge_shards(dirs: &[PathBuf], out: &Path) -> Result<()> {
             )));
         }
     }
+    Ok(())
+}
+
+/// The shard count: one for all, each index once, none missing (else an error naming them).
+fn check_shard_set(dirs: &[PathBuf], records: &[ShardRecord]) -> Result<usize> {
+    let name = |i: usize| dirs[i].display().to_string();
     // One shard count, each index once, all present.
     let parse = |i: usize| -> Result<(usize, usize)> {
         let s = &records[i].shard;
@@ -133,6 +135,17 @@ fn merge_shards(dirs: &[PathBuf], out: &Path) -> Result<()> {
             "merge: shard {k}/{count} is missing; expected all {count} shards' folders"
         )));
     }
+    Ok(count)
+}
+
+/// Which shard ran each unit, and its results file (or "skipped: …"): every unit of the
+/// selection from exactly one shard, else an error naming them.
+fn unit_owners<'a>(
+    dirs: &[PathBuf],
+    records: &'a [ShardRecord],
+) -> Result<BTreeMap<&'a str, (usize, &'a str)>> {
+    let name = |i: usize| dirs[i].display().to_string();
+    let first = &records[0];
     // Every unit from exactly one shard.
     let mut owner: BTreeMap<&str, (usize, &str)> = BTreeMap::new();
     for (i, r) in records.iter().enumerate() {
@@ -157,6 +170,19 @@ fn merge_shards(dirs: &[PathBuf], out: &Path) -> Result<()> {
             "merge: '{unit}' was selected but no shard ran it; expected every unit in some shard"
         )));
     }
+    Ok(owner)
+}
+
+/// Pools the shard folders `dirs` of one `run` or `sweep` into `out`.
+fn merge_shards(dirs: &[PathBuf], out: &Path) -> Result<()> {
+    let records: Vec<ShardRecord> = dirs
+        .iter()
+        .map(|d| ShardRecord::read(d))
+        .collect::<Result<_>>()?;
+    check_one_run(dirs, &records)?;
+    let count = check_shard_set(dirs, &records)?;
+    let owner = unit_owners(dirs, &records)?;
+    let first = &records[0];
     // Read every result (in the selection's order) before anything is written. A run's unit
     // is `SCENE-TECHNIQUE`; its scene is the one of the run's scenes it starts with whose
     // remainder is a technique.
