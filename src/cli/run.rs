@@ -364,14 +364,7 @@ pub(crate) fn exec(args: &RunArgs) -> Result<()> {
                 let mut it = keep.iter();
                 p.params.retain(|_| *it.next().unwrap_or(&false));
             }
-            Some(ShardRecord {
-                command: "run".into(),
-                shard: s.to_string(),
-                source: s.source.clone(),
-                ran: Vec::new(),
-                settings,
-                units,
-            })
+            Some(ShardRecord::new("run", s, units, settings))
         }
         None => None,
     };

@@ -310,6 +310,23 @@ pub struct ShardRecord {
 }
 
 impl ShardRecord {
+    /// The record of `shard` of `command` (`run` or `sweep`) over `units`, before any ran.
+    pub fn new(
+        command: &str,
+        shard: &Shard,
+        units: Vec<String>,
+        settings: std::collections::BTreeMap<String, String>,
+    ) -> ShardRecord {
+        ShardRecord {
+            command: command.into(),
+            shard: shard.to_string(),
+            source: shard.source.clone(),
+            units,
+            ran: Vec::new(),
+            settings,
+        }
+    }
+
     /// Reads `dir`'s record, naming the file on error.
     pub fn read(dir: &std::path::Path) -> Result<ShardRecord> {
         let path = dir.join(RECORD);

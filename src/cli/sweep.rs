@@ -54,14 +54,7 @@ pub(crate) fn exec(args: &SweepArgs) -> Result<()> {
             planned.values.retain(|_| *k.next().unwrap_or(&false));
             let mut k = mine.iter();
             planned.plans.retain(|_| *k.next().unwrap_or(&false));
-            Some(ShardRecord {
-                command: "sweep".into(),
-                shard: s.to_string(),
-                source: s.source.clone(),
-                ran: Vec::new(),
-                settings,
-                units,
-            })
+            Some(ShardRecord::new("sweep", s, units, settings))
         }
         None => None,
     };
