@@ -122,9 +122,8 @@ const SLOT_QUERIES: u32 = 2 * MAX_TIMED_STAGES;
 
 /// A frame whose timestamps are on their way back (frame mode).
 struct PendingSpan {
+    /// Its readback slot; its stages' queries are the profiler's `slot_queries[slot]`.
     slot: usize,
-    /// Stages timed, in submission order: (series index, query index within the slot).
-    queries: Vec<(usize, u32)>,
     /// Whether the frame is measured (not warm-up).
     measured: bool,
 }
@@ -140,6 +139,9 @@ pub struct Profiler {
     slow: Option<(String, Slowdown)>,
     /// (series index, query index) of stages timed this frame.
     frame_queries: Vec<(usize, u32)>,
+    /// Per readback slot, the queries of the frame whose timestamps it holds (swapped with
+    /// `frame_queries` at the frame's end, so that no frame allocates a list).
+    slot_queries: Vec<Vec<(usize, u32)>>,
     frame_commands: Vec<wgpu::CommandBuffer>,
     in_flight: VecDeque<(wgpu::SubmissionIndex, Option<PendingSpan>)>,
     /// The GPU span of each measured frame (frame mode with timestamps).
@@ -195,6 +197,7 @@ impl Profiler {
             timestamps,
             slow: slow_stage_hook(),
             frame_queries: Vec::new(),
+            slot_queries: Vec::new(),
             frame_commands: Vec::new(),
             in_flight: VecDeque::new(),
             gpu_spans: Vec::new(),
@@ -416,9 +419,12 @@ impl Profiler {
                             n as u64 * 8,
                         );
                         self.frame_commands.push(enc.finish());
+                        if self.slot_queries.len() <= slot {
+                            self.slot_queries.resize_with(slot + 1, Vec::new);
+                        }
+                        std::mem::swap(&mut self.frame_queries, &mut self.slot_queries[slot]);
                         Some(PendingSpan {
                             slot,
-                            queries: std::mem::take(&mut self.frame_queries),
                             measured: self.recording,
                         })
                     }
@@ -511,25 +517,27 @@ impl Profiler {
         let Some(ts) = &self.timestamps else {
             return Ok(());
         };
-        let n = 2 * p.queries.len() as u64;
+        let queries = &self.slot_queries[p.slot];
+        let n = 2 * queries.len() as u64;
         let buffer = &ts.readback[p.slot];
         let slice = buffer.slice(..n * 8);
         slice.map_async(wgpu::MapMode::Read, |_| {});
         gpu.wait_for(done)?;
-        let ticks: Vec<u64> = bytemuck::pod_collect_to_vec(
-            &slice.get_mapped_range().map_err(|e| {
+        let span = {
+            let mapped = slice.get_mapped_range().map_err(|e| {
                 crate::Error::Gpu(format!("mapping a timestamp readback buffer failed: {e}"))
-            })?[..],
-        );
+            })?;
+            let ticks: &[u64] = bytemuck::cast_slice(&mapped[..]);
+            GpuFrameSpan::of(
+                queries
+                    .iter()
+                    .map(|&(_, q)| (ticks[2 * q as usize], ticks[2 * q as usize + 1])),
+                ts.period_ns,
+            )
+        };
         buffer.unmap();
         if p.measured {
-            let intervals: Vec<(u64, u64)> = p
-                .queries
-                .iter()
-                .map(|&(_, q)| (ticks[2 * q as usize], ticks[2 * q as usize + 1]))
-                .collect();
-            self.gpu_spans
-                .push(GpuFrameSpan::of(&intervals, ts.period_ns));
+            self.gpu_spans.push(span);
         }
         Ok(())
     }

@@ -80,20 +80,20 @@ pub struct GpuFrameSpan {
 impl GpuFrameSpan {
     /// The span of one frame's stage intervals `(start, end)` in ticks, in submission order,
     /// `period_ns` nanoseconds a tick.
-    pub fn of(intervals: &[(u64, u64)], period_ns: f64) -> GpuFrameSpan {
+    pub fn of(intervals: impl IntoIterator<Item = (u64, u64)>, period_ns: f64) -> GpuFrameSpan {
         let ms = |ticks: u64| ticks as f64 * period_ns * 1e-6;
-        let own: Vec<f64> = intervals
-            .iter()
-            .map(|&(a, b)| ms(b.saturating_sub(a)))
-            .collect();
-        let span = match (intervals.first(), intervals.last()) {
-            (Some(first), Some(last)) => ms(last.1.saturating_sub(first.0)),
-            _ => 0.0,
-        };
+        let (mut first, mut last, mut sum, mut longest) = (None, 0, 0.0, 0.0f64);
+        for (a, b) in intervals {
+            first.get_or_insert(a);
+            last = b;
+            let own = ms(b.saturating_sub(a));
+            sum += own;
+            longest = longest.max(own);
+        }
         GpuFrameSpan {
-            span_ms: span,
-            stage_sum_ms: own.iter().sum(),
-            longest_stage_ms: own.iter().copied().fold(0.0, f64::max),
+            span_ms: first.map_or(0.0, |f| ms(last.saturating_sub(f))),
+            stage_sum_ms: sum,
+            longest_stage_ms: longest,
         }
     }
 }
@@ -378,12 +378,12 @@ mod span_tests {
     #[test]
     fn the_span_is_first_start_to_last_end() {
         // Ticks of 1 µs: stages 0–4, 2–7 and 6–9 ms, overlapping.
-        let overlapping = GpuFrameSpan::of(&[(0, 4000), (2000, 7000), (6000, 9000)], 1000.0);
+        let overlapping = GpuFrameSpan::of([(0, 4000), (2000, 7000), (6000, 9000)], 1000.0);
         assert_eq!(overlapping.span_ms, 9.0);
         assert_eq!(overlapping.stage_sum_ms, 12.0);
         assert_eq!(overlapping.longest_stage_ms, 5.0);
-        let gaps = GpuFrameSpan::of(&[(100, 200), (500, 600)], 1e6);
+        let gaps = GpuFrameSpan::of([(100, 200), (500, 600)], 1e6);
         assert_eq!((gaps.span_ms, gaps.stage_sum_ms), (500.0, 200.0));
-        assert_eq!(GpuFrameSpan::of(&[], 1.0).span_ms, 0.0);
+        assert_eq!(GpuFrameSpan::of(std::iter::empty(), 1.0).span_ms, 0.0);
     }
 }
