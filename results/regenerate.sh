@@ -7,6 +7,7 @@
 #   bash results/regenerate.sh laine      # only the targets whose output is under results/laine
 #   bash results/regenerate.sh baseline   # only CI's baseline (instruction counts, timing)
 #   bash results/regenerate.sh barczak-scenes  # only barczak on Sibenik, Sponza and Maze
+#   bash results/regenerate.sh roofline        # only the stage-efficiency runs (docs/roofline.md)
 #
 # Paper-size runs (`gibench reproduce all` without --quick) are for a GPU and are not part of
 # this script.
@@ -38,6 +39,7 @@ elif [ "$only" != baseline ]; then
   targets=$("$g" reproduce all --quick --list 2>&1 | awk -v d="$only" '/^  [a-z]/ && ($3 == d || index($3, d "/") == 1) { print $1 }' | paste -sd, -)
   case "results/gaitatzes/transfer" in "results/$only"*) transfer_only=1 ;; *) transfer_only=0 ;; esac
   case "results/barczak-scenes/" in "results/$only"*) scenes_only=1 ;; *) scenes_only=0 ;; esac
+  case "results/roofline/" in "results/$only"*) scenes_only=1 ;; esac
   if [ -n "$targets" ]; then
     echo "== gibench reproduce all --quick --html --only $targets"
     "$g" reproduce all --quick --html --only "$targets" --out results
@@ -69,4 +71,9 @@ done
 for s in sibenik sponza maze; do
   run results/barczak-scenes/$s run --scene $s --technique barczak --frames 3 --warmup 0 --timing stages --resolution 128x96 --quality --quiet --out results/barczak-scenes/$s
 done
+# Stage efficiency against the device's bounds (docs/roofline.md): every technique on the
+# Cornell box at the default size, and gaitatzes on Sibenik; `gibench report DIR --detailed`
+# prints their roofline tables.
+run results/roofline/cornell run --frames 20 --warmup 3 --timing stages --no-images --quiet --out results/roofline/cornell
+run results/roofline/sibenik run --scene sibenik --technique gaitatzes --frames 5 --warmup 1 --timing stages --no-images --quiet --out results/roofline/sibenik
 echo "regenerate.sh: done"
