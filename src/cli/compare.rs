@@ -7,6 +7,7 @@ use clap::Args;
 use gibench_harness::measure::results::RunResult;
 use gibench_harness::output::OutputSet;
 use gibench_harness::report;
+use gibench_harness::report::compare::Statistic;
 use gibench_harness::{Error, Result};
 
 use super::files::check_stem;
@@ -19,8 +20,8 @@ pub(crate) struct CompareArgs {
     /// Folder of the CURRENT runs, likewise.
     current: PathBuf,
     /// Smallest relative change a verdict needs: slower only when the median ratio is above
-    /// 1 + tolerance (and the rank test's p is below --alpha); 0.25 keeps a shared CPU's
-    /// run-to-run drift from deciding.
+    /// 1 + tolerance (and the rank test's p is below --alpha); 0.15 is half a 30 % change,
+    /// above a shared CPU's run-to-run drift of the fastest frames.
     #[arg(long, default_value_t = gibench_harness::report::compare::DEFAULT_TOLERANCE)]
     tolerance: f64,
     /// Significance level of the two-sided Mann–Whitney U test a verdict needs (p < alpha).
@@ -31,6 +32,11 @@ pub(crate) struct CompareArgs {
     /// is decided on raw times and the calibrated ratio is only shown.
     #[arg(long)]
     calibrate: bool,
+    /// Each repeat's figure of a stage: `min`, its fastest frame (robust to other processes on
+    /// the machine, which only add time; blind to a change that slows only some frames), or
+    /// `median`, its median frame (as the tables; moves with the machine's load).
+    #[arg(long, value_enum, default_value_t = StatisticArg::Min)]
+    statistic: StatisticArg,
     /// Fail when a run is on one side only (by default such runs are listed and passed over):
     /// CI's check that the committed baseline covers every technique as it is run today.
     #[arg(long)]
@@ -43,6 +49,13 @@ pub(crate) struct CompareArgs {
     stem: String,
 }
 
+/// `--statistic`'s values.
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum StatisticArg {
+    Min,
+    Median,
+}
+
 /// `gibench compare`: reads both sides, compares, prints and writes the table and JSON.
 pub(crate) fn exec(args: &CompareArgs) -> Result<()> {
     check_stem(&args.stem)?;
@@ -50,6 +63,10 @@ pub(crate) fn exec(args: &CompareArgs) -> Result<()> {
         args.tolerance,
         args.alpha,
         args.calibrate,
+        match args.statistic {
+            StatisticArg::Min => Statistic::Min,
+            StatisticArg::Median => Statistic::Median,
+        },
     )?;
     let base = results_under("base", &args.base)?;
     let current = results_under("current", &args.current)?;

@@ -364,7 +364,12 @@ impl StageResult {
     /// some compute passes were seen to miss most of their work), else the median GPU timestamp
     /// time.
     pub fn best_ms(&self) -> Option<f64> {
-        self.wall_ms.or(self.gpu_ms).map(|s| s.median)
+        self.best_stats().map(|s| s.median)
+    }
+
+    /// The per-frame statistics [`StageResult::best_ms`] takes its median of.
+    pub fn best_stats(&self) -> Option<&Stats> {
+        self.wall_ms.as_ref().or(self.gpu_ms.as_ref())
     }
 }
 
