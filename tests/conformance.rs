@@ -12,6 +12,10 @@
 //!    (`TechniqueInfo::conformance`). The mean ratio is the energy check: halving a
 //!    technique's VPL intensities moves it to about 0.5.
 //!
+//! 5. every GPU stage it times declares its minimum cost (`Profiler::stage_cost`, the
+//!    roofline's input, docs/roofline.md), so `gibench report --detailed` has a fraction for
+//!    each.
+//!
 //! Runs on the best adapter there is (Vulkan, else GL).
 
 #[path = "../src/registry.rs"]
@@ -22,6 +26,7 @@ use gibench_harness::glam::Vec3;
 use gibench_harness::gpu::profiler::{ProfileMode, Profiler};
 use gibench_harness::gpu::{GpuContext, GpuOptions};
 use gibench_harness::kit::technique::TechniqueInfo;
+use gibench_harness::measure::results::StageKind;
 use gibench_harness::run::quality::IndirectComponent;
 use gibench_harness::run::runner::{Harness, RunConfig, TimingMode};
 use gibench_harness::scene::assets::AssetPaths;
@@ -30,8 +35,15 @@ use gibench_harness::scene::Scene;
 const SIZE: [u32; 2] = [96, 72];
 const FRAMES: u32 = 3;
 
-/// The technique's indirect irradiance after frames 0..FRAMES, from a fresh build.
-fn render(gpu: &GpuContext, h: &Harness, info: &TechniqueInfo, config: &RunConfig) -> Vec<Vec3> {
+/// The technique's indirect irradiance after frames 0..FRAMES, from a fresh build, and the GPU
+/// stages it timed without declaring a cost (the frames are recorded, so the profiler keeps
+/// the costs declared).
+fn render(
+    gpu: &GpuContext,
+    h: &Harness,
+    info: &TechniqueInfo,
+    config: &RunConfig,
+) -> (Vec<Vec3>, Vec<String>) {
     let params = info.parse_params(&[]).expect("defaults parse");
     let prepared = h.prepare(info, &params, config).expect("prepare");
     let (mut t, compose) = h
@@ -40,15 +52,23 @@ fn render(gpu: &GpuContext, h: &Harness, info: &TechniqueInfo, config: &RunConfi
     let mut profiler = Profiler::new(gpu, ProfileMode::Frame);
     for f in 0..FRAMES {
         let frame = h.clock.frame(f);
-        h.render_frame(t.as_mut(), &compose, &mut profiler, &frame, false)
+        h.render_frame(t.as_mut(), &compose, &mut profiler, &frame, true)
             .expect("frame renders");
     }
     profiler.finish(gpu).expect("frames finish");
-    gibench_harness::gpu::image_io::read_rgb_f32(gpu, t.output().texture())
+    let costs = profiler.stage_costs();
+    let undeclared = profiler
+        .stage_results()
+        .into_iter()
+        .filter(|s| s.kind == StageKind::Gpu && !costs.contains_key(&s.name))
+        .map(|s| s.name)
+        .collect();
+    let output = gibench_harness::gpu::image_io::read_rgb_f32(gpu, t.output().texture())
         .expect("output reads back")
         .into_iter()
         .map(Vec3::from)
-        .collect()
+        .collect();
+    (output, undeclared)
 }
 
 #[test]
@@ -134,13 +154,21 @@ fn conform_on<'a>(
                 &references.last().unwrap().1
             }
         };
-        let a = render(gpu, &h, info, &config);
+        let (a, undeclared) = render(gpu, &h, info, &config);
         let b = if twice {
-            render(gpu, &h, info, &config)
+            render(gpu, &h, info, &config).0
         } else {
             a.clone()
         };
         let name = format!("{} on {scene_name}", info.name);
+        // 5. Every GPU stage declares its cost. Catches a GPU stage added (or a declaration
+        // dropped) without a `stage_cost` beside its `gpu_stage`: the roofline would show "–".
+        if !undeclared.is_empty() {
+            failures.push(format!(
+                "{name}: GPU stages without a declared cost: {}",
+                undeclared.join(", ")
+            ));
+        }
         // 1. Finite.
         if let Some(i) = a.iter().position(|e| !e.is_finite()) {
             failures.push(format!("{name}: non-finite output {} at pixel {i}", a[i]));

@@ -55,6 +55,12 @@ impl StageCost {
         }
     }
 
+    /// This cost `n` times over (a per-map or per-face cost times the maps or faces a frame
+    /// draws).
+    pub fn times(self, n: f64) -> StageCost {
+        self.scaled(n)
+    }
+
     /// The sum of two costs.
     pub fn plus(mut self, other: StageCost) -> StageCost {
         self.add(&other);

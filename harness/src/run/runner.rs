@@ -14,7 +14,7 @@ use serde_json::Value;
 use crate::cpu::bvh::{SceneBvh, SceneTrees};
 use crate::gpu::profiler::{ProfileMode, Profiler};
 use crate::gpu::GpuContext;
-use crate::kit::passes::{Compose, DirectLight, FrameUniforms, GBuffer, GpuScene};
+use crate::kit::passes::{Compose, DirectLight, DrawSet, FrameUniforms, GBuffer, GpuScene};
 use crate::kit::technique::{
     FrameContext, Params, PrepareContext, Prepared, SceneContext, Technique, TechniqueInfo,
 };
@@ -40,11 +40,13 @@ pub const STAGE_COMPOSE: &str = "compose";
 /// harness.
 struct SharedCosts {
     gbuffer: StageCost,
+    /// One face of the direct light's shadow map (times the faces a frame draws).
+    direct_shadow_face: StageCost,
     direct_light: StageCost,
 }
 
 impl SharedCosts {
-    fn new(resolution: [u32; 2], scene: &GpuScene) -> SharedCosts {
+    fn new(resolution: [u32; 2], shadow_size: u32, scene: &GpuScene) -> SharedCosts {
         let pixels = resolution[0] as u64 * resolution[1] as u64;
         // `gbuffer`: the scene drawn once ([`crate::kit::passes::GpuScene::draw_cost`]) and every
         // pixel's depth (4 bytes), normal (Rgba16Float, 8) and albedo (4) written once.
@@ -59,8 +61,19 @@ impl SharedCosts {
         // summed (16). The taps' texels are not counted as bytes: neighbouring pixels share
         // them, so the minimum reads the map's texels once, fewer than the pixels here.
         let direct_light = StageCost::per_element(pixels, 12, 8, 80);
+        // `direct-shadow-map`, per face the light needs (the faces a spot light cannot reach are
+        // not drawn; the frame's count multiplies this): the scene's positions and indices read
+        // once and every vertex moved into the face's view
+        // ([`crate::kit::passes::GpuScene::depth_draw_cost`]), and the face's size² depth
+        // texels (Depth32Float, 4 bytes) written once. Fragments hidden behind nearer ones are
+        // not counted: the minimum writes each texel once.
+        let face = shadow_size as u64 * shadow_size as u64;
+        let direct_shadow_face = scene
+            .depth_draw_cost(DrawSet::StaticAndMovers)
+            .plus(StageCost::per_element(face, 0, 4, 0));
         SharedCosts {
             gbuffer,
+            direct_shadow_face,
             direct_light,
         }
     }
@@ -394,7 +407,7 @@ impl<'a> Harness<'a> {
         let gbuffer = GBuffer::new(gpu, &gpu_scene, &uniforms);
         let direct = DirectLight::new(gpu, &gpu_scene, &uniforms, &gbuffer);
         gpu.check_errors()?;
-        let shared_costs = SharedCosts::new(config.resolution, &gpu_scene);
+        let shared_costs = SharedCosts::new(config.resolution, config.shadow_size, &gpu_scene);
         let trees = SceneTrees::new(scene);
         Ok(Harness {
             gpu,
@@ -485,6 +498,10 @@ impl<'a> Harness<'a> {
             self.direct
                 .encode_shadow_map(enc, &self.gpu_scene, &self.uniforms, &frame.light)
         })?;
+        profiler.stage_cost(
+            STAGE_DIRECT_SHADOW_MAP,
+            self.shared_costs.direct_shadow_face.times(faces as f64),
+        );
         profiler.count("direct-shadow-faces", faces as f64);
         profiler.gpu_stage(gpu, STAGE_DIRECT_LIGHT, |enc| {
             self.direct.encode_lighting(enc, &self.gbuffer)
@@ -496,6 +513,7 @@ impl<'a> Harness<'a> {
             profiler,
         })?;
         profiler.gpu_stage(gpu, STAGE_COMPOSE, |enc| compose.encode(enc, &self.gbuffer))?;
+        profiler.stage_cost(STAGE_COMPOSE, compose.cost);
         profiler.end_frame(gpu)
     }
 

@@ -178,9 +178,11 @@ fn create(
     )?;
     // The database's size never changes after preparation: counted once, reported per frame.
     let patches_and_leaves = renderer.scene().patches_and_leaves();
+    let costs = renderer.stage_costs(ctx.gpu_scene);
     Ok(Box::new(Barczak {
         renderer,
         patches_and_leaves,
+        costs,
     }))
 }
 
@@ -189,6 +191,8 @@ pub struct Barczak {
     renderer: Renderer,
     /// The database's patch receivers and their leaves (the `patches` and `leaves` counters).
     patches_and_leaves: (usize, usize),
+    /// The GPU stages' declared costs, computed once.
+    costs: renderer::StageCosts,
 }
 
 impl Technique for Barczak {
@@ -196,6 +200,7 @@ impl Technique for Barczak {
         let gpu = ctx.gpu;
         let (scene, uniforms, bvh, frame) = (ctx.gpu_scene, ctx.uniforms, ctx.bvh, ctx.frame);
         let r = &mut self.renderer;
+        let costs = &self.costs;
         let mut counts = ctx
             .profiler
             .cpu_stage(STAGE_VISIBILITY, || r.update(gpu, frame))?;
@@ -203,24 +208,33 @@ impl Technique for Barczak {
             ctx.profiler.gpu_stage(gpu, STAGE_SHADOW_MAPS, |enc| {
                 r.encode_shadow_maps(gpu, enc, scene, uniforms)
             })?;
+        ctx.profiler.stage_cost(
+            STAGE_SHADOW_MAPS,
+            costs.shadow_map.times(counts.maps_rendered as f64),
+        );
         ctx.profiler.gpu_stage(gpu, STAGE_LIGHT_MAPS, |enc| {
             r.encode_light_maps(enc, uniforms)
         })?;
+        ctx.profiler.stage_cost(STAGE_LIGHT_MAPS, costs.light_maps);
         let low = r.lowres().is_some();
         if low {
             ctx.profiler
                 .gpu_stage(gpu, STAGE_EDGES, |enc| r.encode_edges(enc))?;
+            ctx.profiler.stage_cost(STAGE_EDGES, costs.edges);
             counts.light_draws += ctx
                 .profiler
                 .gpu_stage(gpu, STAGE_LOW_RES, |enc| r.encode_low(enc, uniforms))?;
+            ctx.profiler.stage_cost(STAGE_LOW_RES, costs.low_res);
         }
         counts.light_draws += ctx
             .profiler
             .gpu_stage(gpu, STAGE_LIGHTS, |enc| r.encode_lights(enc, uniforms))?;
+        ctx.profiler.stage_cost(STAGE_LIGHTS, costs.lights);
         ctx.profiler
             .cpu_stage(STAGE_PRT_LIGHTING, || r.prt_lighting(gpu, bvh));
         ctx.profiler
             .gpu_stage(gpu, STAGE_PRT, |enc| r.encode_prt(enc, scene, uniforms))?;
+        ctx.profiler.stage_cost(STAGE_PRT, costs.prt);
         let samples = &r.scene().samples;
         let vpls = samples.direct.len() + samples.indirect.len();
         ctx.profiler.count("vpls", vpls as f64);

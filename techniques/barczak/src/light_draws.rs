@@ -243,6 +243,11 @@ impl LightDraws {
         Ok(self.draws.len() as u32)
     }
 
+    /// The patch leaves' vertices (what a draw over every leaf reads).
+    pub fn leaf_vertices(&self) -> u32 {
+        self.leaves.vertex_count()
+    }
+
     /// Elements of the last plan.
     pub fn elements(&self) -> usize {
         self.elements

@@ -27,8 +27,9 @@ use gibench_harness::kit::ir::face_cull::Occluders;
 use gibench_harness::kit::ir::raster::{AtlasClear, AtlasRasteriser};
 use gibench_harness::kit::ir::store::VplStore;
 use gibench_harness::kit::passes::{
-    render_target, DrawSet, FrameUniforms, GBuffer, GpuScene, HDR_FORMAT,
+    render_target, DrawSet, FrameUniforms, GBuffer, GpuScene, Vertex, HDR_FORMAT,
 };
+use gibench_harness::measure::roofline::StageCost;
 use gibench_harness::scene::anim::FrameState;
 use gibench_harness::scene::Scene;
 use gibench_harness::{wgpu, Error, Result};
@@ -180,6 +181,21 @@ pub struct FrameCounts {
     pub light_map_changes: u32,
 }
 
+/// The GPU stages' declared minimum costs ([`gibench_harness::measure::roofline`]), computed once
+/// by [`Renderer::stage_costs`]. The light draws' arithmetic, per pixel and light, is not
+/// counted: which pixels each draw's leaves cover is known on the GPU only, so `low-res` and
+/// `lights` declare what they must read and write (a lower bound).
+#[derive(Clone, Copy, Debug)]
+pub struct StageCosts {
+    /// One shadow map (times the maps a frame renders).
+    pub shadow_map: StageCost,
+    pub light_maps: StageCost,
+    pub edges: StageCost,
+    pub low_res: StageCost,
+    pub lights: StageCost,
+    pub prt: StageCost,
+}
+
 /// See the module docs.
 pub struct Renderer {
     bz: BarczakScene,
@@ -323,6 +339,78 @@ impl Renderer {
     /// The prepared scene.
     pub fn scene(&self) -> &BarczakScene {
         &self.bz
+    }
+
+    /// The GPU stages' declared minimum costs for the scene drawn by `scene` (the harness's,
+    /// the one the maps and the PRT draw read); call once, not per frame.
+    pub fn stage_costs(&self, scene: &GpuScene) -> StageCosts {
+        let size = self.output.size();
+        let pixels = size.width as u64 * size.height as u64;
+        // The patch leaves' vertices, read once by a pass that draws them: position and the
+        // (leaf, s, t) or normal a pass needs (24 of their 36 bytes), moved to clip space once
+        // (32 operations).
+        let leaves = StageCost::per_element(self.draws.leaf_vertices() as u64, 24, 0, 32);
+        // `shadow-maps`: the kit's map cost ([`AtlasRasteriser::map_cost`]), per map rendered.
+        let shadow_map = self.raster.map_cost(scene, &self.atlas);
+        // `light-maps` (Full): the leaves drawn once; per pixel the G-buffer's depth read (4
+        // bytes) to find the leaf shown and the irradiance (Rgba16Float, 8) written; the
+        // bilinear blend of four light-map texels (three lerps of three channels, 18) and its
+        // coordinates (about 8). The light-map texels are not counted (how many a frame needs
+        // depends on what the camera sees). Other levels draw nothing here: zero.
+        let light_maps = if self.settings.level == Optimisation::Full {
+            leaves.plus(StageCost::per_element(pixels, 4, 8, 26))
+        } else {
+            StageCost::default()
+        };
+        // `edges`: the kit's edge mask ([`EdgeMask::cost`](gibench_harness::kit::ir::edges::EdgeMask)).
+        // Writing it again as depth for the draws' depth test is this implementation's, not
+        // the minimum's.
+        let edges = self
+            .lowres
+            .as_ref()
+            .map_or(StageCost::default(), |l| l.edges().cost);
+        // `low-res`, `lights`: the leaves drawn once, every light of the store read once
+        // (`GpuVpl`), per pixel drawn (the low resolution's, or the full one's) the G-buffer's
+        // depth read (4) and the irradiance (Rgba16Float, 8) written once; with the low pass,
+        // `lights` also reads the low image once (8 per low pixel). The (pixel, light) pairs'
+        // arithmetic is not counted (see [`StageCosts`]).
+        let vpl_bytes = std::mem::size_of::<gibench_harness::kit::ir::store::GpuVpl>() as u64;
+        let store = StageCost::per_element(self.lights.len() as u64, vpl_bytes, 0, 0);
+        let draws = leaves.plus(store);
+        let (low_res, lights) = match &self.lowres {
+            Some(l) => {
+                let low = l.size[0] as u64 * l.size[1] as u64;
+                (
+                    draws.plus(StageCost::per_element(low, 4, 8, 0)),
+                    draws
+                        .plus(StageCost::per_element(pixels, 4, 8, 0))
+                        .plus(StageCost::per_element(low, 8, 0, 0)),
+                )
+            }
+            None => (
+                StageCost::default(),
+                draws.plus(StageCost::per_element(pixels, 4, 8, 0)),
+            ),
+        };
+        // `prt`: per mover vertex its position (12 bytes) and 25 transfer coefficients (100)
+        // read once, every index read once; per vertex 25 RGB products summed (75 FMAs, 150
+        // operations), clamped (3) and moved to clip space (32). The pixels the movers cover
+        // are not counted (known on the GPU only).
+        let mut prt = StageCost::default();
+        for m in scene.movers.iter() {
+            let vertices = m.vertices.size() / std::mem::size_of::<Vertex>() as u64;
+            prt = prt
+                .plus(StageCost::per_element(vertices, 12 + 100, 0, 185))
+                .plus(StageCost::per_element(m.indices.size(), 1, 0, 0));
+        }
+        StageCosts {
+            shadow_map,
+            light_maps,
+            edges,
+            low_res,
+            lights,
+            prt,
+        }
     }
 
     /// The low-resolution pass, where the level has one.

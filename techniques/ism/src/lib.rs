@@ -44,7 +44,7 @@ use gibench_harness::kit::ir::raster::StoreViews;
 use gibench_harness::kit::ir::rsm::ReflectiveShadowMap;
 use gibench_harness::kit::ir::splat::PointSplat;
 use gibench_harness::kit::ir::vpl_sample::{RsmTexels, VplSampler};
-use gibench_harness::kit::passes::DrawSet;
+use gibench_harness::kit::passes::{needed_cube_faces, DrawSet};
 use gibench_harness::kit::technique::{
     Conformance, FrameContext, Params, PrepareContext, Prepared, Technique, TechniqueInfo,
 };
@@ -272,8 +272,16 @@ impl Technique for Ism {
         ctx.profiler.gpu_stage(gpu, STAGE_RSM, |enc| {
             self.rsm.encode(gpu, enc, scene, uniforms, directional)
         })?;
+        let reached = needed_cube_faces(&ctx.frame.light)
+            .iter()
+            .filter(|f| **f)
+            .count();
+        ctx.profiler
+            .stage_cost(STAGE_RSM, self.rsm.cost(reached as u32));
         ctx.profiler
             .gpu_stage(gpu, STAGE_VPL_SAMPLING, |enc| self.sampler.encode(enc))?;
+        ctx.profiler
+            .stage_cost(STAGE_VPL_SAMPLING, self.sampler.cost);
         match &mut self.maps {
             Maps::Imperfect(m) => {
                 let ImperfectMaps {
@@ -297,6 +305,7 @@ impl Technique for Ism {
                 ctx.profiler.stage_cost(STAGE_POINT_SPLAT, splat.cost());
                 ctx.profiler
                     .gpu_stage(gpu, STAGE_PULL_PUSH, |enc| pullpush.encode(enc))?;
+                ctx.profiler.stage_cost(STAGE_PULL_PUSH, pullpush.cost);
                 ctx.profiler.count("shadow-maps", self.vpls as f64);
             }
             Maps::Classic(views) => self.gather.render_store_maps(ctx, views, self.vpls)?,

@@ -19,6 +19,7 @@ use crate::gpu::GpuContext;
 use crate::kit::passes::{
     bind_buffer, compute_pipeline, params_buffer, params_entry, storage_entry, GBuffer,
 };
+use crate::measure::roofline::StageCost;
 use crate::{Error, Result};
 
 /// What counts as an edge (see the module docs).
@@ -53,6 +54,9 @@ struct ParamsData {
 /// The edge-mask pass (see the module docs).
 pub struct EdgeMask {
     pub settings: EdgeSettings,
+    /// The pass's declared minimum cost per frame ([`crate::measure::roofline`]), from the
+    /// image's size.
+    pub cost: StageCost,
     size: [u32; 2],
     mask: wgpu::Buffer,
     group: wgpu::BindGroup,
@@ -114,7 +118,16 @@ impl EdgeMask {
             "main",
         );
         gpu.check_errors()?;
+        // Per pixel its depth (4 bytes) and normal (Rgba16Float, 8) read once (a neighbour's
+        // are its own pixel's: the minimum reads each once) and its mask word written (4); its
+        // position rebuilt from depth (32 operations, once: the neighbours' positions are their
+        // own pixels'), and per neighbour the offset from it (3), its distance off the plane
+        // (5) and its squared length against it (6), the normals' dot product against the
+        // threshold (6): 20, eight neighbours (a pixel inside a surface, most of them, tests
+        // all eight; an edge may stop sooner) — 192.
+        let cost = StageCost::per_element(w as u64 * h as u64, 12, 4, 32 + 8 * 20);
         Ok(EdgeMask {
+            cost,
             settings,
             size: gbuffer.size,
             mask,

@@ -102,6 +102,8 @@ pub struct VplGather {
     /// `None` when another pass writes the atlas (imperfect shadow maps).
     pub raster: Option<AtlasRasteriser>,
     pub accumulation: Accumulation,
+    /// The stages' declared costs, computed once from the sizes.
+    costs: GatherCosts,
 }
 
 impl VplGather {
@@ -153,7 +155,12 @@ impl VplGather {
             },
         )?;
         let view = output.create_view(&Default::default());
+        let costs = GatherCosts::new(
+            &interleave,
+            raster.as_ref().map(|r| r.map_cost(ctx.gpu_scene, &atlas)),
+        );
         Ok(VplGather {
+            costs,
             _output: output,
             view,
             interleave,
@@ -177,7 +184,7 @@ impl VplGather {
         let n = ctx.profiler.gpu_stage(gpu, STAGE_VPL_SHADOW_MAPS, |enc| {
             raster.render(gpu, enc, &self.atlas, scene, uniforms, vpls, clear)
         })?;
-        ctx.profiler.count("shadow-maps", n as f64);
+        self.maps_rendered(ctx, n);
         Ok(())
     }
 
@@ -202,8 +209,18 @@ impl VplGather {
         let n = ctx.profiler.gpu_stage(gpu, STAGE_VPL_SHADOW_MAPS, |enc| {
             raster.render_store(enc, &self.atlas, scene, uniforms, views, count)
         })?;
-        ctx.profiler.count("shadow-maps", n as f64);
+        self.maps_rendered(ctx, n);
         Ok(())
+    }
+
+    /// Counts the `n` maps the `vpl-shadow-maps` stage rendered as `shadow-maps` and declares
+    /// their cost.
+    fn maps_rendered(&self, ctx: &mut FrameContext, n: u32) {
+        if let Some(map) = self.costs.map {
+            ctx.profiler
+                .stage_cost(STAGE_VPL_SHADOW_MAPS, map.times(n as f64));
+        }
+        ctx.profiler.count("shadow-maps", n as f64);
     }
 
     /// Uploads `vpls` (slot, VPL) into the store and records the gathering stages. Counts
@@ -235,19 +252,25 @@ impl VplGather {
     fn gather_stages(&self, ctx: &mut FrameContext, vpls: u32) -> Result<()> {
         let gpu = ctx.gpu;
         let il = &self.interleave;
-        let costs = GatherCosts::new(il, vpls);
+        let costs = &self.costs;
         ctx.profiler
             .gpu_stage(gpu, STAGE_SPLIT, |enc| il.encode_split(enc))?;
         ctx.profiler.stage_cost(STAGE_SPLIT, costs.split);
         ctx.profiler.gpu_stage(gpu, STAGE_ACCUMULATE, |enc| {
             self.accumulation.encode(enc, il, &self.atlas)
         })?;
-        ctx.profiler.stage_cost(STAGE_ACCUMULATE, costs.accumulate);
+        ctx.profiler.stage_cost(
+            STAGE_ACCUMULATE,
+            costs
+                .accumulate
+                .plus(costs.accumulate_per_vpl.times(vpls as f64)),
+        );
         ctx.profiler
             .gpu_stage(gpu, STAGE_COMBINE, |enc| il.encode_combine(enc))?;
         ctx.profiler.stage_cost(STAGE_COMBINE, costs.combine);
         ctx.profiler
             .gpu_stage(gpu, STAGE_FILTER, |enc| il.encode_filter(enc))?;
+        ctx.profiler.stage_cost(STAGE_FILTER, costs.filter);
         Ok(())
     }
 
@@ -257,16 +280,21 @@ impl VplGather {
     }
 }
 
-/// The gathering stages' declared minimum costs ([`crate::measure::roofline`]), from the interleave's
-/// sizes and the VPL count (arithmetic only: nothing allocated per frame).
+/// The gathering stages' declared minimum costs ([`crate::measure::roofline`]), computed once
+/// from the interleave's sizes and the map's; `accumulate` grows with the frame's VPL count.
 struct GatherCosts {
+    /// One VPL map (`None`: another pass writes the atlas).
+    map: Option<StageCost>,
     split: StageCost,
+    /// `accumulate` without its VPLs; each VPL adds `accumulate_per_vpl`.
     accumulate: StageCost,
+    accumulate_per_vpl: StageCost,
     combine: StageCost,
+    filter: StageCost,
 }
 
 impl GatherCosts {
-    fn new(il: &Interleave, vpls: u32) -> GatherCosts {
+    fn new(il: &Interleave, map: Option<StageCost>) -> GatherCosts {
         let pixels = il.full[0] as u64 * il.full[1] as u64;
         let texels = il.split_texels() as u64;
         let tiles = (il.tiles[0] * il.tiles[1]) as u64;
@@ -276,26 +304,36 @@ impl GatherCosts {
         let split = StageCost::per_element(pixels, 12, 32, 32);
         // `accumulate`: per split texel its position and normal read (32 bytes) and its
         // irradiance written (16); every VPL read once (`GpuVpl`, 80 bytes). A texel is lit by
-        // its tile's VPLs, vpls / tiles of them, so there are texels × vpls / tiles pairs, each
+        // its tile's VPLs, vpls / tiles of them, so each VPL makes texels / tiles pairs, each
         // at least 40 operations: the vector to the VPL and its squared length (8), the
         // reciprocal distance (1), both cosines (10), the map coordinates of the lookup (10),
         // the product of the terms (5) and the flux's three channels scaled and added (6).
         // The shadow-map texels the lookups read are not counted: how many distinct ones
         // they touch depends on the geometry.
-        let pairs = texels as f64 * vpls as f64 / tiles as f64;
-        let accumulate = StageCost {
-            bytes_read: (texels * 32) as f64
-                + vpls as f64 * std::mem::size_of::<super::store::GpuVpl>() as f64,
-            bytes_written: (texels * 16) as f64,
-            ops: pairs * 40.0,
+        let accumulate = StageCost::per_element(texels, 32, 16, 0);
+        let accumulate_per_vpl = StageCost {
+            bytes_read: std::mem::size_of::<super::store::GpuVpl>() as f64,
+            bytes_written: 0.0,
+            ops: texels as f64 / tiles as f64 * 40.0,
         };
         // `combine`: per pixel its split texel's irradiance read and written back in place
         // (a vec4<f32> each way, 16 bytes); no arithmetic.
         let combine = StageCost::per_element(pixels, 16, 16, 0);
+        // `filter`: per pixel its split position and normal (32 bytes) and its combined
+        // irradiance (16) read once — a tap reads a neighbour's, which the neighbour reads
+        // anyway, so the minimum reads each once — and the output (Rgba16Float, 8) written.
+        // Per tap of the n×m box other than the pixel itself, the geometry test: the position
+        // difference (3), its squared length against α² (6), the normals' dot product against
+        // β (6) — 15; per tap taken, its three channels and the count added (4); the mean's
+        // three divisions (3).
+        let filter = StageCost::per_element(pixels, 48, 8, (tiles - 1) * 15 + tiles * 4 + 3);
         GatherCosts {
+            map,
             split,
             accumulate,
+            accumulate_per_vpl,
             combine,
+            filter,
         }
     }
 }

@@ -25,6 +25,7 @@ use crate::gpu::GpuContext;
 use crate::kit::passes::{
     bind_buffer, compute_pipeline, params_entry, storage_entry, storage_texture_entry, PARAMS_USAGE,
 };
+use crate::measure::roofline::StageCost;
 use crate::{Error, Result};
 
 /// GPU layout of `PullPushParams` in `pullpush.wgsl`.
@@ -45,6 +46,8 @@ struct Pass {
 
 /// The pull-push passes (see the module docs).
 pub struct PullPush {
+    /// The passes' declared minimum cost per frame, from the maps' sizes and the levels.
+    pub cost: StageCost,
     /// pull, push, store.
     pipelines: [wgpu::ComputePipeline; 3],
     passes: Vec<Pass>,
@@ -170,7 +173,27 @@ impl PullPush {
         }
         passes.push(pass(2, 0, if levels > 0 { offsets[1] } else { NO_SOURCE }));
         gpu.check_errors()?;
+        // The declared minimum cost ([`crate::measure::roofline`]): level 0 of every map read
+        // once (the splat's `u32`, 4 bytes a texel) and the atlas written once (R32Float, 4);
+        // the coarser levels, a third as many texels, are not counted (a pass pulling and
+        // pushing one map's tile at a time can keep them on chip). Operations: per texel of
+        // each pulled level its four children's weighted depths and weights summed (12), the
+        // mean and the clamped weight (2); per texel pushed (each level below the top, level 0
+        // included) the blend with its parent (4). With no levels the copy does none.
+        let texels = |k: u32| slots as u64 * (size >> k) as u64 * (size >> k) as u64;
+        let (pulled, pushed) = if levels == 0 {
+            (0, 0)
+        } else {
+            (
+                (1..=levels).map(texels).sum::<u64>(),
+                (0..levels).map(texels).sum::<u64>(),
+            )
+        };
+        let cost = StageCost::per_element(texels(0), 4, 4, 0)
+            .plus(StageCost::per_element(pulled, 0, 0, 14))
+            .plus(StageCost::per_element(pushed, 0, 0, 4));
         Ok(PullPush {
+            cost,
             pipelines,
             passes,
             _pyramid: pyramid,

@@ -26,7 +26,7 @@
 use bytemuck::{Pod, Zeroable};
 use glam::Mat4;
 
-use super::atlas::{MapKind, ShadowAtlas};
+use super::atlas::{AtlasFormat, MapKind, ShadowAtlas};
 use super::store::VplStore;
 use crate::cpu::vpl::{frame_from_normal, Vpl};
 use crate::gpu::GpuContext;
@@ -34,6 +34,7 @@ use crate::kit::passes::{
     bind_buffer, compute_pipeline, cube_face_matrix, shader_module, storage_entry, uniform_entry,
     DrawSet, FrameUniforms, GpuScene, Vertex,
 };
+use crate::measure::roofline::StageCost;
 use crate::{Error, Result};
 
 /// What the rasteriser clears before rendering.
@@ -196,6 +197,29 @@ impl AtlasRasteriser {
             map_pipeline,
             clear_pipeline,
         })
+    }
+
+    /// The declared minimum cost of one map ([`crate::measure::roofline`]), for its caller to
+    /// compute once and multiply by the maps a frame renders: the draw set's positions and
+    /// indices read once per map and every vertex moved into the VPL's frame once
+    /// ([`GpuScene::depth_draw_cost`]: a cube map's six faces or an octahedral map's four can
+    /// share one read and one transform per vertex), and every texel of the map's block written
+    /// once (cleared or drawn: 2 or 4 bytes by the atlas's depth format). Fragments hidden behind
+    /// nearer ones and a cube face's or octahedral face's re-projection are not counted.
+    pub fn map_cost(&self, scene: &GpuScene, atlas: &ShadowAtlas) -> StageCost {
+        let (_, [w, h]) = atlas.block(0);
+        let depth_bytes = match atlas.settings.format {
+            AtlasFormat::Depth16 => 2,
+            AtlasFormat::Depth32 | AtlasFormat::Float32 => 4,
+        };
+        scene
+            .depth_draw_cost(self.draw_set)
+            .plus(StageCost::per_element(
+                w as u64 * h as u64,
+                0,
+                depth_bytes,
+                0,
+            ))
     }
 
     /// Writes the view(s) of `vpl` for `slot` into the CPU copy `mirror`.

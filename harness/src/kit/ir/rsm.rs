@@ -23,10 +23,13 @@ use crate::kit::passes::{
     render_target, scene_pipeline, storage_entry, texture_entry, uniform_entry, FrameUniforms,
     GpuScene, ALBEDO_FORMAT, DEPTH_FORMAT, NORMAL_FORMAT, PARAMS_USAGE,
 };
+use crate::measure::roofline::StageCost;
 use crate::Result;
 
 /// The map, its render pipeline and its export pass (see the module docs).
 pub struct ReflectiveShadowMap {
+    /// The declared minimum cost of one face ([`ReflectiveShadowMap::cost`]).
+    face_cost: StageCost,
     size: u32,
     depth_view: wgpu::TextureView,
     normal_view: wgpu::TextureView,
@@ -152,7 +155,19 @@ impl ReflectiveShadowMap {
             "export_texels",
         );
         gpu.check_errors()?;
+        // Per face: the scene drawn once, every vertex with its normal, texture coordinates and
+        // material ([`GpuScene::draw_cost`]), and every texel's position, normal and reflected
+        // flux (three vec4<f32>, 48 bytes) written once — straight from the rasteriser: the
+        // depth, normal and albedo textures this pass goes through are not part of the
+        // minimum. Per texel the flux: the direction to the light and its length (8), the
+        // light's intensity that way (about 10), the texel's solid angle (6) and the albedo
+        // times it (6): 30 operations. Texture reads and hidden fragments are not counted.
+        let face = size as u64 * size as u64;
+        let face_cost = scene
+            .draw_cost()
+            .plus(StageCost::per_element(face, 0, 48, 30));
         Ok(ReflectiveShadowMap {
+            face_cost,
             size,
             depth_view,
             normal_view,
@@ -165,6 +180,13 @@ impl ReflectiveShadowMap {
             buffers,
             _textures: [depth, normal, albedo],
         })
+    }
+
+    /// The declared minimum cost ([`crate::measure::roofline`]) of a frame whose light reaches
+    /// `faces` faces ([`crate::kit::passes::needed_cube_faces`]: a spot light fewer than six,
+    /// the sun one). The faces it cannot reach stay empty, so their texels need no writing.
+    pub fn cost(&self, faces: u32) -> StageCost {
+        self.face_cost.times(faces as f64)
     }
 
     /// Edge of each face, texels (the texel buffers' rows are this long).

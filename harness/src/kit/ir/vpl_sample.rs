@@ -31,6 +31,7 @@ use crate::gpu::GpuContext;
 use crate::kit::passes::{
     bind_buffer, compute_pipeline, params_entry, storage_entry, PARAMS_USAGE,
 };
+use crate::measure::roofline::StageCost;
 use crate::{Error, Result};
 
 #[repr(C)]
@@ -41,6 +42,8 @@ struct ParamsData {
 
 /// The scan and sample passes (see the module docs).
 pub struct VplSampler {
+    /// The pass's declared minimum cost per frame, from the map's texels and the VPL count.
+    pub cost: StageCost,
     scan: wgpu::ComputePipeline,
     sample: wgpu::ComputePipeline,
     group: wgpu::BindGroup,
@@ -178,7 +181,19 @@ impl VplSampler {
         let scan = compute_pipeline(device, "vpl sample scan", &source, &[&layout], "scan");
         let sample = compute_pipeline(device, "vpl sample", &source, &[&layout], "sample");
         gpu.check_errors()?;
+        // The declared minimum cost ([`crate::measure::roofline`]): every texel's flux read
+        // once (a vec4<f32>, 16 bytes) with its luminance (5 operations) added to a running sum
+        // (1) — the VPLs' points are sorted along u, so one sweep over that sum places them all
+        // and the CDF need not be stored; per VPL its texel's position, normal and flux read
+        // (48 bytes), the VPL written (`GpuVpl`), its flux scaled by the total over its texel's
+        // luminance (5 with that luminance, 3 more for the channels) and its frame about the
+        // normal built (about 17): 25 operations. The search for its texel is comparisons, not
+        // counted.
+        let vpl_bytes = std::mem::size_of::<super::store::GpuVpl>() as u64;
+        let cost = StageCost::per_element(rsm.texels as u64, 16, 0, 6)
+            .plus(StageCost::per_element(count as u64, 48, vpl_bytes, 25));
         Ok(VplSampler {
+            cost,
             scan,
             sample,
             group,

@@ -7,6 +7,7 @@
 use wgpu::util::DeviceExt;
 
 use crate::gpu::GpuContext;
+use crate::measure::roofline::StageCost;
 
 use super::{
     bind_buffer, draw_fullscreen, fullscreen_pipeline, params_entry, render_target, shader_module,
@@ -17,6 +18,9 @@ use super::{GBuffer, HDR_FORMAT};
 pub const DISPLAY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
 
 pub struct Compose {
+    /// The pass's declared minimum cost per frame ([`crate::measure::roofline`]), from the
+    /// image's size.
+    pub cost: StageCost,
     pipeline: wgpu::RenderPipeline,
     group: wgpu::BindGroup,
     pub radiance: wgpu::Texture,
@@ -76,7 +80,15 @@ impl Compose {
         );
         let radiance = render_target(device, "radiance", gbuffer.size, HDR_FORMAT);
         let display = render_target(device, "display", gbuffer.size, DISPLAY_FORMAT);
+        // Per pixel: the albedo (Rgba8, 4 bytes), the direct and the indirect irradiance
+        // (Rgba16Float, 8 each) read once, the radiance (Rgba16Float, 8) and the display
+        // value (Rgba8, 4) written once; per channel the indirect clamped at zero and added
+        // (2), times the albedo and 1/π (2), times the exposure and clamped to [0, 1] (3):
+        // 21 operations (the sRGB encoding is the target format's, on write).
+        let [w, h] = gbuffer.size;
+        let cost = StageCost::per_element(w as u64 * h as u64, 20, 12, 21);
         Compose {
+            cost,
             pipeline,
             group,
             radiance_view: radiance.create_view(&Default::default()),

@@ -269,18 +269,7 @@ impl GpuScene {
         object_group_index: u32,
         set: DrawSet,
     ) {
-        let statics = match set {
-            DrawSet::StaticCasters | DrawSet::CastersAndMovers => {
-                self.shadow_mesh.as_ref().unwrap_or(&self.static_mesh)
-            }
-            DrawSet::Static | DrawSet::StaticAndMovers => &self.static_mesh,
-        };
-        let movers = if matches!(set, DrawSet::StaticAndMovers | DrawSet::CastersAndMovers) {
-            &self.movers[..]
-        } else {
-            &[]
-        };
-        for (slot, mesh) in std::iter::once(statics).chain(movers.iter()).enumerate() {
+        for (slot, mesh) in self.meshes(set).enumerate() {
             pass.set_bind_group(
                 object_group_index,
                 &uniforms.object_group,
@@ -641,6 +630,42 @@ impl FrameUniforms {
 }
 
 impl GpuScene {
+    /// The meshes `set` draws, in object-slot order: the static mesh (or its shadow-caster
+    /// copy), then the movers if the set has them.
+    pub fn meshes(&self, set: DrawSet) -> impl Iterator<Item = &GpuMesh> {
+        let statics = match set {
+            DrawSet::StaticCasters | DrawSet::CastersAndMovers => {
+                self.shadow_mesh.as_ref().unwrap_or(&self.static_mesh)
+            }
+            DrawSet::Static | DrawSet::StaticAndMovers => &self.static_mesh,
+        };
+        let movers = if matches!(set, DrawSet::StaticAndMovers | DrawSet::CastersAndMovers) {
+            &self.movers[..]
+        } else {
+            &[]
+        };
+        std::iter::once(statics).chain(movers.iter())
+    }
+
+    /// The least cost of drawing `set` once into a depth-only map (a shadow map), for the
+    /// roofline ([`crate::measure::roofline`]): every vertex's position (12 bytes; the normal,
+    /// texture coordinates and material a depth map does not need are not counted) and every
+    /// index read once, and every vertex moved into the map's space, a 4×4 matrix times a point
+    /// (16 FMAs, 32 operations). The caller adds the depth texels it writes.
+    pub fn depth_draw_cost(&self, set: DrawSet) -> crate::measure::roofline::StageCost {
+        let vertex = std::mem::size_of::<Vertex>() as u64;
+        let (mut indices, mut vertices) = (0, 0);
+        for m in self.meshes(set) {
+            indices += m.indices.size();
+            vertices += m.vertices.size() / vertex;
+        }
+        crate::measure::roofline::StageCost {
+            bytes_read: (indices + vertices * 12) as f64,
+            bytes_written: 0.0,
+            ops: (vertices * 32) as f64,
+        }
+    }
+
     /// The least cost of drawing the scene's meshes (static and movers) once, for the roofline
     /// ([`crate::measure::roofline`]): every vertex and index read once (the meshes' buffers, bytes), and
     /// every vertex moved to clip space, a 4×4 matrix times a point (16 FMAs, 32 operations).
