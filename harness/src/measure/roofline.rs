@@ -55,12 +55,6 @@ impl StageCost {
         }
     }
 
-    /// This cost `n` times over (a per-map or per-face cost times the maps or faces a frame
-    /// draws).
-    pub fn times(self, n: f64) -> StageCost {
-        self.scaled(n)
-    }
-
     /// The sum of two costs.
     pub fn plus(mut self, other: StageCost) -> StageCost {
         self.add(&other);
@@ -73,7 +67,9 @@ impl StageCost {
         self.ops += other.ops;
     }
 
-    fn scaled(&self, factor: f64) -> StageCost {
+    /// This cost `factor` times over (a per-map or per-face cost times the maps or faces a
+    /// frame draws; a sum over frames divided by their number).
+    pub fn scaled(&self, factor: f64) -> StageCost {
         StageCost {
             bytes_read: self.bytes_read * factor,
             bytes_written: self.bytes_written * factor,

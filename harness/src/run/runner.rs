@@ -500,7 +500,7 @@ impl<'a> Harness<'a> {
         })?;
         profiler.stage_cost(
             STAGE_DIRECT_SHADOW_MAP,
-            self.shared_costs.direct_shadow_face.times(faces as f64),
+            self.shared_costs.direct_shadow_face.scaled(faces as f64),
         );
         profiler.count("direct-shadow-faces", faces as f64);
         profiler.gpu_stage(gpu, STAGE_DIRECT_LIGHT, |enc| {

@@ -210,7 +210,7 @@ impl Technique for Barczak {
             })?;
         ctx.profiler.stage_cost(
             STAGE_SHADOW_MAPS,
-            costs.shadow_map.times(counts.maps_rendered as f64),
+            costs.shadow_map.scaled(counts.maps_rendered as f64),
         );
         ctx.profiler.gpu_stage(gpu, STAGE_LIGHT_MAPS, |enc| {
             r.encode_light_maps(enc, uniforms)

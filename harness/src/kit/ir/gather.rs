@@ -218,7 +218,7 @@ impl VplGather {
     fn maps_rendered(&self, ctx: &mut FrameContext, n: u32) {
         if let Some(map) = self.costs.map {
             ctx.profiler
-                .stage_cost(STAGE_VPL_SHADOW_MAPS, map.times(n as f64));
+                .stage_cost(STAGE_VPL_SHADOW_MAPS, map.scaled(n as f64));
         }
         ctx.profiler.count("shadow-maps", n as f64);
     }
@@ -263,7 +263,7 @@ impl VplGather {
             STAGE_ACCUMULATE,
             costs
                 .accumulate
-                .plus(costs.accumulate_per_vpl.times(vpls as f64)),
+                .plus(costs.accumulate_per_vpl.scaled(vpls as f64)),
         );
         ctx.profiler
             .gpu_stage(gpu, STAGE_COMBINE, |enc| il.encode_combine(enc))?;

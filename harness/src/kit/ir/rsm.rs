@@ -186,7 +186,7 @@ impl ReflectiveShadowMap {
     /// `faces` faces ([`crate::kit::passes::needed_cube_faces`]: a spot light fewer than six,
     /// the sun one). The faces it cannot reach stay empty, so their texels need no writing.
     pub fn cost(&self, faces: u32) -> StageCost {
-        self.face_cost.times(faces as f64)
+        self.face_cost.scaled(faces as f64)
     }
 
     /// Edge of each face, texels (the texel buffers' rows are this long).
