@@ -654,7 +654,8 @@ fn sweep_shards_merge_to_the_unsharded_sweep() {
 /// shard runs (the merged results differ from the unsharded run's), a Slurm environment not
 /// read by `run`, a merge that draws a scene's summary table from anything but that scene's
 /// pooled results in the run's order (its shape differs; tried: units split at the first
-/// scene prefix put cornell-omni's runs in cornell's table), or one that pools a shard twice, a unit twice, shards of
+/// scene prefix put cornell-omni's runs in cornell's table), a merge of `--html` shards
+/// without a page of all their runs, or one that pools a shard twice, a unit twice, shards of
 /// other settings, or `run` shards with `reproduce all` folders, instead of refusing by name.
 #[test]
 fn run_shards_merge_to_the_unsharded_run() {
@@ -664,14 +665,14 @@ fn run_shards_merge_to_the_unsharded_run() {
     let dirs: Vec<PathBuf> = (0..3)
         .map(|i| tmp.path().join(format!("shard{i}")))
         .collect();
-    let one = start_run(techniques, "2", &single, &[], &[]);
+    let one = start_run(techniques, "2", &single, &[], &["--html"]);
     let shards: Vec<Child> = (dirs.iter().enumerate())
         .map(|(i, d)| {
             let vars = [
                 ("SLURM_ARRAY_TASK_ID", i.to_string()),
                 ("SLURM_ARRAY_TASK_COUNT", "3".to_string()),
             ];
-            start_run(techniques, "2", d, &vars, &[])
+            start_run(techniques, "2", d, &vars, &["--html"])
         })
         .collect();
     // A shard of other settings (three frames), for the refusal below.
@@ -723,6 +724,17 @@ fn run_shards_merge_to_the_unsharded_run() {
     }
     assert!(merged.join("cornell-summary.svg").is_file());
     assert!(merged.join("cornell-omni-summary.svg").is_file());
+    // The shards ran with --html: the merged set has each scene's page, of every shard's runs.
+    for scene in ["cornell", "cornell-omni"] {
+        let page = std::fs::read_to_string(merged.join(format!("{scene}-report.html")))
+            .unwrap_or_else(|e| panic!("no merged {scene} page: {e}"));
+        for t in techniques.split(',') {
+            assert!(
+                page.contains(&format!("<summary>{t} on {scene}, ")),
+                "the merged {scene} page lacks {t}"
+            );
+        }
+    }
     // Refused by name, nothing written.
     let dup = tmp.path().join("dup");
     std::fs::create_dir_all(&dup).unwrap();

@@ -15,6 +15,7 @@ use gibench_harness::output::{write_atomic, OutputSet};
 use gibench_harness::{Error, Result};
 
 use super::files::writable_dir;
+use super::page::{page_line, with_folder, write_page};
 use super::shard::{ShardRecord, RECORD};
 
 #[derive(Args)]
@@ -235,10 +236,13 @@ fn merge_shards(dirs: &[PathBuf], out: &Path) -> Result<()> {
         }
     }
     let quality = setting("quality") == "true";
+    // The shards wrote their own pages with `--html`: the merged set gets its own, of every run.
+    let html = setting("html") == "true";
+    let mut pages: Vec<PathBuf> = Vec::new();
     let written = if first.command == "sweep" {
         let points: Vec<(String, RunResult)> =
             results.into_iter().map(|(u, r, _)| (u, r)).collect();
-        let (table, _, stem) = crate::cli::sweep::write_summary(
+        let (table, figures, stem) = crate::cli::sweep::write_summary(
             &points,
             &setting("technique"),
             &scenes[0],
@@ -247,6 +251,18 @@ fn merge_shards(dirs: &[PathBuf], out: &Path) -> Result<()> {
             quality,
         )?;
         println!("{}", table.to_terminal());
+        if html {
+            let page = out.join(format!("{stem}.html"));
+            let runs = points.iter().map(|(_, r)| r.clone()).collect();
+            write_page(
+                &page,
+                table.title.clone(),
+                vec![table],
+                figures,
+                with_folder(out, runs),
+            )?;
+            pages.push(page);
+        }
         format!("{} points and {stem}.md/.csv/.tex/.svg", points.len())
     } else {
         // One summary per scene, as `run` writes them.
@@ -266,13 +282,24 @@ fn merge_shards(dirs: &[PathBuf], out: &Path) -> Result<()> {
             let (table, files) =
                 crate::cli::run::write_summary(&runs, &notes, out, scene, quality)?;
             println!("{}", table.to_terminal());
+            if html {
+                let page = out.join(format!("{scene}-report.html"));
+                let figures = (files.iter())
+                    .filter(|f| f.ends_with(".svg"))
+                    .map(|f| out.join(f))
+                    .collect();
+                let title = format!("gibench run on {scene} (merged from {count} shards)");
+                write_page(&page, title, vec![table], figures, with_folder(out, runs))?;
+                pages.push(page);
+            }
             all.extend(files);
         }
         format!("{} results and {}", results.len(), all.join(", "))
     };
     set.publish()?;
+    let page_lines: String = pages.iter().map(|p| page_line(p)).collect();
     eprintln!(
-        "merged {count} shards of `{}`: wrote {written} to {}",
+        "merged {count} shards of `{}`: wrote {written} to {}{page_lines}",
         first.command,
         out.display()
     );

@@ -433,6 +433,7 @@ pub(crate) fn settings(args: &RunArgs, plan: &Plan) -> BTreeMap<String, String> 
         ("shadow-size", c.shadow_size.to_string()),
         ("param", args.params.join(" ")),
         ("images", (!args.no_images).to_string()),
+        ("html", args.html.to_string()),
         ("quality", q.is_some().to_string()),
         (
             "quality-pairs",
