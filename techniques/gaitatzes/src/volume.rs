@@ -8,8 +8,9 @@
 //!   direct light (its shadow map). Writes: three per-axis slice atlases (its own), then the
 //!   voxel buffer, the first propagation buffer (the injected direct radiosity) and the
 //!   accumulation (cleared; plain LPV: the injected light).
-//! * [`Propagation`] — Reads: the voxel buffer. Writes: the propagation buffers (ping-pong) and
-//!   the accumulation.
+//! * [`Propagation`] — Reads: the voxel buffer. Writes: its senders buffer (its own: per cell
+//!   the open faces and the sums that normalise what it sends), the propagation buffers
+//!   (ping-pong) and the accumulation.
 //! * [`Reconstruction`] — Reads: the G-buffer, the voxel buffer, the accumulation. Writes: the
 //!   technique's indirect-irradiance output.
 
@@ -525,54 +526,95 @@ fn combine_pass(
     (combine, combine_group)
 }
 
-/// The propagation iterations (see the module docs).
+/// The propagation iterations (see the module docs). Each iteration is two dispatches
+/// (`propagate.wgsl`): `faces` writes, per cell, which of its faces pass light on and per
+/// channel the two sums that normalise what it sends through them (its own buffer, one
+/// `Sender` of [`CELL_BYTES`] per cell); `propagate` gathers from the six neighbours. The
+/// sender's work is thus done once per cell and iteration, not once per receiving neighbour.
 pub struct Propagation {
     n: u32,
-    pipeline: wgpu::ComputePipeline,
-    /// [a → b, b → a].
-    groups: [wgpu::BindGroup; 2],
+    faces: wgpu::ComputePipeline,
+    gather: wgpu::ComputePipeline,
+    /// Per iteration parity [a → b, b → a]: (faces, gather).
+    groups: [(wgpu::BindGroup, wgpu::BindGroup); 2],
+    _senders: wgpu::Buffer,
 }
 
 impl Propagation {
     pub fn new(gpu: &GpuContext, grid: &Grid, volumes: &Volumes) -> Result<Propagation> {
         let device = &gpu.device;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("propagation"),
+        // Same size as the grid's other buffers: checked by `Grid::check_limits`.
+        let senders = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("propagation senders"),
+            size: grid.cells() * CELL_BYTES,
+            usage: wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        });
+        let faces_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("propagation faces"),
             entries: &[
                 storage_entry(0, true),
                 storage_entry(1, true),
                 storage_entry(2, false),
-                storage_entry(3, false),
             ],
         });
-        let group = |from: usize| {
-            device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("propagation"),
-                layout: &layout,
+        let gather_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("propagation"),
+            entries: &[
+                storage_entry(3, true),
+                storage_entry(4, true),
+                storage_entry(5, false),
+                storage_entry(6, false),
+            ],
+        });
+        let groups = |from: usize| {
+            let faces = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("propagation faces"),
+                layout: &faces_layout,
                 entries: &[
                     bind_buffer(0, &volumes.voxels),
                     bind_buffer(1, &volumes.propagation[from]),
-                    bind_buffer(2, &volumes.propagation[1 - from]),
-                    bind_buffer(3, &volumes.accumulation),
+                    bind_buffer(2, &senders),
                 ],
-            })
+            });
+            let gather = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("propagation"),
+                layout: &gather_layout,
+                entries: &[
+                    bind_buffer(3, &senders),
+                    bind_buffer(4, &volumes.propagation[from]),
+                    bind_buffer(5, &volumes.propagation[1 - from]),
+                    bind_buffer(6, &volumes.accumulation),
+                ],
+            });
+            (faces, gather)
         };
-        let pipeline = compute_pipeline(
+        let source = format!(
+            "{}\n{}",
+            grid.wgsl(),
+            include_str!("shaders/propagate.wgsl")
+        );
+        let faces = compute_pipeline(
+            device,
+            "propagation faces",
+            &source,
+            &[&faces_layout],
+            "faces",
+        );
+        let gather = compute_pipeline(
             device,
             "propagation",
-            &format!(
-                "{}\n{}",
-                grid.wgsl(),
-                include_str!("shaders/propagate.wgsl")
-            ),
-            &[&layout],
+            &source,
+            &[&gather_layout],
             "propagate",
         );
         gpu.check_errors()?;
         Ok(Propagation {
             n: grid.n,
-            pipeline,
-            groups: [group(0), group(1)],
+            faces,
+            gather,
+            groups: [groups(0), groups(1)],
+            _senders: senders,
         })
     }
 
@@ -589,10 +631,14 @@ impl Propagation {
             label: Some("propagation"),
             timestamp_writes: None,
         });
-        pass.set_pipeline(&self.pipeline);
         let g = self.n.div_ceil(4);
         for k in from..from + iterations {
-            pass.set_bind_group(0, &self.groups[k as usize % 2], &[]);
+            let (faces, gather) = &self.groups[k as usize % 2];
+            pass.set_pipeline(&self.faces);
+            pass.set_bind_group(0, faces, &[]);
+            pass.dispatch_workgroups(g, g, g);
+            pass.set_pipeline(&self.gather);
+            pass.set_bind_group(0, gather, &[]);
             pass.dispatch_workgroups(g, g, g);
         }
     }

@@ -1,21 +1,46 @@
-// One propagation iteration (Gaitatzes et al. 2010 §4.2, Eq. 8): every cell gathers from its six
-// neighbours the radiance each sends through the shared face — the neighbour's SH integrated
-// over the face's 90-degree pyramid (SH dot product with the pyramid's coefficients; see
-// face_share) — and takes it as a clamped-cosine lobe of that flux along the direction of
-// travel (TRANSPORT 1: into void cells, with the neighbour's own angular distribution instead,
-// so a lobe keeps its direction; 2: with the distribution of the neighbour's light within the
-// face's pyramid). Void cells pass the gathered radiance on. Occupied cells
-// (MODE 0) add it to the accumulation as incident radiance and reflect it for the next bounce:
-// mirrored along the dominant axis of their normal (the paper's simplification of the rotation
-// to the normal), times the albedo (0.5, the paper's constant, or the voxel's), and send it on
-// through the faces on their lit side only (the side their normal's dominant axis points to:
-// radiance moves through void space, not through walls). Plain LPV
-// (MODE 1): no occupancy, no reflection; every cell accumulates what passes.
+// One propagation iteration (Gaitatzes et al. 2010 §4.2, Eq. 8), in two passes so that what
+// depends only on the sending cell is computed once per cell and iteration, not once for each
+// of its six receivers: `faces`, per cell, which of its faces pass light on and, per channel,
+// the two sums that normalise what it sends through them (see face_share); then `propagate`,
+// per cell, the gather from its six neighbours.
+//
+// Every cell gathers from its six neighbours the radiance each sends through the shared face —
+// the neighbour's SH integrated over the face's 90-degree pyramid (SH dot product with the
+// pyramid's coefficients; see face_share) — and takes it as a clamped-cosine lobe of that flux
+// along the direction of travel (TRANSPORT 1: into void cells, with the neighbour's own angular
+// distribution instead, so a lobe keeps its direction; 2: with the distribution of the
+// neighbour's light within the face's pyramid). Void cells pass the gathered radiance on.
+// Occupied cells (MODE 0) add it to the accumulation as incident radiance and reflect it for
+// the next bounce: mirrored along the dominant axis of their normal (the paper's
+// simplification of the rotation to the normal), times the albedo (0.5, the paper's constant,
+// or the voxel's), and send it on through the faces on their lit side only (the side their
+// normal's dominant axis points to: radiance moves through void space, not through walls).
+// Plain LPV (MODE 1): no occupancy, no reflection; every cell accumulates what passes.
 
+// What `faces` writes per cell and `propagate` reads (three vec4s: the size of an Sh3).
+struct Sender {
+    // rgb: per channel the radiance integral the cell passes on (0 where it or the open faces'
+    // positive integral is not positive: the cell sends nothing in that channel); w: the open
+    // faces (see passes) as a 6-bit mask, bit k for face k (see face_axis), as a float.
+    whole: vec4<f32>,
+    // rgb: per channel the sum of the open faces' positive integrals (1 where whole is 0); w:
+    // 0 for a void cell (always with MODE 1), 1 + the dominant axis of its normal for an
+    // occupied one.
+    positive: vec4<f32>,
+    // rgb: the voxel's albedo (written only with STORED_ALBEDO).
+    albedo: vec4<f32>,
+};
+
+// `faces`' bindings.
 @group(0) @binding(0) var<storage, read> voxels: array<Voxel>;
-@group(0) @binding(1) var<storage, read> source: array<Sh3>;
-@group(0) @binding(2) var<storage, read_write> destination: array<Sh3>;
-@group(0) @binding(3) var<storage, read_write> accumulation: array<Sh3>;
+@group(0) @binding(1) var<storage, read> face_source: array<Sh3>;
+@group(0) @binding(2) var<storage, read_write> senders_out: array<Sender>;
+
+// `propagate`'s bindings (the same group, other slots: each pipeline's layout has its own).
+@group(0) @binding(3) var<storage, read> senders: array<Sender>;
+@group(0) @binding(4) var<storage, read> source: array<Sh3>;
+@group(0) @binding(5) var<storage, read_write> destination: array<Sh3>;
+@group(0) @binding(6) var<storage, read_write> accumulation: array<Sh3>;
 
 // The SH with the l = 1 coefficient of axis `axis` (0 x, 1 y, 2 z) negated.
 fn mirror(c: vec4<f32>, axis: u32) -> vec4<f32> {
@@ -35,16 +60,20 @@ fn face_axis(k: u32) -> vec3<i32> {
     return d;
 }
 
-// Whether cell `j` passes light on through its face towards `d`. Void cells pass through
-// every face. Occupied cells (MODE 0) only into void neighbours (radiance moves through void
-// space, not along the inside of a wall) on the side their normal points to (a wall's back
-// passes nothing on). Faces at the grid's edge let light out.
-fn passes(j: vec3<i32>, d: vec3<i32>) -> bool {
-    if (MODE != 0u) {
-        return true;
+fn dominant_axis(n: vec3<f32>) -> u32 {
+    let a = abs(n);
+    if (a.x >= a.y && a.x >= a.z) {
+        return 0u;
     }
-    let v = voxels[cell_index(j)];
-    if (v.normal.w <= 0.0) {
+    return select(2u, 1u, a.y >= a.z);
+}
+
+// Whether cell `j`, whose voxel is `v`, passes light on through its face towards `d`. Void
+// cells pass through every face. Occupied cells (MODE 0) only into void neighbours (radiance
+// moves through void space, not along the inside of a wall) on the side their normal points
+// to (a wall's back passes nothing on). Faces at the grid's edge let light out.
+fn passes(j: vec3<i32>, v: Voxel, d: vec3<i32>) -> bool {
+    if (MODE != 0u || v.normal.w <= 0.0) {
         return true;
     }
     let axis = dominant_axis(v.normal.xyz);
@@ -55,30 +84,25 @@ fn passes(j: vec3<i32>, d: vec3<i32>) -> bool {
     return !in_grid(k) || voxels[cell_index(k)].normal.w <= 0.0;
 }
 
-// What a cell with radiance `c` (one channel) and open faces `open` sends through its face towards unit axis `d`:
-// the integral of c over that face's 90-degree pyramid. Negative integrals (SH ringing) and
-// faces the cell does not pass light through are dropped, and the rest rescaled so that the
-// faces together pass on exactly the cell's radiance integral (the six pyramids tile the
-// sphere): a void cell keeps its light, an occupied one sends all it emits or reflects into
-// the void in front of it.
-fn face_share(c: vec4<f32>, d: vec3<i32>, open: array<bool, 6>) -> f32 {
-    var positive = 0.0;
-    for (var k = 0u; k < 6u; k++) {
-        if (open[k]) {
-            positive += max(dot(c, sh_face(vec3<f32>(face_axis(k)))), 0.0);
-        }
-    }
-    // The whole integral: c0 times 4 pi Y00.
-    let whole = c.x * 4.0 * 3.14159265 * SH_C0;
-    if (positive <= 0.0 || whole <= 0.0) {
-        return 0.0;
-    }
+// The radiance integral of `c` (one channel): c0 times 4 pi Y00.
+fn whole_integral(c: vec4<f32>) -> f32 {
+    return c.x * 4.0 * 3.14159265 * SH_C0;
+}
+
+// What a cell with radiance `c` (one channel) sends through its open face towards unit axis
+// `d`, given its `whole` and `positive` sums from `faces`: the integral of c over that face's
+// 90-degree pyramid. Negative integrals (SH ringing) and faces the cell does not pass light
+// through are dropped (`positive` sums the open faces' positive integrals), and the rest
+// rescaled so that the faces together pass on exactly the cell's radiance integral (the six
+// pyramids tile the sphere): a void cell keeps its light, an occupied one sends all it emits
+// or reflects into the void in front of it.
+fn face_share(c: vec4<f32>, d: vec3<i32>, whole: f32, positive: f32) -> f32 {
     return max(dot(c, sh_face(vec3<f32>(d))), 0.0) * whole / positive;
 }
 
 // `c` rescaled to a radiance integral of 1 (0 when its integral is not positive).
 fn unit_integral(c: vec4<f32>) -> vec4<f32> {
-    let whole = c.x * 4.0 * 3.14159265 * SH_C0;
+    let whole = whole_integral(c);
     if (whole <= 0.0) {
         return vec4<f32>(0.0);
     }
@@ -96,36 +120,78 @@ fn through_face(c: vec4<f32>, d: vec3<f32>) -> vec4<f32> {
     return vec4<f32>(SH_C0 * flux, SH_C1 * m.y, SH_C1 * m.z, SH_C1 * m.x) / flux;
 }
 
-fn dominant_axis(n: vec3<f32>) -> u32 {
-    let a = abs(n);
-    if (a.x >= a.y && a.x >= a.z) {
-        return 0u;
+// One channel's (whole, positive) of a cell with radiance `c` and open faces `open`:
+// (0, 1) where either sum is not positive.
+fn sums(c: vec4<f32>, open: array<bool, 6>) -> vec2<f32> {
+    var positive = 0.0;
+    for (var k = 0u; k < 6u; k++) {
+        if (open[k]) {
+            positive += max(dot(c, sh_face(vec3<f32>(face_axis(k)))), 0.0);
+        }
     }
-    return select(2u, 1u, a.y >= a.z);
+    let whole = whole_integral(c);
+    if (positive <= 0.0 || whole <= 0.0) {
+        return vec2<f32>(0.0, 1.0);
+    }
+    return vec2<f32>(whole, positive);
 }
 
+// Per cell: its open faces and the sums that normalise what it sends through them.
+@compute @workgroup_size(4, 4, 4)
+fn faces(@builtin(global_invocation_id) id: vec3<u32>) {
+    if (any(id >= vec3<u32>(N))) {
+        return;
+    }
+    let j = vec3<i32>(id);
+    let i = cell_index(j);
+    let v = voxels[i];
+    var open: array<bool, 6>;
+    var mask = 0u;
+    for (var f = 0u; f < 6u; f++) {
+        open[f] = passes(j, v, face_axis(f));
+        mask |= select(0u, 1u << f, open[f]);
+    }
+    let s = face_source[i];
+    let r = sums(s.r, open);
+    let g = sums(s.g, open);
+    let b = sums(s.b, open);
+    var occupied = 0.0;
+    if (MODE == 0u && v.normal.w > 0.0) {
+        occupied = 1.0 + f32(dominant_axis(v.normal.xyz));
+    }
+    senders_out[i].whole = vec4<f32>(r.x, g.x, b.x, f32(mask));
+    senders_out[i].positive = vec4<f32>(r.y, g.y, b.y, occupied);
+    if (STORED_ALBEDO == 1u) {
+        senders_out[i].albedo = v.albedo;
+    }
+}
+
+// Per cell: the gather from its six neighbours, the accumulation and the reflection.
 @compute @workgroup_size(4, 4, 4)
 fn propagate(@builtin(global_invocation_id) id: vec3<u32>) {
     if (any(id >= vec3<u32>(N))) {
         return;
     }
     let c = vec3<i32>(id);
-    let here = voxels[cell_index(c)];
     var g = Sh3(vec4<f32>(0.0), vec4<f32>(0.0), vec4<f32>(0.0));
     var carried = g;
     for (var k = 0u; k < 6u; k++) {
         // The direction the light travels from the neighbour into this cell.
         let d = face_axis(k);
         let j = c - d;
-        if (!in_grid(j) || !passes(j, d)) {
+        if (!in_grid(j)) {
             continue;
         }
-        var open: array<bool, 6>;
-        for (var f = 0u; f < 6u; f++) {
-            open[f] = passes(j, face_axis(f));
+        let sender = senders[cell_index(j)];
+        if ((u32(sender.whole.w) & (1u << k)) == 0u) {
+            continue;
         }
         let s = source[cell_index(j)];
-        let share = vec3<f32>(face_share(s.r, d, open), face_share(s.g, d, open), face_share(s.b, d, open));
+        let share = vec3<f32>(
+            face_share(s.r, d, sender.whole.r, sender.positive.r),
+            face_share(s.g, d, sender.whole.g, sender.positive.g),
+            face_share(s.b, d, sender.whole.b, sender.positive.b)
+        );
         let lobe = sh_cosine_unit(vec3<f32>(d));
         g.r += share.r * lobe;
         g.g += share.g * lobe;
@@ -145,17 +211,18 @@ fn propagate(@builtin(global_invocation_id) id: vec3<u32>) {
         }
     }
     let i = cell_index(c);
-    let v = here;
-    if (TRANSPORT != 0u && !(MODE == 0u && v.normal.w > 0.0)) {
+    let here = senders[i];
+    let occupied = here.positive.w > 0.0;
+    if (TRANSPORT != 0u && !occupied) {
         g = carried;
     }
-    if (MODE == 0u && v.normal.w > 0.0) {
+    if (occupied) {
         let a = accumulation[i];
         accumulation[i] = Sh3(a.r + g.r, a.g + g.g, a.b + g.b);
-        let axis = dominant_axis(v.normal.xyz);
+        let axis = u32(here.positive.w) - 1u;
         var rho = vec3<f32>(0.5);
         if (STORED_ALBEDO == 1u) {
-            rho = v.albedo.rgb;
+            rho = here.albedo.rgb;
         }
         destination[i] = Sh3(rho.r * mirror(g.r, axis), rho.g * mirror(g.g, axis), rho.b * mirror(g.b, axis));
     } else {
