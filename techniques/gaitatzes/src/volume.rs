@@ -8,9 +8,9 @@
 //!   direct light (its shadow map). Writes: three per-axis slice atlases (its own), then the
 //!   voxel buffer, the first propagation buffer (the injected direct radiosity) and the
 //!   accumulation (cleared; plain LPV: the injected light).
-//! * [`Propagation`] — Reads: the voxel buffer. Writes: its senders buffer (its own: per cell
-//!   the open faces and the sums that normalise what it sends), the propagation buffers
-//!   (ping-pong) and the accumulation.
+//! * [`Propagation`] — Reads: the voxel buffer. Writes: its two senders buffers (its own: per
+//!   cell the flux it sends through each face), the propagation buffers (ping-pong) and the
+//!   accumulation.
 //! * [`Reconstruction`] — Reads: the G-buffer, the voxel buffer, the accumulation. Writes: the
 //!   technique's indirect-irradiance output.
 
@@ -100,7 +100,8 @@ pub struct Grid {
     pub transport: Transport,
 }
 
-/// Bytes of one cell of the voxel buffer (`Voxel`) and of an SH buffer (`Sh3`).
+/// Bytes of one cell of the voxel buffer (`Voxel`), of an SH buffer (`Sh3`) and of each of the
+/// propagation's two senders buffers (`Sender`: the flux through three of its faces).
 pub const CELL_BYTES: u64 = 48;
 
 impl Grid {
@@ -527,45 +528,69 @@ fn combine_pass(
 }
 
 /// The propagation iterations (see the module docs). Each iteration is two dispatches
-/// (`propagate.wgsl`): `faces` writes, per cell, which of its faces pass light on and per
-/// channel the two sums that normalise what it sends through them (its own buffer, one
-/// `Sender` of [`CELL_BYTES`] per cell); `propagate` gathers from the six neighbours. The
-/// sender's work is thus done once per cell and iteration, not once per receiving neighbour.
+/// (`propagate.wgsl`): `faces` writes, per cell, the flux it sends through each of its six
+/// faces (its own two buffers, [`CELL_BYTES`] per cell each); `propagate` gathers from the six
+/// neighbours. The sender's work (its occupancy, open faces, face integrals and their
+/// normalisation) is thus done once per cell and iteration, not once per receiving neighbour.
 pub struct Propagation {
     n: u32,
     faces: wgpu::ComputePipeline,
     gather: wgpu::ComputePipeline,
     /// Per iteration parity [a → b, b → a]: (faces, gather).
     groups: [(wgpu::BindGroup, wgpu::BindGroup); 2],
-    _senders: wgpu::Buffer,
+    _senders: [wgpu::Buffer; 2],
 }
 
 impl Propagation {
     pub fn new(gpu: &GpuContext, grid: &Grid, volumes: &Volumes) -> Result<Propagation> {
         let device = &gpu.device;
-        // Same size as the grid's other buffers: checked by `Grid::check_limits`.
-        let senders = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("propagation senders"),
-            size: grid.cells() * CELL_BYTES,
-            usage: wgpu::BufferUsages::STORAGE,
-            mapped_at_creation: false,
-        });
+        // With `transport=carry` or `pyramid` the gather also reads the senders' SH: a fifth
+        // storage buffer (the downlevel limit is four).
+        let carries = grid.transport != Transport::Cosine;
+        let have = device.limits().max_storage_buffers_per_shader_stage;
+        if carries && have < 5 {
+            return Err(Error::param(
+                "transport",
+                format!(
+                    "transport={} needs 5 storage buffers per shader stage; this adapter allows {have} (transport=cosine needs 4)",
+                    grid.transport.name()
+                ),
+            ));
+        }
+        // Their size (that of an SH buffer) is checked by `Grid::check_limits`.
+        let sender = |label: &str| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: grid.cells() * CELL_BYTES,
+                usage: wgpu::BufferUsages::STORAGE,
+                mapped_at_creation: false,
+            })
+        };
+        let senders = [
+            sender("propagation senders +"),
+            sender("propagation senders -"),
+        ];
         let faces_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("propagation faces"),
             entries: &[
                 storage_entry(0, true),
                 storage_entry(1, true),
                 storage_entry(2, false),
+                storage_entry(3, false),
             ],
         });
+        let mut gather_entries = vec![
+            storage_entry(4, true),
+            storage_entry(5, true),
+            storage_entry(6, false),
+            storage_entry(7, false),
+        ];
+        if carries {
+            gather_entries.push(storage_entry(8, true));
+        }
         let gather_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("propagation"),
-            entries: &[
-                storage_entry(3, true),
-                storage_entry(4, true),
-                storage_entry(5, false),
-                storage_entry(6, false),
-            ],
+            entries: &gather_entries,
         });
         let groups = |from: usize| {
             let faces = device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -574,23 +599,36 @@ impl Propagation {
                 entries: &[
                     bind_buffer(0, &volumes.voxels),
                     bind_buffer(1, &volumes.propagation[from]),
-                    bind_buffer(2, &senders),
+                    bind_buffer(2, &senders[0]),
+                    bind_buffer(3, &senders[1]),
                 ],
             });
+            let mut entries = vec![
+                bind_buffer(4, &senders[0]),
+                bind_buffer(5, &senders[1]),
+                bind_buffer(6, &volumes.propagation[1 - from]),
+                bind_buffer(7, &volumes.accumulation),
+            ];
+            if carries {
+                entries.push(bind_buffer(8, &volumes.propagation[from]));
+            }
             let gather = device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("propagation"),
                 layout: &gather_layout,
-                entries: &[
-                    bind_buffer(3, &senders),
-                    bind_buffer(4, &volumes.propagation[from]),
-                    bind_buffer(5, &volumes.propagation[1 - from]),
-                    bind_buffer(6, &volumes.accumulation),
-                ],
+                entries: &entries,
             });
             (faces, gather)
         };
+        // The senders' SH, read by the gather with `transport=carry` and `pyramid` only (with
+        // `cosine` the binding is left out of the shader and its layout).
+        let sender_sh = if carries {
+            "@group(0) @binding(8) var<storage, read> source: array<Sh3>;\n\
+             fn sender_sh(i: u32) -> Sh3 { return source[i]; }"
+        } else {
+            "fn sender_sh(i: u32) -> Sh3 { return Sh3(vec4<f32>(0.0), vec4<f32>(0.0), vec4<f32>(0.0)); }"
+        };
         let source = format!(
-            "{}\n{}",
+            "{}\n{sender_sh}\n{}",
             grid.wgsl(),
             include_str!("shaders/propagate.wgsl")
         );

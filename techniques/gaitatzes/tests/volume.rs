@@ -1,6 +1,7 @@
 //! The voxel passes of `gaitatzes` on the GPU, on every portable backend present: one lit voxel
 //! in an empty grid propagates symmetrically and loses no more than a stated fraction of its
-//! energy per iteration (and never gains); an occupied wall blocks propagation; voxelizing a
+//! energy per iteration (and never gains); an occupied wall blocks propagation; iterations in
+//! one pass match iterations one at a time, and reflect with the albedo; voxelizing a
 //! tilted triangle leaves no hole along any axis and marks no voxel the triangle's plane misses.
 
 use gibench_gaitatzes::sh;
@@ -53,7 +54,21 @@ fn propagate(
     lobe: [f32; 4],
     iterations: u32,
 ) -> (Vec<Vec<f32>>, Vec<f32>) {
-    let g = grid(mode);
+    propagate_in(gpu, &grid(mode), voxels, source, lobe, iterations, false)
+}
+
+/// [`propagate`] in grid `g`; with `one_pass`, the iterations are encoded at once (one compute
+/// pass, as a frame does) and only the last field is returned.
+fn propagate_in(
+    gpu: &GpuContext,
+    g: &Grid,
+    voxels: &[f32],
+    source: (u32, u32, u32),
+    lobe: [f32; 4],
+    iterations: u32,
+    one_pass: bool,
+) -> (Vec<Vec<f32>>, Vec<f32>) {
+    let g = *g;
     let volumes = Volumes::new(gpu, &g).unwrap();
     let propagation = Propagation::new(gpu, &g, &volumes).unwrap();
     let mut field = vec![0f32; N.pow(3) as usize * CELL];
@@ -69,6 +84,15 @@ fn propagate(
         bytemuck::cast_slice(&vec![0f32; field.len()]),
     );
     let mut fields = Vec::new();
+    if one_pass {
+        gpu.queue
+            .write_buffer(&volumes.propagation[0], 0, bytemuck::cast_slice(&field));
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        propagation.encode(&mut enc, iterations);
+        gpu.queue.submit([enc.finish()]);
+        fields.push(read_f32(gpu, &volumes.propagation[iterations as usize % 2]));
+        return (fields, read_f32(gpu, &volumes.accumulation));
+    }
     for k in 0..iterations {
         gpu.queue
             .write_buffer(&volumes.propagation[0], 0, bytemuck::cast_slice(&field));
@@ -226,6 +250,47 @@ fn an_occluding_wall_blocks_propagation() {
             .map(|i| accumulated[index(10, i % N, i / N) * CELL])
             .sum();
         assert!(on_wall > 0.0, "{backend}: nothing accumulated on the wall");
+    }
+}
+
+/// A wall (as in [`an_occluding_wall_blocks_propagation`]) of albedo (0.2, 0.5, 0.8), with the
+/// voxels' albedo for the bounces (`albedo=stored`): 8 iterations encoded in one compute pass
+/// give exactly (bit for bit: the same shaders on the same data) the field and accumulation of
+/// 8 iterations encoded one at a time. Catches an iteration that gathers what the cells sent in
+/// an earlier iteration (the per-face fluxes not recomputed from each iteration's field, or
+/// computed from the other ping-pong buffer). And the light the wall reflects in the first
+/// iteration that reaches it (the same in every channel before) is scaled by each channel's
+/// albedo (to 10⁻⁵): catches the albedo read from the wrong place or channel.
+#[test]
+fn iterations_in_one_pass_match_one_at_a_time_and_reflect_with_the_albedo() {
+    let rho = [0.2f32, 0.5, 0.8];
+    let mut voxels = wall_voxels(Some(10));
+    for c in voxels.chunks_mut(CELL).filter(|c| c[3] > 0.0) {
+        c[4..7].copy_from_slice(&rho);
+    }
+    let g = Grid {
+        stored_albedo: true,
+        ..grid(Mode::Occluded)
+    };
+    let iso = [1.0, 0.0, 0.0, 0.0];
+    for (backend, gpu) in gpus("volume") {
+        let (steps, accumulated) = propagate_in(&gpu, &g, &voxels, (5, 8, 8), iso, 8, false);
+        let (once, accumulated_once) = propagate_in(&gpu, &g, &voxels, (5, 8, 8), iso, 8, true);
+        assert!(
+            steps[7] == once[0] && accumulated == accumulated_once,
+            "{backend}: 8 iterations in one pass differ from 8 one at a time"
+        );
+        // The source is 5 cells from the wall: the light reaches it in the 5th iteration.
+        let wall = &steps[4][index(10, 8, 8) * CELL..][..CELL];
+        assert!(wall[0] > 0.0, "{backend}: nothing reflected at the wall");
+        for c in 1..3 {
+            let ratio = wall[4 * c] / wall[0];
+            let expected = rho[c] / rho[0];
+            assert!(
+                (ratio - expected).abs() <= 1e-5 * expected,
+                "{backend}: channel {c} reflected {ratio} × red, expected {expected}"
+            );
+        }
     }
 }
 

@@ -1,8 +1,7 @@
 // One propagation iteration (Gaitatzes et al. 2010 §4.2, Eq. 8), in two passes so that what
 // depends only on the sending cell is computed once per cell and iteration, not once for each
-// of its six receivers: `faces`, per cell, which of its faces pass light on and, per channel,
-// the two sums that normalise what it sends through them (see face_share); then `propagate`,
-// per cell, the gather from its six neighbours.
+// of its six receivers: `faces`, per cell, the flux it sends through each of its six faces;
+// then `propagate`, per cell, the gather of what its six neighbours send it.
 //
 // Every cell gathers from its six neighbours the radiance each sends through the shared face —
 // the neighbour's SH integrated over the face's 90-degree pyramid (SH dot product with the
@@ -17,30 +16,46 @@
 // normal's dominant axis points to: radiance moves through void space, not through walls).
 // Plain LPV (MODE 1): no occupancy, no reflection; every cell accumulates what passes.
 
-// What `faces` writes per cell and `propagate` reads (three vec4s: the size of an Sh3).
+// What `faces` writes per cell and `propagate` reads, in two buffers (each the size of an SH
+// buffer, so that the grid's largest fits the same limit): per face k (see face_axis), in
+// rgb, the flux the cell sends through it per channel (0 through a face it does not pass light
+// through); faces 0, 2, 4 (+x, +y, +z) in `senders_pos`, 1, 3, 5 in `senders_neg`. The w
+// components, in face order: face 0, 0 for a void cell (always with MODE 1) and 1 + the
+// dominant axis of its normal for an occupied one; faces 1-3, the voxel's albedo (written only
+// with STORED_ALBEDO).
 struct Sender {
-    // rgb: per channel the radiance integral the cell passes on (0 where it or the open faces'
-    // positive integral is not positive: the cell sends nothing in that channel); w: the open
-    // faces (see passes) as a 6-bit mask, bit k for face k (see face_axis), as a float.
-    whole: vec4<f32>,
-    // rgb: per channel the sum of the open faces' positive integrals (1 where whole is 0); w:
-    // 0 for a void cell (always with MODE 1), 1 + the dominant axis of its normal for an
-    // occupied one.
-    positive: vec4<f32>,
-    // rgb: the voxel's albedo (written only with STORED_ALBEDO).
-    albedo: vec4<f32>,
+    face: array<vec4<f32>, 3>,
 };
 
 // `faces`' bindings.
 @group(0) @binding(0) var<storage, read> voxels: array<Voxel>;
 @group(0) @binding(1) var<storage, read> face_source: array<Sh3>;
-@group(0) @binding(2) var<storage, read_write> senders_out: array<Sender>;
+@group(0) @binding(2) var<storage, read_write> senders_pos_out: array<Sender>;
+@group(0) @binding(3) var<storage, read_write> senders_neg_out: array<Sender>;
 
-// `propagate`'s bindings (the same group, other slots: each pipeline's layout has its own).
-@group(0) @binding(3) var<storage, read> senders: array<Sender>;
-@group(0) @binding(4) var<storage, read> source: array<Sh3>;
-@group(0) @binding(5) var<storage, read_write> destination: array<Sh3>;
-@group(0) @binding(6) var<storage, read_write> accumulation: array<Sh3>;
+// `propagate`'s bindings (the same group, other slots: each pipeline's layout has its own;
+// with TRANSPORT 1 and 2 also `source`, binding 8, prepended by the pass with sender_sh).
+@group(0) @binding(4) var<storage, read> senders_pos: array<Sender>;
+@group(0) @binding(5) var<storage, read> senders_neg: array<Sender>;
+@group(0) @binding(6) var<storage, read_write> destination: array<Sh3>;
+@group(0) @binding(7) var<storage, read_write> accumulation: array<Sh3>;
+
+// Writes face k's vec4 of cell i.
+fn send(i: u32, k: u32, v: vec4<f32>) {
+    if ((k & 1u) == 0u) {
+        senders_pos_out[i].face[k / 2u] = v;
+    } else {
+        senders_neg_out[i].face[k / 2u] = v;
+    }
+}
+
+// Face k's vec4 of cell i.
+fn sent(i: u32, k: u32) -> vec4<f32> {
+    if ((k & 1u) == 0u) {
+        return senders_pos[i].face[k / 2u];
+    }
+    return senders_neg[i].face[k / 2u];
+}
 
 // The SH with the l = 1 coefficient of axis `axis` (0 x, 1 y, 2 z) negated.
 fn mirror(c: vec4<f32>, axis: u32) -> vec4<f32> {
@@ -136,7 +151,7 @@ fn sums(c: vec4<f32>, open: array<bool, 6>) -> vec2<f32> {
     return vec2<f32>(whole, positive);
 }
 
-// Per cell: its open faces and the sums that normalise what it sends through them.
+// Per cell: the flux it sends through each face.
 @compute @workgroup_size(4, 4, 4)
 fn faces(@builtin(global_invocation_id) id: vec3<u32>) {
     if (any(id >= vec3<u32>(N))) {
@@ -146,23 +161,29 @@ fn faces(@builtin(global_invocation_id) id: vec3<u32>) {
     let i = cell_index(j);
     let v = voxels[i];
     var open: array<bool, 6>;
-    var mask = 0u;
     for (var f = 0u; f < 6u; f++) {
         open[f] = passes(j, v, face_axis(f));
-        mask |= select(0u, 1u << f, open[f]);
     }
     let s = face_source[i];
     let r = sums(s.r, open);
     let g = sums(s.g, open);
     let b = sums(s.b, open);
-    var occupied = 0.0;
+    var w = array<f32, 6>(0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
     if (MODE == 0u && v.normal.w > 0.0) {
-        occupied = 1.0 + f32(dominant_axis(v.normal.xyz));
+        w[0] = 1.0 + f32(dominant_axis(v.normal.xyz));
     }
-    senders_out[i].whole = vec4<f32>(r.x, g.x, b.x, f32(mask));
-    senders_out[i].positive = vec4<f32>(r.y, g.y, b.y, occupied);
     if (STORED_ALBEDO == 1u) {
-        senders_out[i].albedo = v.albedo;
+        w[1] = v.albedo.r;
+        w[2] = v.albedo.g;
+        w[3] = v.albedo.b;
+    }
+    for (var k = 0u; k < 6u; k++) {
+        var share = vec3<f32>(0.0);
+        if (open[k]) {
+            let d = face_axis(k);
+            share = vec3<f32>(face_share(s.r, d, r.x, r.y), face_share(s.g, d, g.x, g.y), face_share(s.b, d, b.x, b.y));
+        }
+        send(i, k, vec4<f32>(share, w[k]));
     }
 }
 
@@ -182,47 +203,43 @@ fn propagate(@builtin(global_invocation_id) id: vec3<u32>) {
         if (!in_grid(j)) {
             continue;
         }
-        let sender = senders[cell_index(j)];
-        if ((u32(sender.whole.w) & (1u << k)) == 0u) {
-            continue;
-        }
-        let s = source[cell_index(j)];
-        let share = vec3<f32>(
-            face_share(s.r, d, sender.whole.r, sender.positive.r),
-            face_share(s.g, d, sender.whole.g, sender.positive.g),
-            face_share(s.b, d, sender.whole.b, sender.positive.b)
-        );
+        // 0 where the neighbour does not pass light through this face: adding it changes
+        // nothing.
+        let share = sent(cell_index(j), k).xyz;
         let lobe = sh_cosine_unit(vec3<f32>(d));
         g.r += share.r * lobe;
         g.g += share.g * lobe;
         g.b += share.b * lobe;
-        if (TRANSPORT == 1u) {
-            // The flux with the sender's angular distribution (its SH over its integral).
-            carried.r += share.r * unit_integral(s.r);
-            carried.g += share.g * unit_integral(s.g);
-            carried.b += share.b * unit_integral(s.b);
-        } else if (TRANSPORT == 2u) {
-            // The flux with the distribution of what crossed the face (the sender's SH over
-            // the face's pyramid, re-projected).
-            let df = vec3<f32>(d);
-            carried.r += share.r * through_face(s.r, df);
-            carried.g += share.g * through_face(s.g, df);
-            carried.b += share.b * through_face(s.b, df);
+        if (TRANSPORT != 0u && any(share != vec3<f32>(0.0))) {
+            let s = sender_sh(cell_index(j));
+            if (TRANSPORT == 1u) {
+                // The flux with the sender's angular distribution (its SH over its integral).
+                carried.r += share.r * unit_integral(s.r);
+                carried.g += share.g * unit_integral(s.g);
+                carried.b += share.b * unit_integral(s.b);
+            } else {
+                // The flux with the distribution of what crossed the face (the sender's SH
+                // over the face's pyramid, re-projected).
+                let df = vec3<f32>(d);
+                carried.r += share.r * through_face(s.r, df);
+                carried.g += share.g * through_face(s.g, df);
+                carried.b += share.b * through_face(s.b, df);
+            }
         }
     }
     let i = cell_index(c);
-    let here = senders[i];
-    let occupied = here.positive.w > 0.0;
+    let code = sent(i, 0u).w;
+    let occupied = code > 0.0;
     if (TRANSPORT != 0u && !occupied) {
         g = carried;
     }
     if (occupied) {
         let a = accumulation[i];
         accumulation[i] = Sh3(a.r + g.r, a.g + g.g, a.b + g.b);
-        let axis = u32(here.positive.w) - 1u;
+        let axis = u32(code) - 1u;
         var rho = vec3<f32>(0.5);
         if (STORED_ALBEDO == 1u) {
-            rho = here.albedo.rgb;
+            rho = vec3<f32>(sent(i, 1u).w, sent(i, 2u).w, sent(i, 3u).w);
         }
         destination[i] = Sh3(rho.r * mirror(g.r, axis), rho.g * mirror(g.g, axis), rho.b * mirror(g.b, axis));
     } else {
