@@ -5,7 +5,7 @@
 //
 // Every cell gathers from its six neighbours the radiance each sends through the shared face —
 // the neighbour's SH integrated over the face's 90-degree pyramid (SH dot product with the
-// pyramid's coefficients; see face_share) — and takes it as a clamped-cosine lobe of that flux
+// pyramid's coefficients; see face_shares) — and takes it as a clamped-cosine lobe of that flux
 // along the direction of travel (TRANSPORT 1: into void cells, with the neighbour's own angular
 // distribution instead, so a lobe keeps its direction; 2: with the distribution of the
 // neighbour's light within the face's pyramid). Void cells pass the gathered radiance on.
@@ -40,12 +40,25 @@ struct Sender {
 @group(0) @binding(6) var<storage, read_write> destination: array<Sh3>;
 @group(0) @binding(7) var<storage, read_write> accumulation: array<Sh3>;
 
-// Writes face k's vec4 of cell i.
-fn send(i: u32, k: u32, v: vec4<f32>) {
+// Writes the flux through face k of cell i (the w component is left as it is).
+fn send(i: u32, k: u32, v: vec3<f32>) {
     if ((k & 1u) == 0u) {
-        senders_pos_out[i].face[k / 2u] = v;
+        senders_pos_out[i].face[k / 2u].x = v.x;
+        senders_pos_out[i].face[k / 2u].y = v.y;
+        senders_pos_out[i].face[k / 2u].z = v.z;
     } else {
-        senders_neg_out[i].face[k / 2u] = v;
+        senders_neg_out[i].face[k / 2u].x = v.x;
+        senders_neg_out[i].face[k / 2u].y = v.y;
+        senders_neg_out[i].face[k / 2u].z = v.z;
+    }
+}
+
+// Writes the w component of face k of cell i.
+fn send_w(i: u32, k: u32, w: f32) {
+    if ((k & 1u) == 0u) {
+        senders_pos_out[i].face[k / 2u].w = w;
+    } else {
+        senders_neg_out[i].face[k / 2u].w = w;
     }
 }
 
@@ -104,15 +117,32 @@ fn whole_integral(c: vec4<f32>) -> f32 {
     return c.x * 4.0 * 3.14159265 * SH_C0;
 }
 
-// What a cell with radiance `c` (one channel) sends through its open face towards unit axis
-// `d`, given its `whole` and `positive` sums from `faces`: the integral of c over that face's
-// 90-degree pyramid. Negative integrals (SH ringing) and faces the cell does not pass light
-// through are dropped (`positive` sums the open faces' positive integrals), and the rest
-// rescaled so that the faces together pass on exactly the cell's radiance integral (the six
-// pyramids tile the sphere): a void cell keeps its light, an occupied one sends all it emits
-// or reflects into the void in front of it.
-fn face_share(c: vec4<f32>, d: vec3<i32>, whole: f32, positive: f32) -> f32 {
-    return max(dot(c, sh_face(vec3<f32>(d))), 0.0) * whole / positive;
+// What a cell with radiance `c` (one channel) and open faces `open` sends through each face:
+// the integral of c over that face's 90-degree pyramid (SH dot product with the pyramid's
+// coefficients). Negative integrals (SH ringing) and faces the cell does not pass light
+// through are dropped, and the rest rescaled so that the faces together pass on exactly the
+// cell's radiance integral (the six pyramids tile the sphere): a void cell keeps its light,
+// an occupied one sends all it emits or reflects into the void in front of it.
+fn face_shares(c: vec4<f32>, open: array<bool, 6>) -> array<f32, 6> {
+    var integral: array<f32, 6>;
+    var positive = 0.0;
+    for (var k = 0u; k < 6u; k++) {
+        integral[k] = max(dot(c, sh_face(vec3<f32>(face_axis(k)))), 0.0);
+        if (open[k]) {
+            positive += integral[k];
+        }
+    }
+    let whole = whole_integral(c);
+    var share = array<f32, 6>(0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+    if (positive <= 0.0 || whole <= 0.0) {
+        return share;
+    }
+    for (var k = 0u; k < 6u; k++) {
+        if (open[k]) {
+            share[k] = integral[k] * whole / positive;
+        }
+    }
+    return share;
 }
 
 // `c` rescaled to a radiance integral of 1 (0 when its integral is not positive).
@@ -135,22 +165,6 @@ fn through_face(c: vec4<f32>, d: vec3<f32>) -> vec4<f32> {
     return vec4<f32>(SH_C0 * flux, SH_C1 * m.y, SH_C1 * m.z, SH_C1 * m.x) / flux;
 }
 
-// One channel's (whole, positive) of a cell with radiance `c` and open faces `open`:
-// (0, 1) where either sum is not positive.
-fn sums(c: vec4<f32>, open: array<bool, 6>) -> vec2<f32> {
-    var positive = 0.0;
-    for (var k = 0u; k < 6u; k++) {
-        if (open[k]) {
-            positive += max(dot(c, sh_face(vec3<f32>(face_axis(k)))), 0.0);
-        }
-    }
-    let whole = whole_integral(c);
-    if (positive <= 0.0 || whole <= 0.0) {
-        return vec2<f32>(0.0, 1.0);
-    }
-    return vec2<f32>(whole, positive);
-}
-
 // Per cell: the flux it sends through each face.
 @compute @workgroup_size(4, 4, 4)
 fn faces(@builtin(global_invocation_id) id: vec3<u32>) {
@@ -165,25 +179,21 @@ fn faces(@builtin(global_invocation_id) id: vec3<u32>) {
         open[f] = passes(j, v, face_axis(f));
     }
     let s = face_source[i];
-    let r = sums(s.r, open);
-    let g = sums(s.g, open);
-    let b = sums(s.b, open);
-    var w = array<f32, 6>(0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+    let r = face_shares(s.r, open);
+    let g = face_shares(s.g, open);
+    let b = face_shares(s.b, open);
+    for (var k = 0u; k < 6u; k++) {
+        send(i, k, vec3<f32>(r[k], g[k], b[k]));
+    }
     if (MODE == 0u && v.normal.w > 0.0) {
-        w[0] = 1.0 + f32(dominant_axis(v.normal.xyz));
+        send_w(i, 0u, 1.0 + f32(dominant_axis(v.normal.xyz)));
+    } else {
+        send_w(i, 0u, 0.0);
     }
     if (STORED_ALBEDO == 1u) {
-        w[1] = v.albedo.r;
-        w[2] = v.albedo.g;
-        w[3] = v.albedo.b;
-    }
-    for (var k = 0u; k < 6u; k++) {
-        var share = vec3<f32>(0.0);
-        if (open[k]) {
-            let d = face_axis(k);
-            share = vec3<f32>(face_share(s.r, d, r.x, r.y), face_share(s.g, d, g.x, g.y), face_share(s.b, d, b.x, b.y));
-        }
-        send(i, k, vec4<f32>(share, w[k]));
+        send_w(i, 1u, v.albedo.r);
+        send_w(i, 2u, v.albedo.g);
+        send_w(i, 3u, v.albedo.b);
     }
 }
 
