@@ -165,8 +165,8 @@ fn through_face(c: vec4<f32>, d: vec3<f32>) -> vec4<f32> {
     return vec4<f32>(SH_C0 * flux, SH_C1 * m.y, SH_C1 * m.z, SH_C1 * m.x) / flux;
 }
 
-// Per cell: the flux it sends through each face.
-@compute @workgroup_size(4, 4, 4)
+// Per cell: the flux it sends through each face. Workgroups of 8x8x4 cells: Propagation::WORKGROUP.
+@compute @workgroup_size(8, 8, 4)
 fn faces(@builtin(global_invocation_id) id: vec3<u32>) {
     if (any(id >= vec3<u32>(N))) {
         return;
@@ -198,7 +198,7 @@ fn faces(@builtin(global_invocation_id) id: vec3<u32>) {
 }
 
 // Per cell: the gather from its six neighbours, the accumulation and the reflection.
-@compute @workgroup_size(4, 4, 4)
+@compute @workgroup_size(8, 8, 4)
 fn propagate(@builtin(global_invocation_id) id: vec3<u32>) {
     if (any(id >= vec3<u32>(N))) {
         return;
