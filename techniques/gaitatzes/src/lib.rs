@@ -11,7 +11,9 @@
 //!    gathers from its six neighbours what each sends through the shared face (the SH integral
 //!    over the face's 90° pyramid); void cells pass the radiance on, occupied cells accumulate
 //!    it and reflect it (mirrored along the dominant axis of their normal, times 0.5 — the
-//!    paper's constant — or the voxel's albedo): secondary bounces.
+//!    paper's constant — or the voxel's albedo): secondary bounces. Each iteration is two
+//!    dispatches with the same result as the paper's one gather: every cell's flux through
+//!    each of its faces, computed once, then the gather of the six fluxes that arrive.
 //! 3. **Reconstruction** (§4.3, Eq. 11–12; [`volume::Reconstruction`]): per pixel, the
 //!    accumulated radiance interpolated from the occupied ones of the eight nearest cells, and
 //!    the irradiance as its SH dot product with the clamped cosine about the normal, times the
@@ -45,7 +47,9 @@
 //! is taken to hold one cell face of surface (injected radiance B/π per unit cosine);
 //! `transport=carry` and `transport=pyramid` are ours.
 //!
-//! Needs: compute shaders and storage buffers (Vulkan, GL ES 3.1); no optional features.
+//! Needs: compute shaders and storage buffers (Vulkan, GL ES 3.1); no optional features. Four
+//! storage buffers per shader stage, five with `transport=carry` or `pyramid` (checked when the
+//! technique is created).
 
 mod params;
 pub mod sh;
