@@ -30,14 +30,35 @@ How:
   4. gibench's JSON sidecar gives `seconds`, the wall time of its render call, and
      `bvh_build_seconds`, that of its BVH build; their difference against Mitsuba's render
      wall time gives a tracing wall-clock ratio; the primary number stays the CPU one.
+  5. Per ray traced, beside per sample: trace-CPU rays per second, gibench's against
+     Mitsuba's, i.e. the per-sample ratio times (gibench's rays per sample / Mitsuba's).
+     gibench's rays are counted exactly: its sidecar's `rays` (closest-hit and shadow rays,
+     each pixel counting its own, summed once the render is done). Mitsuba has no ray counter,
+     so its rays are counted by a render of the same scene, spp and film with `RayCount`, a
+     Python integrator that mirrors the `path` integrator's loop (Mitsuba 3.9's path.cpp): per
+     sample one camera ray, then at each valid vertex before max_depth one `ray_test` where
+     Mitsuba issues it (Smooth BSDF and the emitter sample's pdf non-zero, Scene::
+     sample_emitter_direction's mask) and one BSDF ray while the throughput is non-zero. It
+     calls the same scene's ray_intersect, BSDF sample and emitter sample, so its paths have
+     the same distribution as the timed render's, with other random numbers: the count is an
+     estimate whose standard error (over pixels) is reported, and is far below 1 %. The
+     per-ray ratio with Mitsuba's upper bound (19 rays per sample at max_depth 10) is
+     reported beside it and labelled as a bound: it over-counts Mitsuba's rays (paths leave
+     the scene early), so it FAVOURS Mitsuba (understates gibench); taking gibench's nominal
+     16 per sample instead of its count would over-count gibench's and favour it. Per ray
+     rewards rays that carry nothing: Mitsuba traces shadow rays from surfaces facing away
+     from the light or outside a spot's cone, where gibench traces none; per sample (the same
+     estimate's cost) stays the primary figure.
 
 Caveats (read before quoting a ratio):
   * Not the same estimator. gibench shoots one primary ray per pixel and `spp` paths from that
-    hit (plus one direct shadow ray per pixel); each path has 8 indirect vertices with one
-    closest-hit and one shadow ray each: 16 rays per sample. Mitsuba resamples the camera ray
-    per sample and, at max_depth 10, traces 1 + 9 + 9 = 19 rays per sample (NEE at 9 vertices
-    and a last BSDF ray from the 9th vertex that can only find emitters). Paths that leave the
-    scene stop early on both sides; gibench traces nothing for pixels that miss the scene.
+    hit (plus one direct shadow ray per pixel); each path has at most 8 indirect vertices with
+    one closest-hit and one shadow ray each: at most 16 rays per sample. Mitsuba resamples the
+    camera ray per sample and, at max_depth 10, traces at most 1 + 9 + 9 = 19 rays per sample
+    (NEE at 9 vertices and a last BSDF ray from the 9th vertex that can only find emitters).
+    Paths that leave the scene stop early on both sides (on Cornell, open at the front, most
+    do: both trace far fewer rays than these bounds, see point 5); gibench traces nothing for
+    pixels that miss the scene and no shadow ray where the light cannot reach the receiver.
   * gibench's spot light is cosine-shaped (I = I0 cos θ); Mitsuba's `spot` with
     cutoff_angle = beam_width = 90 is uniform over the front hemisphere. Images differ; the
     cost per sample is what is compared. Area lights are replaced by a spot light (their far
@@ -73,6 +94,9 @@ LIGHT_NOTE = ("gibench's cosine spot (I0 cos θ) is approximated by Mitsuba's sp
 # max_depth counts exactly these segments (1 = emitters seen directly, 2 = direct light only).
 BOUNCES = 8
 MAX_DEPTH = 1 + BOUNCES + 1
+# Mitsuba's rays per sample at most (camera ray, then a shadow and a BSDF ray at each of the
+# first MAX_DEPTH - 1 vertices).
+MITSUBA_RAYS_BOUND = 1 + 2 * (MAX_DEPTH - 1)
 
 
 def newest_llvm():
@@ -142,6 +166,49 @@ def scene_dict(mi, meta, folder, spp):
     return d
 
 
+def ray_count_integrator(mi, dr):
+    """An integrator whose every sample returns the rays Mitsuba's `path` integrator traces
+    for it (R: closest-hit, G: shadow, B: both): the path loop of path.cpp (3.9) at MAX_DEPTH
+    without Russian roulette, tracing what it traces and accumulating nothing else."""
+
+    class RayCount(mi.SamplingIntegrator):
+        def sample(self, scene, sampler, ray, medium=None, active=True):
+            ray, active = mi.Ray3f(ray), mi.Bool(active)
+            closest, shadow, throughput = mi.Float(0.0), mi.Float(0.0), mi.Spectrum(1.0)
+            ctx = mi.BSDFContext()
+            for depth in range(MAX_DEPTH):
+                # path.cpp intersects every active lane's ray at the top of its loop.
+                closest += dr.select(active, 1.0, 0.0)
+                si = scene.ray_intersect(ray, active)
+                active_next = active & si.is_valid() & (depth + 1 < MAX_DEPTH)
+                bsdf = si.bsdf(ray)
+                active_em = active_next & mi.has_flag(bsdf.flags(), mi.BSDFFlags.Smooth)
+                # Scene::sample_emitter_direction ray_tests the lanes left active with a
+                # non-zero pdf; visibility is not needed for the count.
+                ds, _ = scene.sample_emitter_direction(si, sampler.next_2d(), False, active_em)
+                shadow += dr.select(active_em & (ds.pdf != 0.0), 1.0, 0.0)
+                bs, weight = bsdf.sample(ctx, si, sampler.next_1d(), sampler.next_2d(),
+                                         active_next)
+                throughput = throughput * weight
+                ray = si.spawn_ray(si.to_world(bs.wo))
+                active = active_next & (dr.max(throughput) != 0.0)
+            return mi.Spectrum(closest, shadow, closest + shadow), mi.Bool(True), []
+
+    mi.register_integrator("gibench_ray_count", lambda props: RayCount(props))
+    return mi.load_dict({"type": "gibench_ray_count"})
+
+
+def mitsuba_ray_counts(mi, scene, spp, counter):
+    """Mitsuba's mean closest-hit, shadow and total rays per sample over the film (box filter:
+    each pixel is the mean of its spp samples), with the total's standard error over pixels."""
+    img = mi.TensorXf(mi.render(scene, spp=spp, integrator=counter))
+    rows = [list(map(float, img[..., c].array)) for c in range(3)]
+    n = len(rows[2])
+    mean = [sum(r) / n for r in rows]
+    se = statistics.stdev(rows[2]) / n ** 0.5 if n > 1 else float("nan")
+    return {"closest": mean[0], "shadow": mean[1], "total": mean[2], "total_standard_error": se}
+
+
 def mitsuba_render(mi, dr, scene, spp):
     """Wall and CPU seconds of one render; mi.render is lazy, so evaluate and sync inside."""
     wall, cpu = time.perf_counter(), time.process_time()
@@ -168,6 +235,7 @@ def gibench_render(args, name, w, h, out):
             "bvh_build_cpu_s": sidecar.get("bvh_build_cpu_seconds"),
             "trace_wall_s": minus(sidecar.get("seconds"), sidecar.get("bvh_build_seconds")),
             "trace_cpu_s": minus(sidecar.get("cpu_seconds"), sidecar.get("bvh_build_cpu_seconds")),
+            "rays": sidecar.get("rays"),
             "outside_render_wall_s": wall - sidecar["seconds"] if "seconds" in sidecar else None}
 
 
@@ -261,6 +329,7 @@ def compare_scene(args, mi, dr, name, w, h, tmp):
     # so a 1-spp warm-up leaves the compilation inside the first timed render: warm up at 2.
     warm_spp = min(args.spp, 2)
     warmup = dict(mitsuba_render(mi, dr, scene, warm_spp), spp=warm_spp)
+    mitsuba_rays = mitsuba_ray_counts(mi, scene, args.spp, ray_count_integrator(mi, dr))
     rays = compare_rays(args, mi, dr, name, scene, export, tmp) if args.rays > 0 else None
     samples, runs = w * h * args.spp, []
     for i in range(args.repeats):
@@ -278,6 +347,14 @@ def compare_scene(args, mi, dr, name, w, h, tmp):
             one["ratio_trace_cpu"] = g["samples_per_trace_cpu_s"] / m["samples_per_cpu_s"]
         if g["trace_wall_s"]:
             one["ratio_trace_wall"] = m["wall_s"] / g["trace_wall_s"]
+        if g["rays"] and "ratio_trace_cpu" in one:
+            g["rays_per_sample"] = g["rays"]["total"] / samples
+            # Rays per trace-CPU-second against Mitsuba's: the per-sample ratio scaled by the
+            # two renderers' rays per sample (counted; and with Mitsuba's bound, which favours it).
+            one["ratio_per_ray_trace_cpu"] = (one["ratio_trace_cpu"] * g["rays_per_sample"]
+                                              / mitsuba_rays["total"])
+            one["ratio_per_ray_bound_trace_cpu"] = (one["ratio_trace_cpu"] * g["rays_per_sample"]
+                                                    / MITSUBA_RAYS_BOUND)
         runs.append(one)
         nan = float("nan")
         print(f"  {name} #{i + 1}: gibench {g['cpu_s']:.2f} CPU-s (render "
@@ -285,7 +362,8 @@ def compare_scene(args, mi, dr, name, w, h, tmp):
               f" CPU-s; {g['wall_s']:.2f} s wall, render {g['render_wall_s'] or nan:.2f} s), "
               f"mitsuba {m['cpu_s']:.2f} CPU-s ({m['wall_s']:.2f} s wall), ratio trace CPU "
               f"{one.get('ratio_trace_cpu', nan):.3f}, render CPU "
-              f"{one.get('ratio_render_cpu', nan):.3f}, whole process {one['ratio_cpu']:.3f}",
+              f"{one.get('ratio_render_cpu', nan):.3f}, whole process {one['ratio_cpu']:.3f}, "
+              f"per ray (trace CPU) {one.get('ratio_per_ray_trace_cpu', nan):.3f}",
               flush=True)
     summary = {"gibench_samples_per_cpu_s": spread([r["gibench"]["samples_per_cpu_s"] for r in runs]),
                "mitsuba_samples_per_cpu_s": spread([r["mitsuba"]["samples_per_cpu_s"] for r in runs]),
@@ -300,8 +378,12 @@ def compare_scene(args, mi, dr, name, w, h, tmp):
         summary["ratio_trace_cpu"] = spread([r["ratio_trace_cpu"] for r in runs])
     if all("ratio_trace_wall" in r for r in runs):
         summary["ratio_trace_wall"] = spread([r["ratio_trace_wall"] for r in runs])
+    for k in ("ratio_per_ray_trace_cpu", "ratio_per_ray_bound_trace_cpu"):
+        if all(k in r for r in runs):
+            summary[k] = spread([r[k] for r in runs])
     return {"scene": name, "triangles": meta.get("triangles"), "light_kind": meta["light"]["kind"],
             "mitsuba_load_s": load, "mitsuba_warmup": warmup, "runs": runs, "summary": summary,
+            "gibench_rays": runs[0]["gibench"]["rays"], "mitsuba_rays_per_sample": mitsuba_rays,
             "raw_rays": rays}
 
 
@@ -379,8 +461,34 @@ def main():
               "gibench's process start, scene load, BVH build and image output added. "
               "Trace-wall ratio: the render call's wall time less the BVH build's against "
               "Mitsuba's render wall time.", "",
-              f"Light: {LIGHT_NOTE}", "", "Per sample gibench traces 16 rays (+2 per pixel), "
-              f"Mitsuba 19 (max_depth {MAX_DEPTH}); see scripts/compare_mitsuba.py for caveats."]
+              f"Light: {LIGHT_NOTE}", "", "Per sample gibench traces at most 16 rays (+2 per pixel), "
+              f"Mitsuba 19 (max_depth {MAX_DEPTH}) at most; see the table below and "
+              "scripts/compare_mitsuba.py for caveats."]
+    lines += ["", "## Per ray traced", "",
+              "Trace-CPU rays per second, gibench's against Mitsuba's: the per-sample ratio "
+              "times gibench's rays per sample over Mitsuba's. gibench's rays are counted in "
+              "its tracer (sidecar `rays`); Mitsuba's by a render with an integrator that "
+              "mirrors its `path` loop and traces what it traces (same scene, spp, film; "
+              "another random stream: ± its standard error over pixels). The bound column "
+              f"takes Mitsuba's {MITSUBA_RAYS_BOUND} rays per sample instead: it over-counts "
+              "Mitsuba's rays and so favours Mitsuba. Per ray rewards rays that carry nothing "
+              "(Mitsuba traces shadow rays gibench skips: receivers facing away from the "
+              "light, points outside a spot's cone); per sample stays the primary figure.", "",
+              "| scene | gibench rays/sample (closest + shadow) | Mitsuba rays/sample "
+              "(closest + shadow) | per-sample ratio, trace CPU | per-ray ratio, trace CPU, "
+              "median [min–max] | per-ray ratio with Mitsuba's bound (favours Mitsuba) | "
+              "every alternation's per-ray ratio |", "|---|---:|---:|---:|---:|---:|---|"]
+    for r in results:
+        s, g, m = r["summary"], r["gibench_rays"], r["mitsuba_rays_per_sample"]
+        if not g or "ratio_per_ray_trace_cpu" not in s:
+            continue
+        n = w * h * args.spp
+        each = ", ".join(f"{x['ratio_per_ray_trace_cpu']:.3f}" for x in r["runs"])
+        lines.append(f"| {r['scene']} | {g['total'] / n:.3f} ({g['closest'] / n:.3f} + "
+                     f"{g['shadow'] / n:.3f}) | {m['total']:.3f} ± {m['total_standard_error']:.3f}"
+                     f" ({m['closest']:.3f} + {m['shadow']:.3f}) | {rng(s['ratio_trace_cpu'])}"
+                     f" | {rng(s['ratio_per_ray_trace_cpu'])}"
+                     f" | {rng(s['ratio_per_ray_bound_trace_cpu'])} | {each} |")
     if args.rays > 0:
         lines += ["", "## Raw ray throughput on the same rays", "",
                   f"{args.rays:,} closest-hit and {args.rays:,} shadow rays per scene (`gibench "

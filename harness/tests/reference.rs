@@ -5,7 +5,8 @@
 use std::f32::consts::PI;
 
 use gibench_harness::cpu::reference::{
-    camera_ray, render_reference, ReferenceImages, ReferenceSettings, ReferenceTracer,
+    camera_ray, render_reference, render_reference_timed, ReferenceImages, ReferenceSettings,
+    ReferenceTracer,
 };
 use gibench_harness::glam::{Mat4, Vec2, Vec3};
 use gibench_harness::scene::anim::{CameraPose, FrameClock, FrameState, LightPose};
@@ -417,6 +418,41 @@ fn reference_white_furnace_box() {
         rel(multi, expected_multi) < 0.03,
         "multi {multi} vs {expected_multi}"
     );
+}
+
+/// In a closed box lit from inside by an omni light every ray hits a wall facing the light, so
+/// the rays a render traces are known exactly: per pixel one camera ray and one shadow ray,
+/// per path `bounces` segments each with its shadow ray. Catches a ray traced but not counted
+/// (or counted twice: the counts feed `scripts/compare_mitsuba.py`'s per-ray ratio) and pixels'
+/// counts lost when they are summed.
+#[test]
+fn reference_counts_the_rays_it_traces() {
+    let size = Vec3::new(4.0, 3.0, 5.0);
+    let s = scene(
+        support::closed_box_mesh(size, 0),
+        vec![material("grey", Vec3::splat(0.5))],
+    );
+    let l = light(
+        LightKind::Omni,
+        Vec3::new(1.3, 1.7, 2.2),
+        Vec3::NEG_Y,
+        100.0,
+        [0.0; 2],
+    );
+    let f = frame(Vec3::new(2.0, 1.5, 0.5), Vec3::new(2.0, 1.5, 4.0), l);
+    let settings = ReferenceSettings {
+        spp: 3,
+        bounces: 4,
+        seed: 5,
+    };
+    let (r, setup) = render_reference_timed(&s, &f, [16, 12], &settings);
+    let pixels = 16 * 12u64;
+    assert!(r.hit.iter().all(|&h| h), "the camera is inside the box");
+    let paths = pixels * settings.spp as u64;
+    let rays = setup.rays;
+    assert_eq!(rays.closest, pixels + paths * settings.bounces as u64);
+    assert_eq!(rays.shadow, pixels + paths * settings.bounces as u64);
+    assert_eq!(rays.total(), rays.closest + rays.shadow);
 }
 
 /// The error between two seeds falls (at least) as 1/√spp: 4× the paths divide it by 2 for

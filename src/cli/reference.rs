@@ -175,6 +175,9 @@ pub(crate) fn reference_planned(
         "cpu_seconds": cpu_seconds,
         "bvh_build_seconds": setup.map(|t| t.seconds),
         "bvh_build_cpu_seconds": setup.and_then(|t| t.cpu_seconds),
+        "rays": setup.map(|t| serde_json::json!({
+            "closest": t.rays.closest, "shadow": t.rays.shadow, "total": t.rays.total(),
+        })),
         "reference_version": gibench_harness::cpu::reference::REFERENCE_VERSION,
         "git_commit": gibench_harness::run::runner::git_commit(), "error_estimate": estimate,
     });

@@ -198,6 +198,31 @@ impl ReferenceImages {
     }
 }
 
+/// The rays a render traced ([`TracerSetup::rays`]): counted where the tracer asks its trees,
+/// one per query whatever the number of trees (static and movers) it asks.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RayCounts {
+    /// Closest-hit rays: one per pixel from the camera, one per path segment.
+    pub closest: u64,
+    /// Shadow rays: one per light point whose light reaches the receiver's side (a receiver
+    /// facing away, or outside a spot's cone, traces none).
+    pub shadow: u64,
+}
+
+impl RayCounts {
+    /// Closest-hit and shadow rays together.
+    pub fn total(&self) -> u64 {
+        self.closest + self.shadow
+    }
+}
+
+impl std::ops::AddAssign for RayCounts {
+    fn add_assign(&mut self, o: RayCounts) {
+        self.closest += o.closest;
+        self.shadow += o.shadow;
+    }
+}
+
 /// Irradiance at one surface point (see [`ReferenceTracer::irradiance_at`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct PointIrradiance {
@@ -354,6 +379,15 @@ fn srgb_to_linear(c: f32) -> f32 {
     }
 }
 
+/// A point receiving light: position `p`, the shadow rays' `origin` (`p` offset along `ng`),
+/// geometric and shading normals `ng` and `ns` on the receiving side.
+struct Receiver {
+    p: Vec3,
+    origin: Vec3,
+    ng: Vec3,
+    ns: Vec3,
+}
+
 /// How the primary light is sampled.
 enum LightShape {
     /// A point with radiant intensity [`LightPose::intensity_toward`].
@@ -479,12 +513,13 @@ impl<'a> ReferenceTracer<'a> {
 
     /// Whether the segment from `from` (already offset from its surface) to the light point
     /// `to` is free; the last ε before `to` is not tested.
-    fn visible(&self, from: Vec3, to: Vec3) -> bool {
+    fn visible(&self, from: Vec3, to: Vec3, rays: &mut RayCounts) -> bool {
         let d = to - from;
         let len = d.length();
         if len <= self.eps {
             return true;
         }
+        rays.shadow += 1;
         !self.bvh.any_hit(from, d, 0.0, 1.0 - self.eps / len)
     }
 
@@ -492,12 +527,10 @@ impl<'a> ReferenceTracer<'a> {
     /// `intensity(l)` (l: unit direction from `p` to `y`), times visibility.
     fn point_irradiance(
         &self,
-        p: Vec3,
-        origin: Vec3,
-        ng: Vec3,
-        ns: Vec3,
+        &Receiver { p, origin, ng, ns }: &Receiver,
         y: Vec3,
         intensity: impl Fn(Vec3) -> Vec3,
+        rays: &mut RayCounts,
     ) -> Vec3 {
         let to = y - p;
         let r2 = to.length_squared();
@@ -510,7 +543,7 @@ impl<'a> ReferenceTracer<'a> {
             return Vec3::ZERO;
         }
         let i = intensity(l);
-        if i == Vec3::ZERO || !self.visible(origin, y) {
+        if i == Vec3::ZERO || !self.visible(origin, y, rays) {
             return Vec3::ZERO;
         }
         i * (cos_r / r2)
@@ -518,14 +551,21 @@ impl<'a> ReferenceTracer<'a> {
 
     /// Direct irradiance at `p` (geometric normal `ng`, shading normal `ns`, both on the
     /// receiving side). Area lights use `samples` points: stratified when `rng_strata`.
-    fn direct(&self, p: Vec3, ng: Vec3, ns: Vec3, samples: u32, rng: &mut Rng) -> Vec3 {
+    fn direct(
+        &self,
+        p: Vec3,
+        ng: Vec3,
+        ns: Vec3,
+        samples: u32,
+        rng: &mut Rng,
+        rays: &mut RayCounts,
+    ) -> Vec3 {
         let origin = p + ng * self.eps;
+        let at = Receiver { p, origin, ng, ns };
         match &self.shape {
             LightShape::Point => {
                 let light = &self.light;
-                self.point_irradiance(p, origin, ng, ns, light.position, |l| {
-                    light.intensity_toward(-l)
-                })
+                self.point_irradiance(&at, light.position, |l| light.intensity_toward(-l), rays)
             }
             LightShape::Sun => {
                 let l = -self.light.axis();
@@ -533,6 +573,7 @@ impl<'a> ReferenceTracer<'a> {
                 if cos_r <= 0.0 || ng.dot(l) <= 0.0 {
                     return Vec3::ZERO;
                 }
+                rays.shadow += 1;
                 if self.bvh.any_hit(origin, l, 0.0, f32::INFINITY) {
                     return Vec3::ZERO;
                 }
@@ -551,9 +592,12 @@ impl<'a> ReferenceTracer<'a> {
                     let u = 2.0 * strata.sample(j, rng) - Vec2::ONE;
                     let y = self.light.position + u.x * *half_u + u.y * *half_v;
                     // Per point: L·A · cos θ_l (the pdf 1/A cancels A).
-                    sum += self.point_irradiance(p, origin, ng, ns, y, |l| {
-                        *radiance_area * (-l).dot(*normal).max(0.0)
-                    });
+                    sum += self.point_irradiance(
+                        &at,
+                        y,
+                        |l| *radiance_area * (-l).dot(*normal).max(0.0),
+                        rays,
+                    );
                 }
                 sum / n as f32
             }
@@ -573,9 +617,30 @@ impl<'a> ReferenceTracer<'a> {
         settings: &ReferenceSettings,
         stream: u64,
     ) -> PointIrradiance {
+        let mut rays = RayCounts::default();
+        self.irradiance_counted(
+            point,
+            geometric_normal,
+            shading_normal,
+            settings,
+            stream,
+            &mut rays,
+        )
+    }
+
+    /// [`ReferenceTracer::irradiance_at`], adding the rays it traces to `rays`.
+    fn irradiance_counted(
+        &self,
+        point: Vec3,
+        geometric_normal: Vec3,
+        shading_normal: Vec3,
+        settings: &ReferenceSettings,
+        stream: u64,
+        rays: &mut RayCounts,
+    ) -> PointIrradiance {
         let mut rng = Rng::new(settings.seed, stream);
         let (ng, ns) = (geometric_normal, shading_normal);
-        let direct = self.direct(point, ng, ns, settings.spp, &mut rng);
+        let direct = self.direct(point, ng, ns, settings.spp, &mut rng, rays);
         let mut one = Vec3::ZERO;
         let mut multi = Vec3::ZERO;
         if settings.spp > 0 && settings.bounces > 0 {
@@ -588,6 +653,7 @@ impl<'a> ReferenceTracer<'a> {
                 let mut origin = point + ng * self.eps;
                 let mut beta = Vec3::ONE;
                 for k in 1..=settings.bounces {
+                    rays.closest += 1;
                     let Some(hit) = self.bvh.closest_hit(origin, dir, 0.0, f32::INFINITY) else {
                         break;
                     };
@@ -598,6 +664,7 @@ impl<'a> ReferenceTracer<'a> {
                         hit.shading_normal,
                         1,
                         &mut rng,
+                        rays,
                     );
                     // β ρ/π E_d, times the estimator's π.
                     let c = beta * rho * e;
@@ -640,9 +707,10 @@ pub fn render_reference(
 }
 
 /// What setting up the tracer cost in a [`render_reference_timed`] call: the frame's trees
-/// (the static mesh's when not built yet, and the movers'), built before any ray is traced. Renderers that build their acceleration structure
-/// when the scene loads (Mitsuba, Embree) leave this out of their render time; a like-for-like
-/// comparison subtracts it from the render call's.
+/// (the static mesh's when not built yet, and the movers'), built before any ray is traced.
+/// Renderers that build their acceleration structure when the scene loads (Mitsuba, Embree)
+/// leave this out of their render time; a like-for-like comparison subtracts it from the
+/// render call's. With it, the rays the render then traced (for a per-ray cost).
 #[derive(Clone, Copy, Debug)]
 pub struct TracerSetup {
     /// Wall seconds.
@@ -650,6 +718,9 @@ pub struct TracerSetup {
     /// CPU seconds of every thread of the process over the same span (`None` where the
     /// platform has no process CPU clock).
     pub cpu_seconds: Option<f64>,
+    /// The rays the render traced after the set-up, summed over its pixels (each pixel counts
+    /// its own, added up once the pixels are done: nothing shared in the loop).
+    pub rays: RayCounts,
 }
 
 /// [`render_reference`], with what setting up the tracer cost.
@@ -672,30 +743,42 @@ pub fn render_reference_with(
 ) -> (ReferenceImages, TracerSetup) {
     let (tracer, seconds, cpu_seconds) =
         crate::measure::calibrate::timed(|| ReferenceTracer::with_trees(trees, frame));
-    let setup = TracerSetup {
-        seconds,
-        cpu_seconds,
-    };
     let [w, h] = resolution;
     let inv = view_projection(frame, resolution).inverse();
-    let pixels: Vec<Option<(Vec3, PointIrradiance)>> = (0..w as usize * h as usize)
+    let pixels: Vec<(Option<(Vec3, PointIrradiance)>, RayCounts)> = (0..w as usize * h as usize)
         .into_par_iter()
         .with_min_len(w.max(1) as usize)
         .map(|i| {
             let (x, y) = (i as u32 % w, i as u32 / w);
             let (origin, dir, near) = camera_ray_near(&inv, frame, resolution, x, y);
-            let hit = tracer.bvh.closest_hit(origin, dir, near, f32::INFINITY)?;
+            let mut rays = RayCounts {
+                closest: 1,
+                shadow: 0,
+            };
+            let Some(hit) = tracer.bvh.closest_hit(origin, dir, near, f32::INFINITY) else {
+                return (None, rays);
+            };
             let albedo = tracer.albedo(hit.material, hit.uv);
-            let e = tracer.irradiance_at(
+            let e = tracer.irradiance_counted(
                 hit.position,
                 hit.geometric_normal,
                 hit.shading_normal,
                 settings,
                 i as u64,
+                &mut rays,
             );
-            Some((albedo, e))
+            (Some((albedo, e)), rays)
         })
         .collect();
+    let mut rays = RayCounts::default();
+    for (_, r) in &pixels {
+        rays += *r;
+    }
+    let setup = TracerSetup {
+        seconds,
+        cpu_seconds,
+        rays,
+    };
     let n = pixels.len();
     let mut out = ReferenceImages {
         size: resolution,
@@ -709,7 +792,7 @@ pub fn render_reference_with(
         multi_bounce: Vec::with_capacity(n),
         radiance: Vec::with_capacity(n),
     };
-    for p in pixels {
+    for (p, _) in pixels {
         let (albedo, e) = p.unwrap_or_default();
         out.hit.push(p.is_some());
         out.albedo.push(albedo);
