@@ -69,6 +69,27 @@ pub fn gpu_kind(kind: LightKind) -> f32 {
     }
 }
 
+/// A light's radiant intensity by direction ([`LightPose::emitter`]).
+#[derive(Clone, Copy, Debug)]
+pub struct PointEmitter {
+    axis: Vec3,
+    on_axis: Vec3,
+    /// Whether it falls off as the cosine to the axis (spot, area), or not (omni, sun).
+    cosine: bool,
+}
+
+impl PointEmitter {
+    /// [`LightPose::intensity_toward`].
+    #[inline]
+    pub fn intensity_toward(&self, dir_from_light: Vec3) -> Vec3 {
+        if self.cosine {
+            self.on_axis * dir_from_light.dot(self.axis).max(0.0)
+        } else {
+            self.on_axis
+        }
+    }
+}
+
 impl LightPose {
     /// The light's unit axis (spot direction, area normal, sun direction), −Y if unusable.
     pub fn axis(&self) -> Vec3 {
@@ -117,9 +138,16 @@ impl LightPose {
     /// Radiant intensity of a point light (spot, omni; area lights as a cosine spot at their
     /// centre) towards unit `dir_from_light`; the sun's E⊥ for the sun.
     pub fn intensity_toward(&self, dir_from_light: Vec3) -> Vec3 {
-        match self.kind {
-            LightKind::Omni | LightKind::Sun => self.axis_intensity(),
-            _ => self.axis_intensity() * dir_from_light.dot(self.axis()).max(0.0),
+        self.emitter().intensity_toward(dir_from_light)
+    }
+
+    /// [`LightPose::intensity_toward`] set up once: the axis and on-axis intensity, which it
+    /// would otherwise compute (a normalisation, three divisions) at every call.
+    pub fn emitter(&self) -> PointEmitter {
+        PointEmitter {
+            axis: self.axis(),
+            on_axis: self.axis_intensity(),
+            cosine: !matches!(self.kind, LightKind::Omni | LightKind::Sun),
         }
     }
 

@@ -72,6 +72,7 @@ use glam::{Mat4, Vec2, Vec3, Vec4};
 use rayon::prelude::*;
 
 use crate::cpu::bvh::{mover_mesh, FrameBvh, SceneTrees};
+use crate::cpu::light::PointEmitter;
 use crate::scene::anim::{FrameState, LightPose};
 use crate::scene::descriptor::LightKind;
 use crate::scene::{Mesh, Scene, Texture};
@@ -390,8 +391,8 @@ struct Receiver {
 
 /// How the primary light is sampled.
 enum LightShape {
-    /// A point with radiant intensity [`LightPose::intensity_toward`].
-    Point,
+    /// A point with radiant intensity [`LightPose::intensity_toward`], set up once.
+    Point(PointEmitter),
     /// A rectangle: centre `position`, half-extent vectors, normal, radiance × area (Φ/π).
     Rect {
         half_u: Vec3,
@@ -443,7 +444,7 @@ impl<'a> ReferenceTracer<'a> {
                 radiance_area: light.power / std::f32::consts::PI,
             },
             // Spot, omni, and an area light with no area (its far field: a cosine spot).
-            _ => LightShape::Point,
+            _ => LightShape::Point(light.emitter()),
         };
         let mut srgb = [0.0; 256];
         for (i, s) in srgb.iter_mut().enumerate() {
@@ -563,9 +564,9 @@ impl<'a> ReferenceTracer<'a> {
         let origin = p + ng * self.eps;
         let at = Receiver { p, origin, ng, ns };
         match &self.shape {
-            LightShape::Point => {
-                let light = &self.light;
-                self.point_irradiance(&at, light.position, |l| light.intensity_toward(-l), rays)
+            LightShape::Point(emitter) => {
+                let position = self.light.position;
+                self.point_irradiance(&at, position, |l| emitter.intensity_toward(-l), rays)
             }
             LightShape::Sun => {
                 let l = -self.light.axis();
