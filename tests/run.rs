@@ -193,6 +193,20 @@ fn reference_two_seeds_agree_at_default_spp() {
         (0.0..wall).contains(&build) && (0.0..cpu).contains(&build_cpu),
         "{info}"
     );
+    // The rays it traced (for scripts/compare_mitsuba.py's per-ray ratio): one camera ray per
+    // pixel, at most 8 segments per path (256 paths a pixel), a shadow ray at most per vertex.
+    let rays = &info["rays"];
+    let (closest, shadow) = (rays["closest"].as_u64(), rays["shadow"].as_u64());
+    let (Some(closest), Some(shadow)) = (closest, shadow) else {
+        panic!("no ray counts: {info}");
+    };
+    let pixels = 128 * 96;
+    let most = pixels * (1 + 256 * 8);
+    assert!(
+        (pixels..=most).contains(&closest) && (1..=most).contains(&shadow),
+        "{info}"
+    );
+    assert_eq!(rays["total"].as_u64(), Some(closest + shadow), "{info}");
     let e = &info["error_estimate"];
     for k in ["one_bounce_rel_mse", "multi_bounce_rel_mse"] {
         let v = e[k].as_f64().unwrap();
