@@ -387,6 +387,19 @@ def compare_scene(args, mi, dr, name, w, h, tmp):
             "raw_rays": rays}
 
 
+def git_commit():
+    """The checkout's commit, "-dirty" when files outside results/ differ from it (as
+    results/regenerate.sh decides: results being regenerated beside this run are not the code
+    that made them); None outside a git checkout."""
+    root = Path(__file__).resolve().parent.parent
+    git = lambda *a: subprocess.run(["git", *a], capture_output=True, text=True, cwd=root)
+    head = git("rev-parse", "--short=7", "HEAD").stdout.strip()
+    if not head:
+        return None
+    dirty = git("status", "--porcelain", "--untracked-files=no", "--", ".", ":(exclude)results")
+    return head + ("-dirty" if dirty.stdout.strip() else "")
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("--scenes", default="cornell,sibenik")
@@ -422,9 +435,7 @@ def main():
                              "RUSAGE_CHILDREN) ratio_cpu; 'seconds' less 'bvh_build_seconds' "
                              "(wall) gives ratio_trace_wall",
               "mitsuba_cpu": "time.process_time around mi.render + dr.eval + dr.sync_thread"}
-    git = subprocess.run(["git", "describe", "--always", "--dirty", "--abbrev=7"],
-                         capture_output=True, text=True, cwd=Path(__file__).resolve().parent)
-    common["gibench_git_commit"] = git.stdout.strip() or None
+    common["gibench_git_commit"] = git_commit()
     out = Path(args.out)
     results = []
     for name in [s.strip() for s in args.scenes.split(",") if s.strip()]:
