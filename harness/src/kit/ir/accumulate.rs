@@ -24,7 +24,7 @@ use super::atlas::ShadowAtlas;
 use super::interleave::{Interleave, INTERLEAVE_WGSL};
 use super::store::VplStore;
 use crate::gpu::GpuContext;
-use crate::kit::passes::{bind_buffer, compute_pipeline, params_entry, PARAMS_USAGE};
+use crate::kit::passes::{bind_buffer, compute_pipeline, params_buffer, params_entry};
 use crate::Result;
 
 /// GPU layout of `AccumulateParams` in `accumulate.wgsl`.
@@ -85,18 +85,12 @@ impl Accumulation {
         clamp: IrradianceClamp,
     ) -> Result<Accumulation> {
         let device = &gpu.device;
-        let params = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("accumulate params"),
-            size: std::mem::size_of::<ParamsData>() as u64,
-            usage: PARAMS_USAGE,
-            mapped_at_creation: false,
-        });
-        gpu.queue.write_buffer(
-            &params,
-            0,
-            bytemuck::bytes_of(&ParamsData {
+        let params = params_buffer(
+            gpu,
+            "accumulate params",
+            &ParamsData {
                 clamp: [clamp.per_flux(), 0.0, 0.0, 0.0],
-            }),
+            },
         );
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("accumulate"),

@@ -23,7 +23,8 @@ use super::atlas::{AtlasFormat, ShadowAtlas};
 use super::splat::{texel_buffer_size, PointSplat};
 use crate::gpu::GpuContext;
 use crate::kit::passes::{
-    bind_buffer, compute_pipeline, params_entry, storage_entry, storage_texture_entry, PARAMS_USAGE,
+    bind_buffer, compute_pipeline, params_buffer, params_entry, storage_entry,
+    storage_texture_entry,
 };
 use crate::measure::roofline::StageCost;
 use crate::{Error, Result};
@@ -127,19 +128,13 @@ impl PullPush {
         let columns = atlas.columns();
         let pass = |kind: usize, level: u32, source: u32| -> Pass {
             let s = size >> level;
-            let params = device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("pull-push params"),
-                size: std::mem::size_of::<ParamsData>() as u64,
-                usage: PARAMS_USAGE,
-                mapped_at_creation: false,
-            });
-            gpu.queue.write_buffer(
-                &params,
-                0,
-                bytemuck::bytes_of(&ParamsData {
+            let params = params_buffer(
+                gpu,
+                "pull-push params",
+                &ParamsData {
                     counts: [level, s, slots, columns],
                     offsets: [offsets[level as usize], source, 0, 0],
-                }),
+                },
             );
             let mut entries = vec![
                 bind_buffer(0, &params),

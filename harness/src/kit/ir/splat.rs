@@ -22,7 +22,7 @@ use super::atlas::{MapKind, ShadowAtlas};
 use super::store::VplStore;
 use crate::gpu::GpuContext;
 use crate::kit::passes::{
-    bind_buffer, compute_pipeline, params_entry, storage_entry, PARAMS_USAGE,
+    bind_buffer, compute_pipeline, params_buffer, params_entry, storage_entry,
 };
 use crate::{Error, Result};
 
@@ -108,18 +108,12 @@ impl PointSplat {
                 | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
-        let params = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("splat params"),
-            size: std::mem::size_of::<ParamsData>() as u64,
-            usage: PARAMS_USAGE,
-            mapped_at_creation: false,
-        });
-        gpu.queue.write_buffer(
-            &params,
-            0,
-            bytemuck::bytes_of(&ParamsData {
+        let params = params_buffer(
+            gpu,
+            "splat params",
+            &ParamsData {
                 counts: [points_per_vpl, pool, 0, 0],
-            }),
+            },
         );
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("splat"),

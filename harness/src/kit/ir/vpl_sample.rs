@@ -29,7 +29,7 @@ use bytemuck::{Pod, Zeroable};
 use super::store::VplStore;
 use crate::gpu::GpuContext;
 use crate::kit::passes::{
-    bind_buffer, compute_pipeline, params_entry, storage_entry, PARAMS_USAGE,
+    bind_buffer, compute_pipeline, params_buffer, params_entry, storage_entry,
 };
 use crate::measure::roofline::StageCost;
 use crate::{Error, Result};
@@ -114,23 +114,17 @@ impl VplSampler {
             )));
         }
         let device = &gpu.device;
-        let params = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("vpl sample params"),
-            size: std::mem::size_of::<ParamsData>() as u64,
-            usage: PARAMS_USAGE,
-            mapped_at_creation: false,
-        });
-        gpu.queue.write_buffer(
-            &params,
-            0,
-            bytemuck::bytes_of(&ParamsData {
+        let params = params_buffer(
+            gpu,
+            "vpl sample params",
+            &ParamsData {
                 counts: [
                     rsm.texels,
                     count,
                     rsm.row,
                     (warp == VplWarp::RowColumn) as u32,
                 ],
-            }),
+            },
         );
         let buffer = |label: &str, size: u64| {
             device.create_buffer(&wgpu::BufferDescriptor {
