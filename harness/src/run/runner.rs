@@ -299,6 +299,32 @@ fn reset_peak_memory() {
     let _ = std::fs::write("/proc/self/clear_refs", "5");
 }
 
+/// The warning for the negative indirect irradiance `neg` found in an image of `pixels` pixels:
+/// the pixels past −1 % of the image's mean (the technique's estimates disagreeing) and those
+/// within it (half-float rounding) told apart.
+fn negative_warning(neg: &Negatives, pixels: usize) -> String {
+    let rounding = neg.pixels - neg.beyond_rounding;
+    let lowest = 100.0 * neg.lowest;
+    let found = format!(
+        "indirect irradiance was negative in {} of {pixels} pixels of the last frame",
+        neg.pixels
+    );
+    let cause = if neg.beyond_rounding == 0 {
+        format!(
+            "all within 1 % of the image's mean below zero (the lowest {lowest:.2} %): half-float \
+             rounding where the technique's estimates cancel to about zero"
+        )
+    } else {
+        format!(
+            "{} of them beyond -1 % of the image's mean (the lowest {lowest:.1} %), where the \
+             technique's estimates undershoot; {rounding} within 1 % of it (half-float rounding \
+             where estimates cancel to about zero)",
+            neg.beyond_rounding
+        )
+    };
+    format!("{found}: {cause}; set to 0 in the images and the error metrics")
+}
+
 /// Largest finite half float: the irradiance buffers (Rgba16Float) clamp above it.
 pub const HALF_MAX: f32 = 65504.0;
 
@@ -311,13 +337,7 @@ impl FrameImages {
         let mut out = Vec::new();
         let neg = self.negative_indirect;
         if neg.pixels > 0 {
-            out.push(format!(
-                "indirect irradiance was negative in {} of {} pixels of the last frame, {} of them below -1 % of the image's mean (the lowest {:.1} % of it): the technique's estimates undershoot there (within 1 %: half-float rounding where estimates cancel to about zero); set to 0 in the images and the error metrics",
-                neg.pixels,
-                self.indirect.len(),
-                neg.beyond_rounding,
-                100.0 * neg.lowest
-            ));
+            out.push(negative_warning(&neg, self.indirect.len()));
         }
         for (what, img) in [("indirect", &self.indirect), ("direct", &self.direct)] {
             let nan = img.iter().filter(|p| p.iter().any(|c| c.is_nan())).count();
@@ -812,6 +832,30 @@ mod tests {
         assert_eq!(img[3], [0.0; 3]);
         assert_eq!(img[4], [0.2, 0.0, 0.0]);
         assert_eq!(non_negative(&mut img), Negatives::default());
+    }
+
+    /// The warning names the pixels past -1 % apart from the rounding ones, and says rounding
+    /// alone only when nothing is past it. Caught by: one sentence for both (it read "3 below
+    /// -1 % ... the lowest -43 % ... (within 1 %: rounding)").
+    #[test]
+    fn the_negative_warning_tells_undershoot_from_rounding() {
+        let both = Negatives {
+            pixels: 1000,
+            beyond_rounding: 80,
+            lowest: -1.22,
+        };
+        let w = negative_warning(&both, 12288);
+        assert!(w.starts_with("indirect irradiance was negative in 1000 of 12288 pixels"));
+        assert!(w.contains("80 of them beyond -1 % of the image's mean (the lowest -122.0 %)"));
+        assert!(w.contains("undershoot; 920 within 1 % of it (half-float rounding"));
+        let rounding = Negatives {
+            pixels: 7,
+            beyond_rounding: 0,
+            lowest: -0.0004,
+        };
+        let w = negative_warning(&rounding, 3072);
+        assert!(w.contains("all within 1 % of the image's mean below zero (the lowest -0.04 %)"));
+        assert!(!w.contains("undershoot"), "{w}");
     }
 
     #[test]
