@@ -303,6 +303,7 @@ fn gpu_options(args: &RunArgs) -> GpuOptions {
         backend: args.gpu.backend.clone(),
         adapter: args.gpu.adapter.clone(),
         gpu_timeout: args.gpu.gpu_timeout,
+        limits: None,
     }
 }
 

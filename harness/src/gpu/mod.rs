@@ -25,6 +25,10 @@ pub struct GpuOptions {
     /// The longest one wait for the GPU may last before it fails, seconds (`--gpu-timeout`);
     /// `None` waits as long as the work takes.
     pub gpu_timeout: Option<f64>,
+    /// Limits to ask the device for instead of the adapter's own (each at most the adapter's):
+    /// tests make a smaller adapter's device this way, to check a technique's error for a
+    /// limit it needs beyond what the adapter offers.
+    pub limits: Option<wgpu::Limits>,
 }
 
 /// One blocking wait is at most this long and is then renewed: wgpu's GL backend caps a fence
@@ -248,7 +252,7 @@ impl GpuContext {
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("gibench"),
             required_features: features,
-            required_limits: adapter.limits(),
+            required_limits: opts.limits.clone().unwrap_or_else(|| adapter.limits()),
             ..Default::default()
         }))
         .map_err(|e| Error::Gpu(format!("could not create a device on '{}': {e}", ai.name)))?;

@@ -163,6 +163,7 @@ pub fn open_gpu(args: &ReproduceArgs) -> Result<GpuContext> {
         backend: args.backend.clone(),
         adapter: args.adapter.clone(),
         gpu_timeout: args.gpu_timeout,
+        limits: None,
     })
 }
 

@@ -9,7 +9,7 @@ use gibench_gaitatzes::volume::{
     Grid, Mode, Propagation, Transport, Volumes, Voxelizer, CELL_BYTES,
 };
 use gibench_harness::glam::{Vec2, Vec3};
-use gibench_harness::gpu::GpuContext;
+use gibench_harness::gpu::{GpuContext, GpuOptions};
 use gibench_harness::run::runner::Harness;
 use gibench_harness::scene::{Material, Mesh};
 use gibench_test_support::{gpus, read_f32, run_config, scene_from_json};
@@ -427,5 +427,49 @@ fn voxelize_triangle(a: Vec3, b: Vec3, c: Vec3) {
                 }
             }
         }
+    }
+}
+
+/// On an adapter with the downlevel four storage buffers per shader stage, `transport=carry`
+/// and `pyramid` (a fifth: the senders' SH) are refused by name before any pipeline is made,
+/// and `transport=cosine` still builds. Caught by: the check dropped (pipeline creation then
+/// fails inside wgpu, an uncaptured validation error instead of the parameter's name) or
+/// counting the cosine transport's buffers as five.
+#[test]
+fn transports_needing_a_fifth_storage_buffer_are_refused_with_four() {
+    for (backend, full) in gpus("transports_needing_a_fifth_storage_buffer_are_refused_with_four") {
+        let limits = gibench_harness::wgpu::Limits {
+            max_storage_buffers_per_shader_stage: 4,
+            ..full.device.limits()
+        };
+        let gpu = GpuContext::new(&GpuOptions {
+            backend: Some(backend.into()),
+            limits: Some(limits),
+            ..Default::default()
+        })
+        .unwrap_or_else(|e| panic!("{backend}: a device with 4 storage buffers: {e}"));
+        for transport in [Transport::Carry, Transport::Pyramid, Transport::Cosine] {
+            let g = Grid {
+                transport,
+                ..grid(Mode::Occluded)
+            };
+            let volumes = Volumes::new(&gpu, &g).unwrap();
+            let made = Propagation::new(&gpu, &g, &volumes);
+            if transport == Transport::Cosine {
+                assert!(made.is_ok(), "{backend}: cosine with 4 buffers");
+                continue;
+            }
+            let err = made.err().unwrap().to_string();
+            assert!(
+                err.contains("transport")
+                    && err.contains(
+                        "needs 5 storage buffers per shader stage; this adapter allows 4"
+                    ),
+                "{backend} {}: {err}",
+                transport.name()
+            );
+        }
+        gpu.check_errors()
+            .unwrap_or_else(|e| panic!("{backend}: no validation error: {e}"));
     }
 }
