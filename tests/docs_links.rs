@@ -652,6 +652,52 @@ fn the_readme_fits_in_250_lines() {
     );
 }
 
+/// The tracked tree's limit in bytes (issue 51): a GPU slot copies the working tree (at most 64
+/// MiB, with the prebuilt bundle of `scripts/gpu-bundle.sh` beside it), so the checkout keeps
+/// half of that. `results/.gitignore` keeps the images that regenerate out.
+const TRACKED_TREE_MAX_BYTES: u64 = 32 << 20;
+
+/// The size of the files git tracks under `root` (apparent sizes, as `du -b` adds them), or
+/// `None` outside a git checkout.
+fn tracked_bytes(root: &Path) -> Option<(u64, Vec<(u64, String)>)> {
+    let o = std::process::Command::new("git")
+        .args(["ls-files", "-z"])
+        .current_dir(root)
+        .output()
+        .ok()
+        .filter(|o| o.status.success())?;
+    let mut files: Vec<(u64, String)> = o
+        .stdout
+        .split(|b| *b == 0)
+        .filter(|n| !n.is_empty())
+        .map(|n| String::from_utf8_lossy(n).into_owned())
+        // A file deleted but not yet staged is not in the tree a copy takes.
+        .filter_map(|n| Some((std::fs::metadata(root.join(&n)).ok()?.len(), n)))
+        .collect();
+    files.sort();
+    Some((files.iter().map(|f| f.0).sum(), files))
+}
+
+#[test]
+fn the_tracked_tree_stays_under_32_mib() {
+    let root = root();
+    let Some((total, files)) = tracked_bytes(&root) else {
+        eprintln!("not a git checkout (or no git): the tracked tree's size was not checked");
+        return;
+    };
+    let largest: Vec<String> = files
+        .iter()
+        .rev()
+        .take(10)
+        .map(|(n, f)| format!("{f} ({n} bytes)"))
+        .collect();
+    assert!(
+        total < TRACKED_TREE_MAX_BYTES,
+        "the tracked tree is {total} bytes, over {TRACKED_TREE_MAX_BYTES} (32 MiB): keep \
+         regenerable images out (results/.gitignore); the largest files: {largest:#?}"
+    );
+}
+
 #[test]
 fn every_link_in_the_readme_docs_and_results_readmes_is_alive() {
     let root = root();

@@ -189,6 +189,28 @@ fn run_page_loads_clean_and_fails_on_a_broken_image_or_console_error() {
         );
     }
     assert!(html.contains("-reference-frames.png\""));
+    // The reference's images are written once per run set (issue 51), not once per technique:
+    // the three techniques compare with one component (one-bounce), so one file of each kind,
+    // which every run lists.
+    for suffix in [
+        "-reference.png",
+        "-reference-indirect.png",
+        "-reference-frames.png",
+    ] {
+        let shared: Vec<_> = std::fs::read_dir(&out)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .filter(|n| n.ends_with(suffix))
+            .collect();
+        assert_eq!(shared.len(), 1, "{suffix}: {shared:?}");
+        for t in ["direct", "keller-full", "laine"] {
+            let json = std::fs::read_to_string(out.join(format!("cornell-{t}.json"))).unwrap();
+            assert!(
+                json.contains(&format!("\"{}\"", shared[0])),
+                "{t}: {suffix}"
+            );
+        }
+    }
     assert_eq!(attribute(&browser, &page, "data-players"), "ok 1");
     let shot = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("html-report/screenshot.png");
     screenshot(&browser, &page, &shot);
@@ -206,6 +228,16 @@ fn run_page_loads_clean_and_fails_on_a_broken_image_or_console_error() {
     assert!(
         v.starts_with("fail") && v.contains("cornell-laine-flip.png"),
         "{v}"
+    );
+    // ... and says so at the top of the page, where a reader of a checkout (which keeps only
+    // some of the images: results/.gitignore) sees it.
+    assert_eq!(
+        attribute(
+            &browser,
+            &broken.join("cornell-report.html"),
+            "class=\"selfcheck-fail\" role"
+        ),
+        "alert"
     );
 
     // A player whose step does not advance: its check fails.

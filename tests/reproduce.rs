@@ -338,9 +338,7 @@ fn a_paper_targets_second_quality_run_renders_no_reference() {
                 let mut v: serde_json::Value =
                     serde_json::from_slice(&std::fs::read(p).unwrap()).unwrap();
                 let q = v["quality"].take();
-                let reference = p.with_file_name(
-                    p.file_stem().unwrap().to_string_lossy().into_owned() + "-reference.png",
-                );
+                let reference = support::reference_image(p, "-reference.png");
                 (q, std::fs::read(reference).unwrap())
             })
             .collect::<Vec<_>>()

@@ -151,7 +151,10 @@ fn quality_columns_and_results() {
         q.rel_mse.mean
     );
     assert!(q.rmse.mean > 0.0 && q.flip_mean.mean > 0.0);
-    assert!(tmp.path().join("cornell-direct-reference.png").is_file());
+    assert!(
+        support::reference_image(&tmp.path().join("cornell-direct.json"), "-reference.png")
+            .is_file()
+    );
     assert!(tmp.path().join("cornell-direct-flip.png").is_file());
     // The references were cached: frames 4 and 5, one-bounce (the VPL techniques) and
     // multi-bounce (`gaitatzes`).
@@ -408,7 +411,8 @@ fn quality_run_builds_the_static_tree_once_and_movers_per_frame() {
             &out,
         );
         let r = RunResult::read(&out.join("cornell-bunny-direct.json")).unwrap();
-        let png = std::fs::read(out.join("cornell-bunny-direct-reference-frames.png")).unwrap();
+        let json = out.join("cornell-bunny-direct.json");
+        let png = std::fs::read(support::reference_image(&json, "-reference-frames.png")).unwrap();
         (
             r.quality.unwrap().reference_work.expect("reference_work"),
             png,

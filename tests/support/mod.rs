@@ -25,3 +25,20 @@ pub fn run_ok<S: AsRef<OsStr> + std::fmt::Debug>(args: &[S]) -> Output {
     );
     o
 }
+
+/// The shared reference image ending in `suffix` (`-reference.png`, `-reference-indirect.png`,
+/// `-reference-frames.png`) that the run whose results file is `json` was compared with: the
+/// run set writes it once, named after the scene and a key of its contents, and each run's
+/// `images` lists it.
+pub fn reference_image(json: &std::path::Path, suffix: &str) -> std::path::PathBuf {
+    let v: serde_json::Value = serde_json::from_slice(&std::fs::read(json).unwrap()).unwrap();
+    let stem = json.file_stem().unwrap().to_string_lossy().into_owned();
+    let name = v["images"]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .filter_map(|i| i.as_str())
+        .find(|i| i.ends_with(suffix) && !i.starts_with(&stem))
+        .unwrap_or_else(|| panic!("{}: no shared image '*{suffix}' in images", json.display()));
+    json.with_file_name(name)
+}

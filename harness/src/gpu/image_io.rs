@@ -115,22 +115,39 @@ pub fn read_rgb_f32(gpu: &GpuContext, texture: &wgpu::Texture) -> Result<Vec<[f3
         .collect())
 }
 
-/// Writes an RGBA8 image as PNG.
+/// Writes an RGBA8 image as PNG: as RGB when every pixel is opaque (every image gibench shows
+/// is), and at the encoder's best compression with adaptive filters rather than its fast
+/// default, so that the images a checkout keeps stay small (issue 51).
 pub fn write_png(path: &Path, size: [u32; 2], rgba8: &[u8]) -> Result<()> {
-    let img = image::RgbaImage::from_raw(size[0], size[1], rgba8.to_vec()).ok_or_else(|| {
+    use image::codecs::png::{CompressionType, FilterType, PngEncoder};
+    use image::{ExtendedColorType, ImageEncoder};
+    let mismatch = || {
         Error::Invalid(format!(
             "{}: image data does not match {}x{}",
             path.display(),
             size[0],
             size[1]
         ))
-    })?;
+    };
+    let pixels = size[0] as usize * size[1] as usize;
+    if rgba8.len() != pixels * 4 {
+        return Err(mismatch());
+    }
+    let opaque = rgba8.chunks_exact(4).all(|p| p[3] == 255);
+    let rgb: Vec<u8>;
+    let (data, color) = if opaque {
+        rgb = rgba8
+            .chunks_exact(4)
+            .flat_map(|p| [p[0], p[1], p[2]])
+            .collect();
+        (&rgb[..], ExtendedColorType::Rgb8)
+    } else {
+        (rgba8, ExtendedColorType::Rgba8)
+    };
     let mut bytes = Vec::new();
-    img.write_to(
-        &mut std::io::Cursor::new(&mut bytes),
-        image::ImageFormat::Png,
-    )
-    .map_err(|e| Error::bad_file(path, format!("PNG encoding failed: {e}")))?;
+    PngEncoder::new_with_quality(&mut bytes, CompressionType::Best, FilterType::Adaptive)
+        .write_image(data, size[0], size[1], color)
+        .map_err(|e| Error::bad_file(path, format!("PNG encoding failed: {e}")))?;
     crate::output::write_atomic(path, &bytes)
 }
 

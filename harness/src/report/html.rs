@@ -18,7 +18,8 @@
 //! `console.error` may occur; it records the outcome on its root element
 //! (`data-selfcheck="ok N"` for N images, else `fail …`), and whether every frame player
 //! advances to another tile of strips of the expected size (`data-players="ok N"`), which
-//! `tests/html.rs` reads from headless Chromium.
+//! `tests/html.rs` reads from headless Chromium. A failed check also shows a warning at the top
+//! of the page (a checkout keeps only some of the images: `results/.gitignore`).
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -250,15 +251,25 @@ impl Page {
                             .unwrap_or("")
                             .trim()
                             .to_string();
-                        if !references.contains(&component) && has(r, &img(QUALITY_IMAGES[1])) {
+                        // The reference's images are shared by the run set
+                        // (`reference_image_name`), listed in each run's images.
+                        let reference = |suffix: &str| {
+                            r.images
+                                .iter()
+                                .find(|i| i.ends_with(suffix) && !i.starts_with(&stem))
+                                .or_else(|| r.images.iter().find(|i| **i == img(suffix)))
+                        };
+                        if let Some(shown) = reference(QUALITY_IMAGES[1])
+                            .filter(|_| !references.contains(&component))
+                        {
                             shots.push(Shot {
                                 label: format!("reference ({component})"),
-                                url: url(folder, &img(QUALITY_IMAGES[1])),
+                                url: url(folder, shown),
                             });
-                            if has(r, &img(QUALITY_IMAGES[4])) {
+                            if let Some(indirect) = reference(QUALITY_IMAGES[4]) {
                                 shots.push(Shot {
                                     label: format!("reference ({component}), indirect only"),
-                                    url: url(folder, &img(QUALITY_IMAGES[4])),
+                                    url: url(folder, indirect),
                                 });
                             }
                             references.push(component);
@@ -343,8 +354,8 @@ impl Page {
             let Some(stem) = r
                 .images
                 .iter()
-                .find_map(|i| i.strip_suffix(QUALITY_IMAGES[5]))
-                .filter(|s| !s.ends_with("-reference"))
+                .filter_map(|i| i.strip_suffix(QUALITY_IMAGES[5]))
+                .find(|s| !s.ends_with("-reference"))
             else {
                 continue;
             };
@@ -352,8 +363,22 @@ impl Page {
                 .iter()
                 .map(|f| f.frame)
                 .collect();
-            let reference_strip = format!("{stem}{}", QUALITY_IMAGES[6]);
-            if frames.len() < 2 || !r.images.contains(&reference_strip) {
+            // Shared by the run set (`reference_image_name`); a run written before that
+            // names it after its own stem.
+            let Some(reference_strip) = r
+                .images
+                .iter()
+                .find(|i| i.ends_with(QUALITY_IMAGES[6]) && !i.starts_with(stem))
+                .or_else(|| {
+                    r.images
+                        .iter()
+                        .find(|i| **i == format!("{stem}{}", QUALITY_IMAGES[6]))
+                })
+                .cloned()
+            else {
+                continue;
+            };
+            if frames.len() < 2 {
                 continue;
             }
             let url = |name: &str| relative_url(dir, &folder.join(name));
@@ -579,6 +604,7 @@ fn url_of(relative: &str) -> String {
 }
 
 const STYLE: &str = "body{font-family:sans-serif;margin:1.5em;max-width:1400px;color:#222}\
+.selfcheck-fail{background:#fde8e8;border:1px solid #c00;padding:.5em 1em;font-weight:bold}\
 table{border-collapse:collapse;margin:.5em 0;font-size:14px}th,td{border:1px solid #ccc;padding:3px 7px;text-align:right}\
 th{background:#eee;cursor:pointer;user-select:none}td:first-child,th:first-child{text-align:left}\
 tr.paper td{background:#fff7e0;font-style:italic}.note{font-size:13px;color:#555;max-width:1100px}\
@@ -596,7 +622,11 @@ window.addEventListener('error',function(e){var t=e.target;errors.push(t&&t.tagN
 var ce=console.error;console.error=function(){errors.push(Array.prototype.join.call(arguments,' '));return ce.apply(console,arguments);};\
 window.addEventListener('load',function(){var imgs=Array.prototype.slice.call(document.images);\
 var bad=imgs.filter(function(i){return !(i.complete&&i.naturalWidth>0);}).map(function(i){return i.getAttribute('src');});\
-document.documentElement.setAttribute('data-selfcheck',(bad.length||errors.length)?('fail '+JSON.stringify({images:bad,errors:errors})):('ok '+imgs.length));});})();";
+document.documentElement.setAttribute('data-selfcheck',(bad.length||errors.length)?('fail '+JSON.stringify({images:bad,errors:errors})):('ok '+imgs.length));\
+if(bad.length||errors.length){var w=document.createElement('p');w.className='selfcheck-fail';w.setAttribute('role','alert');\
+w.textContent='This page is incomplete: '+bad.length+' image(s) did not load'+(errors.length?(' and '+errors.length+' error(s) were raised'):'')+'. '\
++'A checkout keeps only the composed images of committed results; the command on this page (or bash results/regenerate.sh) writes the rest.';\
+document.body.insertBefore(w,document.body.firstChild);}});})();";
 
 /// Sortable tables and the A/B image viewers.
 const UI_SCRIPT: &str = "document.querySelectorAll('table.sortable').forEach(function(t){\

@@ -161,7 +161,7 @@ pub fn scene_content_hash(scene: &Scene) -> u64 {
     h
 }
 
-fn fnv1a(bytes: &[u8], mut h: u64) -> u64 {
+pub(crate) fn fnv1a(bytes: &[u8], mut h: u64) -> u64 {
     for b in bytes {
         h ^= *b as u64;
         h = h.wrapping_mul(0x100000001b3);

@@ -20,11 +20,18 @@ use crate::run::runner::{Harness, PreparedTechnique, RunConfig, TimingMode};
 use crate::scene::Scene;
 use crate::{Error, Result};
 
-/// The quality pass's images, by file-name suffix after the run's stem
-/// ([`crate::run::quality::QualityImages`]). Of the last compared frame: the technique's composed
-/// image, the reference's, the FLIP error map, and the indirect light alone of the technique
-/// and of the reference at one shared exposure. Then the film strips of every compared frame's
-/// indirect light, the technique's and the reference's, which the HTML page's player shows.
+/// The quality pass's images, by file-name suffix. Of the last compared frame: the technique's
+/// composed image, the reference's, the FLIP error map, and the indirect light alone of the
+/// technique and of the reference at one shared exposure. Then the film strips of every
+/// compared frame's indirect light, the technique's and the reference's, which the HTML page's
+/// player shows.
+///
+/// The technique's images are named after its run's stem (`cornell-laine-compared.png`). The
+/// reference's three (indices 1, 4 and 6) are the same for every technique of a run set that
+/// compares with the same reference component on the same frames, so they are written once
+/// per set, named after the scene and a key of their contents ([`reference_image_name`]:
+/// `cornell-3f9a2c1d-reference-frames.png`); each run's `images` lists the ones it was
+/// compared with.
 pub const QUALITY_IMAGES: [&str; 7] = [
     "-compared.png",
     "-reference.png",
@@ -34,6 +41,32 @@ pub const QUALITY_IMAGES: [&str; 7] = [
     "-frames.png",
     "-reference-frames.png",
 ];
+
+/// The name of a reference image shared by a run set: `{scene}-{key}{suffix}`, the key being
+/// eight hex digits of a hash of the three reference images' pixels and sizes, so that runs
+/// compared with the same reference share the files and runs compared with another do not.
+pub fn reference_image_name(scene: &str, key: u32, suffix: &str) -> String {
+    format!("{scene}-{key:08x}{suffix}")
+}
+
+/// The key of [`reference_image_name`] for a quality pass's reference images.
+fn reference_key(q: &crate::run::quality::QualityImages) -> u32 {
+    use crate::run::quality::fnv1a;
+    let mut h = 0xcbf2_9ce4_8422_2325;
+    for (size, bytes) in [
+        (q.size, &q.reference_display),
+        (q.size, &q.reference_indirect_display),
+        (
+            q.reference_indirect_strip.size,
+            &q.reference_indirect_strip.rgba,
+        ),
+    ] {
+        h = fnv1a(&size[0].to_le_bytes(), h);
+        h = fnv1a(&size[1].to_le_bytes(), h);
+        h = fnv1a(bytes, h);
+    }
+    (h >> 32) as u32 ^ h as u32
+}
 
 /// The run's own images, by file-name suffix after its stem: the composed image, the indirect
 /// and the direct light (HDR).
@@ -171,8 +204,17 @@ pub fn execute_skipping(
         }
     }
     let mut results = Vec::with_capacity(prepared.len());
+    // The shared reference images written so far (each once per set).
+    let mut references_written = std::collections::HashSet::new();
     for (run, p) in &prepared {
-        results.push(execute_one(&harness, spec, run, p, progress)?);
+        results.push(execute_one(
+            &harness,
+            spec,
+            run,
+            p,
+            &mut references_written,
+            progress,
+        )?);
     }
     Ok((results, skipped))
 }
@@ -182,6 +224,7 @@ fn execute_one(
     spec: &RunSpec,
     run: &TechniqueRun,
     prepared: &PreparedTechnique,
+    references_written: &mut std::collections::HashSet<String>,
     progress: &mut dyn FnMut(Progress),
 ) -> Result<RunResult> {
     let (info, params, config) = (run.info, &run.params, &spec.config);
@@ -205,24 +248,56 @@ fn execute_one(
             })?;
         result.quality = Some(summary);
         if spec.images {
-            for (suffix, rgba) in [
-                (QUALITY_IMAGES[0], &qimages.compared_display),
-                (QUALITY_IMAGES[1], &qimages.reference_display),
-                (QUALITY_IMAGES[2], &qimages.flip_map),
-                (QUALITY_IMAGES[3], &qimages.indirect_display),
-                (QUALITY_IMAGES[4], &qimages.reference_indirect_display),
+            let key = reference_key(&qimages);
+            let scene = &spec.scene.descriptor.name;
+            for (suffix, size, rgba, shared) in [
+                (
+                    QUALITY_IMAGES[0],
+                    qimages.size,
+                    &qimages.compared_display,
+                    false,
+                ),
+                (
+                    QUALITY_IMAGES[1],
+                    qimages.size,
+                    &qimages.reference_display,
+                    true,
+                ),
+                (QUALITY_IMAGES[2], qimages.size, &qimages.flip_map, false),
+                (
+                    QUALITY_IMAGES[3],
+                    qimages.size,
+                    &qimages.indirect_display,
+                    false,
+                ),
+                (
+                    QUALITY_IMAGES[4],
+                    qimages.size,
+                    &qimages.reference_indirect_display,
+                    true,
+                ),
+                (
+                    QUALITY_IMAGES[5],
+                    qimages.indirect_strip.size,
+                    &qimages.indirect_strip.rgba,
+                    false,
+                ),
+                (
+                    QUALITY_IMAGES[6],
+                    qimages.reference_indirect_strip.size,
+                    &qimages.reference_indirect_strip.rgba,
+                    true,
+                ),
             ] {
-                let png = out(suffix);
-                write_png(&png, qimages.size, rgba)?;
-                extra_images.push(file_name(&png));
-            }
-            for (suffix, strip) in [
-                (QUALITY_IMAGES[5], &qimages.indirect_strip),
-                (QUALITY_IMAGES[6], &qimages.reference_indirect_strip),
-            ] {
-                let png = out(suffix);
-                write_png(&png, strip.size, &strip.rgba)?;
-                extra_images.push(file_name(&png));
+                let name = if shared {
+                    reference_image_name(scene, key, suffix)
+                } else {
+                    format!("{}{suffix}", run.stem)
+                };
+                if !shared || references_written.insert(name.clone()) {
+                    write_png(&spec.out.join(&name), size, rgba)?;
+                }
+                extra_images.push(name);
             }
         }
     }
