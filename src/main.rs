@@ -72,6 +72,9 @@ enum Command {
     /// Time the reference's BVH on the rays of `export-scene --rays N` (closest hit and shadow
     /// rays, wall and CPU time), for `scripts/compare_mitsuba.py --rays`.
     Raycast(RaycastArgs),
+    /// Print the adapter runs would use (`--backend`, `--adapter`); `--require-gpu` refuses a
+    /// CPU rasteriser by name (`scripts/gpu-run.sh` checks a slot's device with it).
+    Adapter(cli::adapter::AdapterArgs),
 }
 
 fn main() -> ExitCode {
@@ -92,6 +95,7 @@ fn main() -> ExitCode {
         Some(Command::ExportScene(args)) => cli::export_scene::exec(&args),
         Some(Command::Raycast(args)) => cli::raycast::exec(&args),
         Some(Command::Reproduce(args)) => cli::reproduce::exec(&args),
+        Some(Command::Adapter(args)) => cli::adapter::exec(&args),
     };
     match outcome {
         Ok(()) => ExitCode::SUCCESS,

@@ -445,6 +445,79 @@ fn a_budget_runs_what_fits_and_lists_what_it_left_out() {
     assert!(md.contains("TEST SIZE tiny"), "{md}");
 }
 
+/// Catches: within a budget (a GPU slot), one failing target costing the others (the whole
+/// output set discarded), publishing any file of the failed target, or exiting 0 after a
+/// failure. `GIBENCH_TEST_FAIL_TARGET` makes laine-management fail after writing its files.
+#[test]
+fn a_target_failing_within_a_budget_is_left_out_and_the_rest_published() {
+    let tmp = tempfile::tempdir().unwrap();
+    let first = tmp.path().join("first");
+    finish(
+        start("laine-management,laine-dispersion", &first, &[]),
+        "the first run",
+    );
+    let mut m = manifest(&first);
+    for t in m["targets"].as_array_mut().unwrap() {
+        t["seconds"] = serde_json::json!(1.0);
+        t["files"] = serde_json::json!([]);
+    }
+    let out = tmp.path().join("budget");
+    std::fs::create_dir_all(&out).unwrap();
+    std::fs::write(
+        out.join("reproduce-all.json"),
+        serde_json::to_vec(&m).unwrap(),
+    )
+    .unwrap();
+    let mut c = support::gibench();
+    for v in SHARD_VARS {
+        c.env_remove(v);
+    }
+    let o = c
+        .env("GIBENCH_TEST_SIZE", "tiny")
+        .env("GIBENCH_TEST_FAIL_TARGET", "laine-management")
+        .args([
+            "reproduce",
+            "all",
+            "--quick",
+            "--quiet",
+            "--budget",
+            "5m",
+            "--only",
+            "laine-management,laine-dispersion",
+            "--out",
+        ])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success(), "a failed target must fail the command");
+    assert!(
+        stderr.contains("1 target(s) failed and were left out: laine-management"),
+        "{stderr}"
+    );
+    assert!(out.join("laine/laine-dispersion.md").is_file(), "{stderr}");
+    assert!(
+        !out.join("laine/laine-management.md").exists(),
+        "the failed target's files were published"
+    );
+    let m = manifest(&out);
+    let entry = m["targets"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|t| t["name"] == "laine-management")
+        .unwrap()
+        .clone();
+    assert!(
+        entry["left_out"]
+            .as_str()
+            .unwrap()
+            .starts_with("failed: GIBENCH_TEST_FAIL_TARGET"),
+        "{entry}"
+    );
+    assert_eq!(entry["files"], serde_json::json!([]));
+}
+
 /// Catches: bad shard and budget values reaching the work (or a panic) instead of an error
 /// naming the option or variable and what was expected.
 #[test]

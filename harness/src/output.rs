@@ -56,6 +56,15 @@ const REPLACE_FILES: &str = "replace-files:";
 
 static ACTIVE: Mutex<Option<Active>> = Mutex::new(None);
 
+/// How far an open set had got ([`OutputSet::mark`]): the counts of its staged files, replaced
+/// subfolders and replaced patterns.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Mark {
+    staged: usize,
+    replaced: usize,
+    patterns: usize,
+}
+
 /// An open output set (see the module docs). Publish it on success; dropping it unpublished
 /// discards what was staged.
 pub struct OutputSet {
@@ -401,6 +410,39 @@ impl OutputSet {
             if !a.replaced.iter().any(|r| r == sub) {
                 a.replaced.push(sub.to_path_buf());
             }
+        }
+        Ok(())
+    }
+
+    /// Where the set stands now, for [`OutputSet::rollback`].
+    pub fn mark(&self) -> Mark {
+        ACTIVE
+            .lock()
+            .ok()
+            .and_then(|a| {
+                a.as_ref().map(|a| Mark {
+                    staged: a.staged.len(),
+                    replaced: a.replaced.len(),
+                    patterns: a.patterns.len(),
+                })
+            })
+            .unwrap_or_default()
+    }
+
+    /// Drops what was staged, and the subfolders and patterns declared replaced, since `mark`:
+    /// for a part of a command that failed while the rest is still published (a target of
+    /// `reproduce all --budget`). A file first staged before the mark and written again after
+    /// it keeps its newer content.
+    pub fn rollback(&self, mark: Mark) -> Result<()> {
+        let mut active = ACTIVE
+            .lock()
+            .map_err(|_| Error::param(&self.option, "output state poisoned"))?;
+        if let Some(a) = active.as_mut() {
+            for rel in a.staged.drain(mark.staged.min(a.staged.len())..) {
+                let _ = std::fs::remove_file(a.dir.join(STAGING).join(rel));
+            }
+            a.replaced.truncate(mark.replaced);
+            a.patterns.truncate(mark.patterns);
         }
         Ok(())
     }

@@ -11,6 +11,7 @@
 //! files and folders of them), [`progress`] (progress bars and where a command reports) and
 //! [`page`] (the HTML page a command writes with `--html`).
 
+pub(crate) mod adapter;
 pub(crate) mod compare;
 pub(crate) mod export;
 pub(crate) mod export_scene;

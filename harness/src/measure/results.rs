@@ -111,6 +111,26 @@ pub struct DeviceInfo {
     pub timestamp_period_ns: f32,
 }
 
+impl DeviceInfo {
+    /// Whether the adapter is a CPU rasteriser rather than a GPU: wgpu's CPU device type, or a
+    /// name of the software drivers (Mesa's llvmpipe, lavapipe and softpipe, SwiftShader,
+    /// Microsoft's WARP, "Basic Render Driver"), which some backends report as another type.
+    pub fn is_software(&self) -> bool {
+        let name = format!("{} {}", self.adapter, self.driver).to_lowercase();
+        self.device_type == "Cpu"
+            || [
+                "llvmpipe",
+                "lavapipe",
+                "softpipe",
+                "swiftshader",
+                "basic render driver",
+                "warp",
+            ]
+            .iter()
+            .any(|s| name.contains(s))
+    }
+}
+
 /// Frames: how many were measured, how many warm-up frames were dropped before them.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct FrameRange {

@@ -149,8 +149,26 @@ pub fn reproduce(args: &ReproduceArgs) -> Result<()> {
     manifest.write_index(&root)?;
     set.publish()?;
     println!("{}", manifest.listing(&root));
+    let failed: Vec<&str> = manifest
+        .targets
+        .iter()
+        .filter(|t| t.left_out.as_deref().is_some_and(|w| w.starts_with(FAILED)))
+        .map(|t| t.name.as_str())
+        .collect();
+    if !failed.is_empty() {
+        return Err(Error::Invalid(format!(
+            "{} target(s) failed and were left out: {} (reproduce-all.json says why); the \
+             others are published in {}",
+            failed.len(),
+            failed.join(", "),
+            root.display()
+        )));
+    }
     Ok(())
 }
+
+/// How a target that failed within a budget is recorded as left out.
+const FAILED: &str = "failed: ";
 
 /// The targets of shard `s`: the selection split by [`crate::cli::shard::assign`] on the
 /// estimates of the committed manifest (the same file on every machine of a checkout), a
@@ -365,9 +383,31 @@ fn run_targets(
             spans[i],
             p.work.frames,
         );
+        let mark = set.mark();
         claim_folders(set, p.target)?;
         let t = Instant::now();
-        let done = p.run(gpu, &Bars::Shared(&overall))?;
+        let done = match p.run(gpu, &Bars::Shared(&overall)) {
+            Ok(done) => done,
+            // Within a budget (a short GPU slot) one target's failure does not cost the
+            // others: it is left out with its error, nothing of it is published, the rest go on,
+            // and the command fails after publishing.
+            Err(e) if budget.is_some() => {
+                set.rollback(mark)?;
+                before = set.staged().len();
+                let why = format!("{FAILED}{e}");
+                overall.note(&format!("{} {why}", p.target.name));
+                records[i] = Some(record(
+                    p,
+                    estimates[i],
+                    adapter,
+                    None,
+                    Vec::new(),
+                    Some(why),
+                ));
+                continue;
+            }
+            Err(e) => return Err(e),
+        };
         let seconds = t.elapsed().as_secs_f64();
         if let Some(Some((e, from))) = budget.map(|b| &b.measured[i]) {
             if p.needs_gpu() && *from != adapter {

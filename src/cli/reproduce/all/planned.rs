@@ -125,8 +125,21 @@ impl Planned {
         }
     }
 
-    /// Runs the target; returns a line saying what it wrote.
+    /// Runs the target; returns a line saying what it wrote. `GIBENCH_TEST_FAIL_TARGET=NAME`
+    /// makes target NAME fail after it has written its files: how the tests try a failure
+    /// within a budget (`reproduce all --budget` leaves it out and publishes the rest).
     pub(super) fn run(&self, gpu: Option<&GpuContext>, bars: &Bars) -> Result<String> {
+        let done = self.run_target(gpu, bars)?;
+        if std::env::var("GIBENCH_TEST_FAIL_TARGET").is_ok_and(|v| v == self.target.name) {
+            return Err(Error::Invalid(format!(
+                "GIBENCH_TEST_FAIL_TARGET: target '{}' failed on purpose after writing its files",
+                self.target.name
+            )));
+        }
+        Ok(done)
+    }
+
+    fn run_target(&self, gpu: Option<&GpuContext>, bars: &Bars) -> Result<String> {
         match (&self.job, &self.target.kind) {
             (Some(job), _) => job.execute(gpu, bars),
             (None, Kind::Command { .. }) => Err(Error::Invalid(format!(
