@@ -698,6 +698,39 @@ fn the_tracked_tree_stays_under_32_mib() {
     );
 }
 
+/// The house's limit on a source file, in lines (docs/architecture.md): past it a file is split
+/// by concern.
+const SOURCE_MAX_LINES: usize = 900;
+
+/// Every Rust source file of the repository (but `target/` and hidden folders), relative.
+fn rust_sources(root: &Path) -> Vec<PathBuf> {
+    let mut files = Vec::new();
+    walk(root, Path::new(""), &["target", "results"], &mut files);
+    files.retain(|f| f.extension().is_some_and(|e| e == "rs"));
+    files
+}
+
+#[test]
+fn no_source_file_passes_900_lines() {
+    let root = root();
+    let sources = rust_sources(&root);
+    assert!(
+        sources.iter().any(|f| f.ends_with("src/main.rs")) && sources.len() > 100,
+        "the walk found too few sources: {sources:?}"
+    );
+    let long: Vec<String> = sources
+        .iter()
+        .filter_map(|f| {
+            let n = std::fs::read_to_string(root.join(f)).ok()?.lines().count();
+            (n > SOURCE_MAX_LINES).then(|| format!("{} ({n} lines)", f.display()))
+        })
+        .collect();
+    assert!(
+        long.is_empty(),
+        "source files over {SOURCE_MAX_LINES} lines (split them by concern): {long:?}"
+    );
+}
+
 #[test]
 fn every_link_in_the_readme_docs_and_results_readmes_is_alive() {
     let root = root();

@@ -56,6 +56,9 @@ const REPLACE_FILES: &str = "replace-files:";
 
 static ACTIVE: Mutex<Option<Active>> = Mutex::new(None);
 
+mod lock;
+use lock::{FolderLock, LockError};
+
 /// How far an open set had got ([`OutputSet::mark`]): the counts of its staged files, replaced
 /// subfolders and replaced patterns.
 #[derive(Clone, Copy, Debug, Default)]
@@ -159,92 +162,6 @@ fn resolve(path: &Path) -> PathBuf {
             _ => return abs,
         }
     }
-}
-
-/// Why the folder's lock could not be taken.
-#[derive(Debug)]
-enum LockError {
-    /// Another process holds it (its process id, if it has written it yet).
-    InUse(Option<u32>),
-    Other(String),
-}
-
-/// The operating system's exclusive lock on a folder's `.gibench.lock`, held while the file is
-/// open and released by the operating system when the process ends, however it ends.
-#[derive(Debug)]
-struct FolderLock {
-    file: std::fs::File,
-    path: PathBuf,
-}
-
-impl FolderLock {
-    /// Takes the lock of `dir` (which exists), writing this process's id into the lock file.
-    fn take(dir: &Path) -> std::result::Result<FolderLock, LockError> {
-        use std::io::Write;
-        let path = dir.join(LOCK);
-        if path.is_dir() {
-            return Err(LockError::Other(format!(
-                "{} is a folder, not gibench's lock file; remove it",
-                path.display()
-            )));
-        }
-        let other = |what: &str, e: std::io::Error| {
-            LockError::Other(format!("cannot {what} {}: {e}", path.display()))
-        };
-        loop {
-            let mut file = std::fs::OpenOptions::new()
-                .read(true)
-                .write(true)
-                .create(true)
-                .truncate(false)
-                .open(&path)
-                .map_err(|e| other("open", e))?;
-            match file.try_lock() {
-                Ok(()) => {}
-                Err(std::fs::TryLockError::WouldBlock) => {
-                    let pid = std::fs::read_to_string(&path)
-                        .ok()
-                        .and_then(|s| s.trim().parse::<u32>().ok());
-                    return Err(LockError::InUse(pid));
-                }
-                Err(std::fs::TryLockError::Error(e)) => return Err(other("lock", e)),
-            }
-            // A command that finishes removes its lock file while holding the lock; one that
-            // opened the file before that holds the lock of a removed file, and tries again.
-            if !same_file(&file, &path) {
-                continue;
-            }
-            file.set_len(0).map_err(|e| other("write", e))?;
-            file.write_all(std::process::id().to_string().as_bytes())
-                .map_err(|e| other("write", e))?;
-            return Ok(FolderLock { file, path });
-        }
-    }
-
-    /// Removes the lock file (where the platform lets a lock's file be identified, so that a
-    /// removed one is never mistaken for the current one), then releases the lock.
-    fn release(self) {
-        if cfg!(unix) {
-            let _ = std::fs::remove_file(&self.path);
-        }
-        drop(self.file);
-    }
-}
-
-/// Whether the open `file` is the file now at `path`.
-#[cfg(unix)]
-fn same_file(file: &std::fs::File, path: &Path) -> bool {
-    use std::os::unix::fs::MetadataExt;
-    match (file.metadata(), std::fs::metadata(path)) {
-        (Ok(a), Ok(b)) => a.dev() == b.dev() && a.ino() == b.ino(),
-        _ => false,
-    }
-}
-
-/// Elsewhere the lock file is never removed, so the open file is the one at `path`.
-#[cfg(not(unix))]
-fn same_file(_: &std::fs::File, path: &Path) -> bool {
-    path.is_file()
 }
 
 /// Refuses `dir` if a folder below it (not `dir` itself) is a symbolic link: a command writes,
