@@ -492,6 +492,96 @@ pub fn compare_table(rows: &[CompareRow], settings: &Settings) -> Table {
     }
 }
 
+/// The comparison as the short Markdown a reviewer reads in a pull request's comment or a CI
+/// job's summary (`gibench compare --format markdown`): a title naming both sides, the rows
+/// that changed (*slower* first, largest ratio first; then *faster*, smallest ratio first)
+/// with run, stage, both medians, the ratio the verdict was decided on, p and the verdict, then
+/// one line counting the unchanged stages, then `notes` (runs not compared). `sides` are the
+/// BASE and CURRENT folders as given.
+pub fn compare_markdown(
+    rows: &[CompareRow],
+    settings: &Settings,
+    sides: [&str; 2],
+    notes: &[String],
+) -> String {
+    let cell = |s: &str| s.replace('|', "\\|");
+    let code = |s: &str| format!("`{}`", s.replace('`', "'"));
+    let mut out = format!(
+        "### gibench compare: {} (CURRENT) against {} (BASE)\n\n",
+        code(sides[1]),
+        code(sides[0])
+    );
+    let count = |v: Verdict| rows.iter().filter(|r| r.verdict == v).count();
+    let (slower, faster) = (count(Verdict::Slower), count(Verdict::Faster));
+    let unchanged = rows.len() - slower - faster;
+    out.push_str(&format!(
+        "**{slower} slower, {faster} faster**, {unchanged} unchanged of {} stages. Each \
+         repeat's {}{}; a verdict needs p < {} (two-sided Mann–Whitney U) and a ratio beyond \
+         {:.2} or {:.3}.\n\n",
+        rows.len(),
+        settings.statistic.name(),
+        if settings.calibrate {
+            ", divided by its session's calibration"
+        } else {
+            ", raw"
+        },
+        settings.alpha,
+        1.0 + settings.tolerance,
+        1.0 / (1.0 + settings.tolerance),
+    ));
+    // Slower by ratio, largest first; faster by ratio, smallest first (a stage timed at 0 ms
+    // on one side has no ratio and leads its group).
+    let key = |r: &&CompareRow, sign: f64| r.ratio.map_or(f64::NEG_INFINITY, |x| sign * x);
+    let mut changed: Vec<&CompareRow> = rows
+        .iter()
+        .filter(|r| r.verdict == Verdict::Slower)
+        .collect();
+    changed.sort_by(|a, b| key(a, -1.0).total_cmp(&key(b, -1.0)));
+    let mut better: Vec<&CompareRow> = rows
+        .iter()
+        .filter(|r| r.verdict == Verdict::Faster)
+        .collect();
+    better.sort_by(|a, b| key(a, 1.0).total_cmp(&key(b, 1.0)));
+    changed.extend(better);
+    if changed.is_empty() {
+        out.push_str("No stage is slower or faster.\n\n");
+    } else {
+        out.push_str(&format!(
+            "| run | stage | base ms | current ms | ratio{} | p | verdict |\n\
+             |---|---|---:|---:|---:|---:|---|\n",
+            if settings.calibrate {
+                " (calibrated)"
+            } else {
+                ""
+            }
+        ));
+        for r in changed {
+            let verdict = match r.verdict {
+                Verdict::Slower => "**slower**",
+                v => v.name(),
+            };
+            out.push_str(&format!(
+                "| {} | {} | {} | {} | {} | {} | {verdict} |\n",
+                cell(&r.run),
+                cell(&r.stage),
+                Cell::Ms(Some(r.base_ms)).display(),
+                Cell::Ms(Some(r.current_ms)).display(),
+                Cell::Num(r.ratio, 3).display(),
+                r.p_value.map_or("–".to_string(), |p| format!("{p:.4}")),
+            ));
+        }
+        out.push('\n');
+    }
+    out.push_str(&format!(
+        "Unchanged: {unchanged} of {} stages.\n",
+        rows.len()
+    ));
+    for note in notes {
+        out.push_str(&format!("\n{note}\n"));
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
