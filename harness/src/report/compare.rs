@@ -492,6 +492,54 @@ pub fn compare_table(rows: &[CompareRow], settings: &Settings) -> Table {
     }
 }
 
+/// Each run's label for [`compare_markdown`]: its [`run_key`] without the parameters that all
+/// compared runs of its scene, technique and resolution share (`cornell/laine/128x96` when it
+/// is the only one; `cornell/ism/256x192 (vpls=256)` among a sweep's points). The parameters
+/// are read back from the key (`NAME=VALUE` pairs joined by ", "); a key that does not parse so
+/// keeps its whole self.
+fn short_labels(rows: &[CompareRow]) -> BTreeMap<&str, String> {
+    type Params<'a> = Vec<(&'a str, &'a str)>;
+    let mut by_base: BTreeMap<&str, Vec<(&str, Params)>> = BTreeMap::new();
+    for r in rows {
+        let (base, params) = match r.run.split_once(" (") {
+            Some((base, rest)) => {
+                let inner = rest.strip_suffix(')').unwrap_or(rest);
+                let pairs: Option<Params> =
+                    inner.split(", ").map(|kv| kv.split_once('=')).collect();
+                match pairs {
+                    Some(p) => (base, p),
+                    None => continue,
+                }
+            }
+            None => (r.run.as_str(), Vec::new()),
+        };
+        let runs = by_base.entry(base).or_default();
+        if !runs.iter().any(|(k, _)| *k == r.run.as_str()) {
+            runs.push((r.run.as_str(), params));
+        }
+    }
+    let mut labels = BTreeMap::new();
+    for (base, runs) in by_base {
+        for (key, params) in &runs {
+            let differing: Vec<String> = params
+                .iter()
+                .filter(|(k, v)| {
+                    runs.iter()
+                        .any(|(_, other)| !other.iter().any(|(ok, ov)| ok == k && ov == v))
+                })
+                .map(|(k, v)| format!("{k}={v}"))
+                .collect();
+            let label = if differing.is_empty() {
+                base.to_string()
+            } else {
+                format!("{base} ({})", differing.join(", "))
+            };
+            labels.insert(*key, label);
+        }
+    }
+    labels
+}
+
 /// The comparison as the short Markdown a reviewer reads in a pull request's comment or a CI
 /// job's summary (`gibench compare --format markdown`): a title naming both sides, the rows
 /// that changed (*slower* first, largest ratio first; then *faster*, smallest ratio first)
@@ -543,6 +591,7 @@ pub fn compare_markdown(
         .collect();
     better.sort_by(|a, b| key(a, 1.0).total_cmp(&key(b, 1.0)));
     changed.extend(better);
+    let labels = short_labels(rows);
     if changed.is_empty() {
         out.push_str("No stage is slower or faster.\n\n");
     } else {
@@ -562,7 +611,7 @@ pub fn compare_markdown(
             };
             out.push_str(&format!(
                 "| {} | {} | {} | {} | {} | {} | {verdict} |\n",
-                cell(&r.run),
+                cell(labels.get(r.run.as_str()).map_or(&r.run, |l| l)),
                 cell(&r.stage),
                 Cell::Ms(Some(r.base_ms)).display(),
                 Cell::Ms(Some(r.current_ms)).display(),
@@ -811,5 +860,53 @@ mod tests {
             rows.iter().find(|r| r.stage == "a").unwrap().verdict,
             Verdict::Faster
         );
+    }
+
+    /// The Markdown's run labels keep only the parameters that tell the compared runs of one
+    /// scene, technique and resolution apart, and none for a run alone; the regression leads.
+    #[test]
+    fn markdown_labels_name_only_differing_parameters() {
+        let row = |run: &str, stage: &str, verdict: Verdict, ratio: f64| CompareRow {
+            run: run.to_string(),
+            stage: stage.to_string(),
+            base_ms: 1.0,
+            current_ms: ratio,
+            statistic: Statistic::Min,
+            ratio_raw: Some(ratio),
+            ratio: Some(ratio),
+            ratio_calibrated: None,
+            calibrated: false,
+            p_value: Some(0.008),
+            p_exact: true,
+            verdict,
+            repeats: [5, 5],
+            cpu_ms: None,
+        };
+        let (a, b) = (
+            "cornell/ism/256x192 (tiles=4x4, vpls=256)",
+            "cornell/ism/256x192 (tiles=4x4, vpls=1024)",
+        );
+        let rows = [
+            row(a, "pull-push", Verdict::Faster, 0.5),
+            row(
+                "cornell/laine/128x96 (vpls=64)",
+                "compose",
+                Verdict::Unchanged,
+                1.0,
+            ),
+            row(b, "split", Verdict::Slower, 1.4),
+        ];
+        let md = compare_markdown(&rows, &Settings::default(), ["b", "c"], &[]);
+        let lines: Vec<&str> = md.lines().filter(|l| l.starts_with("| cornell")).collect();
+        assert_eq!(lines.len(), 2, "{md}");
+        assert!(
+            lines[0].starts_with("| cornell/ism/256x192 (vpls=1024) | split |"),
+            "{md}"
+        );
+        assert!(
+            lines[1].starts_with("| cornell/ism/256x192 (vpls=256) | pull-push |"),
+            "{md}"
+        );
+        assert!(md.contains("Unchanged: 1 of 3 stages."), "{md}");
     }
 }
