@@ -35,6 +35,10 @@
 //!   *unchanged* otherwise (and the reverse for *faster*).
 //!
 //! CPU stages also report the median thread CPU time of each side.
+//!
+//! [`compare_table`] renders every row (terminal, Markdown, CSV, LaTeX files);
+//! [`compare_markdown`] only the changed ones, regressions first, for a review
+//! (`gibench compare --format markdown`).
 
 use std::collections::BTreeMap;
 
