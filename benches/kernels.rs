@@ -23,6 +23,8 @@ mod registry;
 
 /// A criterion measurement: the CPU time of every thread of the process, in nanoseconds (where
 /// the platform has no such clock it reads 0 and the bench says so).
+/// The groups measured with it end in `-cpu`: `gibench export --criterion` exports those as
+/// the `cpu-time` measure, the others as `latency`.
 struct ProcessCpuTime;
 
 impl Measurement for ProcessCpuTime {

@@ -89,7 +89,10 @@ fn main() -> ExitCode {
         Some(Command::Sweep(args)) => cli::sweep::exec(&args),
         Some(Command::Merge(args)) => cli::merge::exec(&args),
         Some(Command::PlotQuality(args)) => cli::plot_quality::exec(&args),
-        Some(Command::Compare(args)) => cli::compare::exec(&args),
+        Some(Command::Compare(args)) => match cli::compare::exec(&args) {
+            Ok(status) => return status,
+            Err(e) => Err(e),
+        },
         Some(Command::Export(args)) => cli::export::exec(&args),
         Some(Command::Instructions(args)) => cli::instructions::exec(&args),
         Some(Command::ExportScene(args)) => cli::export_scene::exec(&args),

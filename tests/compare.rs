@@ -172,6 +172,135 @@ fn verdicts_on_synthetic_results_are_exact() {
     assert!(busy.iter().all(|(_, v)| v == "unchanged"), "{busy:?}");
 }
 
+/// `gibench compare BASE CURRENT --format markdown OPTIONS`: exit code, standard output,
+/// standard error.
+fn compare_markdown(
+    dir: &Path,
+    base: &str,
+    current: &str,
+    options: &[&str],
+) -> (Option<i32>, String, String) {
+    let out = dir.join(format!("md-{base}-{current}").replace('/', "-"));
+    let o = support::gibench()
+        .arg("compare")
+        .arg(dir.join(base))
+        .arg(dir.join(current))
+        .args(["--format", "markdown"])
+        .args(options)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    (
+        o.status.code(),
+        String::from_utf8_lossy(&o.stdout).into_owned(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+/// The line of `md` holding the table row of `stage`, or `None`.
+fn row_of(md: &str, stage: &str) -> Option<usize> {
+    md.lines()
+        .position(|l| l.starts_with("| ") && l.contains(&format!(" | {stage} | ")))
+}
+
+/// `--format markdown` on synthetic runs where `compose` is 1.5 times slower and `gbuffer` 0.5
+/// times the time: a title naming both folders, the regression's row before the improvement's,
+/// both before the one line counting the two unchanged stages, which get no row; the default
+/// output stays the terminal table. `--fail-on slower` exits with status 3 there and 0 on
+/// the same build (without it, 0 either way); `--fail-on faster` and `any-change` judge the
+/// improvement. Catches rows in the table's order (compose comes last), unchanged stages
+/// listed, a status that ignores the verdicts or fires without the flag.
+#[test]
+fn markdown_lists_regressions_first_and_fail_on_sets_the_status() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let cal = serde_json::json!(10.0);
+    synthetic(&dir.join("base"), &BASE, |_| 1.0, cal.clone());
+    let same = [1.01, 0.99, 1.02, 1.0, 0.985];
+    synthetic(&dir.join("same"), &same, |_| 1.0, cal.clone());
+    let mixed = |s: &str| match s {
+        "compose" => 1.5,
+        "gbuffer" => 0.5,
+        _ => 1.0,
+    };
+    synthetic(&dir.join("mixed"), &same, mixed, cal);
+
+    let (code, md, stderr) = compare_markdown(dir, "base", "mixed", &[]);
+    assert_eq!(code, Some(0), "{stderr}");
+    let title = md.lines().next().unwrap_or_default();
+    assert!(
+        title.starts_with("### ")
+            && title.contains(&dir.join("mixed").display().to_string())
+            && title.contains(&dir.join("base").display().to_string()),
+        "{md}"
+    );
+    let (slower, faster) = (row_of(&md, "compose"), row_of(&md, "gbuffer"));
+    let unchanged = md
+        .lines()
+        .position(|l| l.starts_with("Unchanged: 2 of 4 stages"));
+    assert!(
+        slower.is_some() && slower < faster && faster < unchanged,
+        "slower, faster, then the unchanged count:\n{md}"
+    );
+    let compose = md.lines().nth(slower.unwrap()).unwrap();
+    assert!(
+        compose.contains("cornell/direct/128x96") && compose.contains("slower"),
+        "{compose}"
+    );
+    assert!(md.lines().nth(faster.unwrap()).unwrap().contains("faster"));
+    for stage in ["direct-light", "direct-shadow-map"] {
+        assert_eq!(
+            row_of(&md, stage),
+            None,
+            "{stage} is unchanged: no row\n{md}"
+        );
+    }
+    let (code, md, _) = compare_markdown(dir, "base", "same", &[]);
+    assert_eq!(code, Some(0));
+    assert!(
+        md.contains("No stage is slower or faster") && md.contains("Unchanged: 4 of 4"),
+        "{md}"
+    );
+    // The default output is the terminal table, as before.
+    let o = support::gibench()
+        .arg("compare")
+        .arg(dir.join("base"))
+        .arg(dir.join("mixed"))
+        .arg("--out")
+        .arg(dir.join("default"))
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success()
+            && stdout.contains("Comparison: 1 slower, 1 faster, 2 unchanged")
+            && !stdout.contains("###"),
+        "{stdout}"
+    );
+
+    for (current, fail_on, want) in [
+        ("mixed", "slower", 3),
+        ("same", "slower", 0),
+        ("mixed", "faster", 3),
+        ("mixed", "any-change", 3),
+        ("same", "any-change", 0),
+    ] {
+        let (code, md, stderr) = compare_markdown(dir, "base", current, &["--fail-on", fail_on]);
+        assert_eq!(code, Some(want), "{current} --fail-on {fail_on}: {stderr}");
+        assert!(md.starts_with("### "), "printed before exiting: {md}");
+    }
+    // An improvement alone does not fail `--fail-on slower`.
+    synthetic(
+        &dir.join("better"),
+        &same,
+        |s| if s == "gbuffer" { 0.5 } else { 1.0 },
+        serde_json::json!(10.0),
+    );
+    let (code, _, stderr) = compare_markdown(dir, "base", "better", &["--fail-on", "slower"]);
+    assert_eq!(code, Some(0), "{stderr}");
+}
+
 /// A run on one side only (here `direct` with a parameter it gained since BASE was run) is
 /// listed as not compared, in the terminal and in the table's notes; with `--require-all` the
 /// command fails naming it, before writing anything. Catches the comparison passing over such
@@ -460,6 +589,20 @@ fn compare_runs_end_to_end() {
         let (ok, rows, stderr) = compare_with(dir, &base, &slow, &options);
         assert!(ok, "{stderr}");
         assert_eq!(rows.len(), STAGES.len(), "{rows:?}");
+        if t == 0 {
+            // The Markdown and `--fail-on slower` on real runs: the slowed stage is the first
+            // row and sets status 3; the same build prints no row and exits 0.
+            let (code, md, stderr) = compare_markdown(dir, &base, &slow, &["--fail-on", "slower"]);
+            assert_eq!(code, Some(3), "{stderr}\n{md}");
+            let first = md.lines().find(|l| l.starts_with("| cornell/"));
+            assert!(
+                first.is_some_and(|l| l.contains(" | compose | ") && l.contains("slower")),
+                "{md}"
+            );
+            let (code, md, stderr) = compare_markdown(dir, &base, &same, &["--fail-on", "slower"]);
+            assert_eq!(code, Some(0), "{stderr}\n{md}");
+            assert!(md.contains("No stage is slower or faster"), "{md}");
+        }
         for (stage, verdict) in &rows {
             let want = if stage == "compose" {
                 "slower"

@@ -241,5 +241,222 @@ fn export_names_bad_input() {
     );
     let e = run(&["export".as_ref(), "--format".as_ref(), "bmf".as_ref()]);
     assert!(e.contains("inputs"), "{e}");
+    // Two runs whose names would print alike: one without the parameter `gained`, one whose
+    // `gained` is the word that stands for a missing value.
+    let two = dir.join("two");
+    std::fs::create_dir_all(&two).unwrap();
+    let mut v: Value = serde_json::from_slice(
+        &std::fs::read(root().join("results/baseline/r1/cornell-direct.json")).unwrap(),
+    )
+    .unwrap();
+    std::fs::write(two.join("a.json"), serde_json::to_vec(&v).unwrap()).unwrap();
+    v["parameters"]["gained"] = "absent".into();
+    std::fs::write(two.join("b.json"), serde_json::to_vec(&v).unwrap()).unwrap();
+    let e = run(&[
+        "export".as_ref(),
+        "--format".as_ref(),
+        "bmf".as_ref(),
+        two.as_os_str(),
+        "--out".as_ref(),
+        out.as_os_str(),
+    ]);
+    assert!(
+        e.contains("inputs") && e.contains("cornell@128x96/direct/gained=absent"),
+        "{e}"
+    );
     assert!(!out.exists());
+}
+
+/// The distinct benchmark prefixes (names without their last segment, the stage) of `doc`.
+fn prefixes(doc: &Value) -> std::collections::BTreeSet<String> {
+    doc.as_object()
+        .unwrap()
+        .keys()
+        .map(|k| k.rsplit_once('/').unwrap().0.to_string())
+        .collect()
+}
+
+/// `gibench export --format bmf DIRS...`'s document.
+fn export(dirs: &[&Path]) -> Value {
+    let mut args: Vec<&std::ffi::OsStr> =
+        vec!["export".as_ref(), "--format".as_ref(), "bmf".as_ref()];
+    args.extend(dirs.iter().map(|d| d.as_os_str()));
+    let o = support::run_ok(&args);
+    serde_json::from_slice(&o.stdout).unwrap()
+}
+
+/// A whole reproduction exports: the committed `results/` folder (its sweeps, where runs of
+/// one scene, resolution and technique differ only in parameters, and runs of one technique
+/// made with other frame counts by different targets) gives one document that passes the
+/// documented shape, with every point of the ISM VPL-count and Keller tile sweeps under its
+/// own name; a sweep's folder alone names only the swept parameter
+/// (`cornell@256x192/ism/vpls=1024/...`), the baseline's repeats stay one benchmark and a
+/// single run keeps the short name. Catches the old refusal ("two runs would share the
+/// benchmark names"), sweep points folded together as repeats, and names that carry every
+/// parameter (this test failed so).
+#[test]
+fn a_whole_reproduction_exports_with_sweep_points_apart() {
+    let results = root().join("results");
+    let doc = export(&[&results]);
+    let n = check_bmf_shape(&doc).unwrap_or_else(|e| panic!("{e}"));
+    assert!(n > 1000, "{n} metrics");
+    let names = prefixes(&doc);
+    // The values of `param` in the results files of the sweep folder `dir`.
+    let swept = |dir: &str, param: &str| -> Vec<String> {
+        let mut v: Vec<String> = std::fs::read_dir(results.join(dir))
+            .unwrap()
+            .filter_map(|e| {
+                let p = e.unwrap().path();
+                let v: Value = serde_json::from_slice(&std::fs::read(&p).ok()?).ok()?;
+                let x = &v["parameters"][param];
+                Some(x.as_str().map_or(x.to_string(), String::from)).filter(|_| !x.is_null())
+            })
+            .collect();
+        v.sort();
+        v
+    };
+    // Every point of two sweeps is a benchmark of its own, in the whole export (where other
+    // parameters and frame counts differ too) and in its folder's alone (where only the swept
+    // parameter is named).
+    for (dir, prefix, param) in [
+        ("ism/vpls", "cornell@256x192/ism", "vpls"),
+        ("keller/tiles", "cornell@256x192/keller-full", "tiles"),
+    ] {
+        let values = swept(dir, param);
+        assert!(values.len() >= 3, "{dir}: {values:?}");
+        let alone = prefixes(&export(&[&results.join(dir)]));
+        let want: std::collections::BTreeSet<String> = values
+            .iter()
+            .map(|v| format!("{prefix}/{param}={v}"))
+            .collect();
+        assert_eq!(alone, want, "{dir}");
+        for v in &values {
+            let named = |n: &&String| {
+                n.strip_prefix(&format!("{prefix}/"))
+                    .is_some_and(|rest| rest.split(',').any(|kv| kv == format!("{param}={v}")))
+            };
+            assert!(names.iter().any(|n| named(&n)), "{param}={v} in {names:#?}");
+        }
+    }
+    // The baseline's five repeats of a run are one benchmark.
+    let baseline = prefixes(&export(&[&results.join("baseline")]));
+    assert!(baseline.contains("cornell@128x96/laine"), "{baseline:?}");
+    // A single run keeps today's short name.
+    let tmp = tempfile::tempdir().unwrap();
+    std::fs::copy(
+        results.join("baseline/r1/cornell-laine.json"),
+        tmp.path().join("cornell-laine.json"),
+    )
+    .unwrap();
+    let one = prefixes(&export(&[tmp.path()]));
+    assert_eq!(
+        one.into_iter().collect::<Vec<_>>(),
+        ["cornell@128x96/laine"]
+    );
+}
+
+/// Criterion's output folder (`--criterion`): `tests/fixtures/criterion` holds three
+/// benchmarks' `new/benchmark.json` and `new/estimates.json` copied from a real `cargo bench
+/// --bench kernels` (two wall-time, one `reference-cpu` bench in CPU time); a saved baseline
+/// (`base/`, here with every figure doubled) and an HTML report folder are added beside them.
+/// The export passes the documented shape, names each benchmark `kernels/<criterion id>`,
+/// gives the mean's point estimate with its confidence interval in nanoseconds as `latency`
+/// (`cpu-time` for the `-cpu` groups), and reads only `new/`. Catches the baseline read
+/// instead of the latest run (or both, which would collide), a misread estimate (the median,
+/// or the standard error as a bound), and a missing folder accepted.
+#[test]
+fn criterion_benchmarks_export_as_kernels() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("criterion");
+    let fixture = root().join("tests/fixtures/criterion");
+    let mut estimates = std::collections::BTreeMap::new();
+    for bench in std::fs::read_dir(&fixture).unwrap() {
+        let bench = bench.unwrap().path();
+        let to = dir.join(bench.file_name().unwrap());
+        for sub in ["new", "base"] {
+            std::fs::create_dir_all(to.join(sub)).unwrap();
+            std::fs::copy(
+                bench.join("new/benchmark.json"),
+                to.join(sub).join("benchmark.json"),
+            )
+            .unwrap();
+        }
+        std::fs::create_dir_all(to.join("report")).unwrap();
+        std::fs::write(to.join("report/index.html"), "<html></html>").unwrap();
+        let est: Value =
+            serde_json::from_slice(&std::fs::read(bench.join("new/estimates.json")).unwrap())
+                .unwrap();
+        std::fs::write(
+            to.join("new/estimates.json"),
+            serde_json::to_vec(&est).unwrap(),
+        )
+        .unwrap();
+        let mut base = est.clone();
+        for k in ["mean", "median", "slope"] {
+            if let Some(m) = base.get_mut(k).filter(|m| m.is_object()) {
+                m["point_estimate"] = (m["point_estimate"].as_f64().unwrap() * 2.0).into();
+            }
+        }
+        std::fs::write(
+            to.join("base/estimates.json"),
+            serde_json::to_vec(&base).unwrap(),
+        )
+        .unwrap();
+        let id: Value =
+            serde_json::from_slice(&std::fs::read(bench.join("new/benchmark.json")).unwrap())
+                .unwrap();
+        estimates.insert(id["full_id"].as_str().unwrap().to_string(), est);
+    }
+    assert_eq!(estimates.len(), 3);
+    let out = tmp.path().join("bmf.json");
+    support::run_ok(&[
+        "export".as_ref(),
+        "--format".as_ref(),
+        "bmf".as_ref(),
+        "--criterion".as_ref(),
+        dir.as_os_str(),
+        "--out".as_ref(),
+        out.as_os_str(),
+    ]);
+    let doc: Value = serde_json::from_slice(&std::fs::read(&out).unwrap()).unwrap();
+    assert_eq!(check_bmf_shape(&doc), Ok(3), "{doc:#}");
+    for (id, est) in &estimates {
+        let measure = if id.starts_with("reference-cpu/") {
+            "cpu-time"
+        } else {
+            "latency"
+        };
+        let m = &doc[format!("kernels/{id}")][measure];
+        let mean = &est["mean"];
+        assert_eq!(m["value"], mean["point_estimate"], "{id}: {m}");
+        assert_eq!(
+            m["lower_value"], mean["confidence_interval"]["lower_bound"],
+            "{id}"
+        );
+        assert_eq!(
+            m["upper_value"], mean["confidence_interval"]["upper_bound"],
+            "{id}"
+        );
+    }
+    assert!(
+        doc["kernels/rays/closest-hit-1024/cornell"]["latency"]["value"]
+            .as_f64()
+            .unwrap()
+            > 1e3
+    );
+
+    let empty = tmp.path().join("empty");
+    std::fs::create_dir_all(&empty).unwrap();
+    for bad in [&empty, &tmp.path().join("missing")] {
+        let o = support::gibench()
+            .args(["export", "--format", "bmf", "--criterion"])
+            .arg(bad)
+            .output()
+            .unwrap();
+        let e = String::from_utf8_lossy(&o.stderr);
+        assert!(
+            !o.status.success() && e.contains("criterion") && e.contains("target/criterion"),
+            "{e}"
+        );
+    }
 }

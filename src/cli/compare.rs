@@ -1,13 +1,18 @@
 //! `gibench compare`: CURRENT runs against BASE runs stage by stage, with a rank test's
 //! p-value, the median ratio and a verdict, refusing to compare runs with themselves.
+//!
+//! `--format markdown` prints the short Markdown of a pull request's comment or a CI job's
+//! summary instead of the terminal table; `--fail-on slower` makes a regression exit with
+//! [`CHANGE_STATUS`] (3), for runners whose timings can be trusted to gate a change.
 
 use std::path::{Path, PathBuf};
+use std::process::ExitCode;
 
 use clap::Args;
 use gibench_harness::measure::results::RunResult;
 use gibench_harness::output::OutputSet;
 use gibench_harness::report;
-use gibench_harness::report::compare::Statistic;
+use gibench_harness::report::compare::{Statistic, Verdict};
 use gibench_harness::{Error, Result};
 
 use super::files::check_stem;
@@ -47,6 +52,37 @@ pub(crate) struct CompareArgs {
     /// File name stem of the outputs.
     #[arg(long, default_value = "compare")]
     stem: String,
+    /// What to print on standard output: `table`, the whole comparison as a terminal table,
+    /// or `markdown`, the changed stages only (slower first, then faster) and a count of the
+    /// unchanged, for a pull request's comment or a CI job's summary. The files in --out are
+    /// the same either way.
+    #[arg(long, value_enum, default_value_t = OutputFormat::Table)]
+    format: OutputFormat,
+    /// Exit with status 3 (after printing and writing everything) when a stage's verdict is
+    /// this: `slower` (a regression), `faster`, or `any-change` (either). Only for runners
+    /// whose timings are stable enough to gate a change; without it the verdicts never change
+    /// the exit status.
+    #[arg(long, value_enum)]
+    fail_on: Option<FailOn>,
+}
+
+/// The exit status of `gibench compare --fail-on` when a verdict it names is found (1 is an
+/// error, 2 a usage error).
+pub(crate) const CHANGE_STATUS: u8 = 3;
+
+/// `--format`'s values.
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum OutputFormat {
+    Table,
+    Markdown,
+}
+
+/// `--fail-on`'s values.
+#[derive(Clone, Copy, PartialEq, clap::ValueEnum)]
+enum FailOn {
+    Slower,
+    Faster,
+    AnyChange,
 }
 
 /// `--statistic`'s values.
@@ -56,8 +92,9 @@ enum StatisticArg {
     Median,
 }
 
-/// `gibench compare`: reads both sides, compares, prints and writes the table and JSON.
-pub(crate) fn exec(args: &CompareArgs) -> Result<()> {
+/// `gibench compare`: reads both sides, compares, prints and writes the table and JSON; the
+/// exit status is [`CHANGE_STATUS`] when `--fail-on` names a verdict found.
+pub(crate) fn exec(args: &CompareArgs) -> Result<ExitCode> {
     check_stem(&args.stem)?;
     let settings = gibench_harness::report::compare::Settings::new(
         args.tolerance,
@@ -95,12 +132,28 @@ pub(crate) fn exec(args: &CompareArgs) -> Result<()> {
     }
     let rows = gibench_harness::report::compare::compare(&base, &current, &settings)?;
     let mut table = gibench_harness::report::compare::compare_table(&rows, &settings);
+    let mut notes = Vec::new();
     if !listing.is_empty() {
         let note = format!("Not compared (on one side only): {}.", listing.join("; "));
         eprintln!("warning: {note}");
-        table.notes.push(note);
+        table.notes.push(note.clone());
+        notes.push(note);
     }
-    println!("{}", table.to_terminal());
+    match args.format {
+        OutputFormat::Table => println!("{}", table.to_terminal()),
+        OutputFormat::Markdown => print!(
+            "{}",
+            gibench_harness::report::compare::compare_markdown(
+                &rows,
+                &settings,
+                [
+                    &args.base.display().to_string(),
+                    &args.current.display().to_string()
+                ],
+                &notes
+            )
+        ),
+    }
     let set = OutputSet::begin("out", &args.out)?;
     report::write_tables(&table, &args.out, &args.stem)?;
     let json = serde_json::to_vec_pretty(&rows).map_err(|e| Error::Invalid(e.to_string()))?;
@@ -111,7 +164,30 @@ pub(crate) fn exec(args: &CompareArgs) -> Result<()> {
         args.out.display(),
         stem = args.stem
     );
-    Ok(())
+    if let Some(fail_on) = args.fail_on {
+        let hit = rows
+            .iter()
+            .filter(|r| match r.verdict {
+                Verdict::Slower => fail_on != FailOn::Faster,
+                Verdict::Faster => fail_on != FailOn::Slower,
+                Verdict::Unchanged => false,
+            })
+            .count();
+        if hit > 0 {
+            eprintln!(
+                "{hit} stage(s) {}: exit status {CHANGE_STATUS} (--fail-on {})",
+                match fail_on {
+                    FailOn::Slower => "slower",
+                    FailOn::Faster => "faster",
+                    FailOn::AnyChange => "slower or faster",
+                },
+                clap::ValueEnum::to_possible_value(&fail_on)
+                    .map_or(String::new(), |v| v.get_name().to_string())
+            );
+            return Ok(ExitCode::from(CHANGE_STATUS));
+        }
+    }
+    Ok(ExitCode::SUCCESS)
 }
 
 /// Refuses a comparison of runs with themselves: BASE and CURRENT the same folder, a results

@@ -1,11 +1,17 @@
-//! `gibench export --format bmf`: results folders (and an instruction-count file) as Bencher
-//! Metric Format JSON, for `bencher run --adapter json --file ...` to keep their history
-//! (docs/history.md).
+//! `gibench export --format bmf`: results folders (and an instruction-count file, and
+//! criterion's output) as Bencher Metric Format JSON, for `bencher run --adapter json --file
+//! ...` to keep their history (docs/history.md).
 //!
 //! Benchmarks are named `SCENE@WxH/TECHNIQUE/STAGE` (and `.../frame`, `.../gpu-frame-span`,
-//! `.../image-error`, `kernels/KERNEL`); each holds measures whose `value` is the median over
-//! the repeats found and whose `lower_value` and `upper_value` are the smallest and largest
-//! repeat (present with two repeats or more):
+//! `.../image-error`). Where the exported runs of one scene, resolution and technique differ
+//! (a sweep, or runs of other targets made with other frame counts), a segment after the
+//! technique names what differs among them, sorted by name: the parameters and the run options
+//! `timing`, `frames`, `warmup`, `first-frame` and `seed` whose values are not the same in all
+//! of them (`absent` for a run without the parameter), e.g.
+//! `cornell@256x192/ism/vpls=1024/accumulate`; runs alike in all of them are repeats (a single
+//! run, or the repeats of one, keeps the short name). Each benchmark holds measures whose
+//! `value` is the median over the repeats found and whose `lower_value` and `upper_value` are
+//! the smallest and largest repeat (present with two repeats or more):
 //!
 //! * `latency`, Bencher's built-in measure, in its unit, **nanoseconds**: per stage, each
 //!   repeat's median stage time (flushed wall time, else GPU timestamps, as the tables show);
@@ -14,7 +20,13 @@
 //! * `rmse` and `flip` (custom measures, no unit): each repeat's mean RMSE and mean FLIP over
 //!   its compared frames, where the runs were made with `--quality`;
 //! * `instructions` (custom): a kernel's instruction count under callgrind, from a file that
-//!   `gibench instructions --write` made.
+//!   `gibench instructions --write` made, as `kernels/KERNEL`;
+//! * criterion's benchmarks (`--criterion target/criterion`), as `kernels/<criterion id>`:
+//!   `latency` in nanoseconds, the `value` the point estimate of the **mean** time per
+//!   iteration of the latest run (`new/estimates.json`) and the bounds its confidence interval
+//!   (criterion's bootstrap, 95 % by default); `cpu-time` (custom, nanoseconds of the
+//!   process's CPU time) for the groups whose name ends in `-cpu`, which `benches/kernels.rs`
+//!   measures so.
 //!
 //! The testbed (`--print-testbed`) is named from the runs' adapter, backend and driver.
 
@@ -24,7 +36,6 @@ use std::path::PathBuf;
 use clap::{Args, ValueEnum};
 use gibench_harness::measure::results::RunResult;
 use gibench_harness::measure::stats::median;
-use gibench_harness::report::compare::group;
 use gibench_harness::report::stage_ms;
 use gibench_harness::{Error, Result};
 use serde_json::{json, Map, Value};
@@ -51,6 +62,11 @@ pub(crate) struct ExportResultsArgs {
     /// results/baseline/instructions.json) to export beside the runs.
     #[arg(long)]
     instructions: Option<PathBuf>,
+    /// Criterion's output folder (target/criterion after `cargo bench`) to export beside the
+    /// runs: each benchmark's latest estimates (`.../new/estimates.json`) as
+    /// `kernels/<criterion id>`.
+    #[arg(long, value_name = "DIR")]
+    criterion: Option<PathBuf>,
     /// The file to write (default: standard output).
     #[arg(long)]
     out: Option<PathBuf>,
@@ -62,10 +78,10 @@ pub(crate) struct ExportResultsArgs {
 
 /// `gibench export`: reads the inputs, checks they make one testbed, writes the JSON.
 pub(crate) fn exec(args: &ExportResultsArgs) -> Result<()> {
-    if args.inputs.is_empty() && args.instructions.is_none() {
+    if args.inputs.is_empty() && args.instructions.is_none() && args.criterion.is_none() {
         return Err(Error::param(
             "inputs",
-            "give at least one folder of results files, or --instructions FILE",
+            "give at least one folder of results files, --instructions FILE or --criterion DIR",
         ));
     }
     if let Some(out) = &args.out {
@@ -105,13 +121,18 @@ pub(crate) fn exec(args: &ExportResultsArgs) -> Result<()> {
         .as_ref()
         .map(|p| read_instructions(p).map(|k| (p.clone(), k)))
         .transpose()?;
-    let bmf = bmf(&runs, instructions.as_ref().map(|(_, k)| k))?;
+    let criterion = args.criterion.as_deref().map(read_criterion).transpose()?;
+    let bmf = bmf(
+        &runs,
+        instructions.as_ref().map(|(_, k)| k),
+        criterion.as_deref().unwrap_or_default(),
+    )?;
     let text = serde_json::to_string_pretty(&bmf).map_err(|e| Error::Invalid(e.to_string()))?;
     match &args.out {
         Some(out) => {
             gibench_harness::output::write_atomic(out, format!("{text}\n").as_bytes())?;
             eprintln!(
-                "wrote {} benchmarks ({} runs{}) to {}",
+                "wrote {} benchmarks ({} runs{}{}) to {}",
                 bmf.len(),
                 runs.len(),
                 if instructions.is_some() {
@@ -119,6 +140,10 @@ pub(crate) fn exec(args: &ExportResultsArgs) -> Result<()> {
                 } else {
                     ""
                 },
+                criterion.as_ref().map_or(String::new(), |c| format!(
+                    ", {} criterion benchmarks",
+                    c.len()
+                )),
                 out.display()
             );
         }
@@ -207,6 +232,114 @@ fn read_instructions(path: &std::path::Path) -> Result<BTreeMap<String, u64>> {
         .collect()
 }
 
+/// One criterion benchmark's latest estimate, nanoseconds.
+struct CriterionBench {
+    /// Criterion's `full_id`, e.g. `rays/closest-hit-1024/cornell`.
+    id: String,
+    /// The mean's point estimate and its confidence interval (criterion's bootstrap, 95 % by
+    /// default), widened to hold the point estimate.
+    mean: f64,
+    lower: f64,
+    upper: f64,
+}
+
+/// The benchmarks of criterion's output folder `dir` (`target/criterion`): every
+/// `new/benchmark.json` beside a `new/estimates.json`, at any depth (criterion nests a
+/// group's benchmarks by function and value). Saved baselines (`base/`, `--save-baseline`'s
+/// folders) and reports are passed over. An error names the file that cannot be read, or the
+/// folder when it holds no benchmark.
+fn read_criterion(dir: &std::path::Path) -> Result<Vec<CriterionBench>> {
+    fn walk(dir: &std::path::Path, found: &mut Vec<PathBuf>) -> Result<()> {
+        let entries = std::fs::read_dir(dir).map_err(|e| Error::io(dir, e))?;
+        let mut dirs: Vec<PathBuf> = Vec::new();
+        for entry in entries {
+            let entry = entry.map_err(|e| Error::io(dir, e))?;
+            if entry
+                .file_type()
+                .map_err(|e| Error::io(entry.path(), e))?
+                .is_dir()
+            {
+                dirs.push(entry.path());
+            }
+        }
+        dirs.sort();
+        for d in dirs {
+            if d.file_name().is_some_and(|n| n == "new") {
+                if d.join("benchmark.json").is_file() {
+                    found.push(d);
+                }
+            } else {
+                walk(&d, found)?;
+            }
+        }
+        Ok(())
+    }
+    if !dir.is_dir() {
+        return Err(Error::param(
+            "criterion",
+            format!(
+                "{} is not a folder; expected criterion's output folder (target/criterion \
+                 after `cargo bench`)",
+                dir.display()
+            ),
+        ));
+    }
+    let mut found = Vec::new();
+    walk(dir, &mut found)?;
+    if found.is_empty() {
+        return Err(Error::param(
+            "criterion",
+            format!(
+                "{} holds no criterion benchmark (no .../new/benchmark.json); expected \
+                 criterion's output folder (target/criterion after `cargo bench`)",
+                dir.display()
+            ),
+        ));
+    }
+    let read = |path: &std::path::Path| -> Result<Value> {
+        let bytes = gibench_harness::error::read_bounded(path, 1 << 24)?;
+        serde_json::from_slice(&bytes).map_err(|e| Error::bad_file(path, format!("not JSON: {e}")))
+    };
+    let mut out = Vec::new();
+    for new in found {
+        let bench_file = new.join("benchmark.json");
+        let id = read(&bench_file)?
+            .get("full_id")
+            .and_then(Value::as_str)
+            .filter(|id| !id.is_empty())
+            .ok_or_else(|| {
+                Error::bad_file(
+                    &bench_file,
+                    "has no 'full_id' string; expected criterion's benchmark.json",
+                )
+            })?
+            .to_string();
+        let est_file = new.join("estimates.json");
+        let est = read(&est_file)?;
+        let mean = &est["mean"];
+        let num = |v: &Value| v.as_f64().filter(|x| x.is_finite() && *x >= 0.0);
+        let (Some(value), Some(lo), Some(hi)) = (
+            num(&mean["point_estimate"]),
+            num(&mean["confidence_interval"]["lower_bound"]),
+            num(&mean["confidence_interval"]["upper_bound"]),
+        ) else {
+            return Err(Error::bad_file(
+                &est_file,
+                "has no 'mean' with a 'point_estimate' and a 'confidence_interval' \
+                 (lower_bound, upper_bound) of numbers >= 0; expected criterion's \
+                 estimates.json",
+            ));
+        };
+        out.push(CriterionBench {
+            id,
+            mean: value,
+            lower: lo.min(value),
+            upper: hi.max(value),
+        });
+    }
+    Ok(out)
+}
+
 /// A BMF metric: the median of `values` (non-empty, finite), with the smallest and largest as
 /// lower and upper values when there are two or more.
 fn metric(values: &[f64]) -> Value {
@@ -221,30 +354,108 @@ fn metric(values: &[f64]) -> Value {
     Value::Object(m)
 }
 
+/// What tells one run of a scene, resolution and technique from another: its parameters
+/// (named as `gibench list` names them, valued as `gibench compare` prints them) and the run
+/// options that change what is measured (`timing`, `frames`, `warmup`, `first-frame`,
+/// `seed`).
+fn distinguishing(r: &RunResult) -> BTreeMap<String, String> {
+    let mut d: BTreeMap<String, String> = r
+        .parameters
+        .iter()
+        .map(|(k, v)| (k.clone(), v.to_string().trim_matches('"').to_string()))
+        .collect();
+    for (option, value) in [
+        ("timing", r.timing_mode.clone()),
+        ("frames", r.frames.measured.to_string()),
+        ("warmup", r.frames.warmup.to_string()),
+        ("first-frame", r.frames.first.to_string()),
+        ("seed", r.seed.to_string()),
+    ] {
+        // A technique parameter of the same name (none today) keeps its name; the option
+        // is then told by a `run-` prefix.
+        let name = if d.contains_key(option) {
+            format!("run-{option}")
+        } else {
+            option.to_string()
+        };
+        d.insert(name, value);
+    }
+    d
+}
+
+/// The runs as benchmarks: each named `SCENE@WxH/TECHNIQUE`, then, where runs of that scene,
+/// resolution and technique differ, `/NAME=VALUE,...` of the parameters and run options
+/// ([`distinguishing`]) whose values differ among them, sorted by name (`absent` for a run
+/// without the parameter), with their repeats (runs alike in all of them). Names are stable
+/// for a given set of runs, and a single run, or the repeats of one, keeps the short name.
+fn benchmarks(runs: &[RunResult]) -> Result<Vec<(String, Vec<&RunResult>)>> {
+    // Scene, resolution and technique -> distinguishing values -> repeats.
+    type Repeats<'a> = BTreeMap<BTreeMap<String, String>, Vec<&'a RunResult>>;
+    let mut by_prefix: BTreeMap<String, Repeats> = BTreeMap::new();
+    for r in runs {
+        let prefix = format!(
+            "{}@{}x{}/{}",
+            r.scene, r.resolution[0], r.resolution[1], r.technique
+        );
+        by_prefix
+            .entry(prefix)
+            .or_default()
+            .entry(distinguishing(r))
+            .or_default()
+            .push(r);
+    }
+    let mut out = Vec::new();
+    // Benchmark name -> the run it was given to, to refuse two runs one name.
+    let mut named: BTreeMap<String, String> = BTreeMap::new();
+    for (prefix, groups) in by_prefix {
+        let names: std::collections::BTreeSet<&String> =
+            groups.keys().flat_map(|d| d.keys()).collect();
+        let differing: Vec<String> = names
+            .into_iter()
+            .filter(|n| {
+                let first = groups.keys().next().and_then(|d| d.get(*n));
+                groups.keys().any(|d| d.get(*n) != first)
+            })
+            .cloned()
+            .collect();
+        for (dims, repeats) in groups {
+            let mut name = prefix.clone();
+            if !differing.is_empty() {
+                let parts: Vec<String> = differing
+                    .iter()
+                    .map(|n| format!("{n}={}", dims.get(n).map_or("absent", String::as_str)))
+                    .collect();
+                name = format!("{name}/{}", parts.join(","));
+            }
+            let run = format!(
+                "{} {}",
+                gibench_harness::report::compare::run_key(repeats[0]),
+                serde_json::to_string(&repeats[0].parameters).unwrap_or_default()
+            );
+            if let Some(other) = named.insert(name.clone(), run.clone()) {
+                return Err(Error::param(
+                    "inputs",
+                    format!(
+                        "two different runs would share the benchmark names {name}/...: \
+                         {other}; {run} (their parameters' values print alike, e.g. \"1\" and 1); export them \
+                         from separate folders"
+                    ),
+                ));
+            }
+            out.push((name, repeats));
+        }
+    }
+    Ok(out)
+}
+
 /// The BMF document (see the module docs): benchmark name → measure slug → metric.
 fn bmf(
     runs: &[RunResult],
     instructions: Option<&BTreeMap<String, u64>>,
+    criterion: &[CriterionBench],
 ) -> Result<BTreeMap<String, Map<String, Value>>> {
     let mut out: BTreeMap<String, Map<String, Value>> = BTreeMap::new();
-    // Benchmark names carry scene, resolution and technique, not the parameters: two runs
-    // that differ only in them would share names, and are refused.
-    let mut named: BTreeMap<String, String> = BTreeMap::new();
-    for (key, repeats) in group(runs) {
-        let r0 = repeats[0];
-        let prefix = format!(
-            "{}@{}x{}/{}",
-            r0.scene, r0.resolution[0], r0.resolution[1], r0.technique
-        );
-        if let Some(other) = named.insert(prefix.clone(), key.clone()) {
-            return Err(Error::param(
-                "inputs",
-                format!(
-                    "two runs would share the benchmark names {prefix}/...: {other}; {key} \
-                     (they differ in parameters); export them from separate folders"
-                ),
-            ));
-        }
+    for (prefix, repeats) in benchmarks(runs)? {
         let mut add = |bench: String, measure: &str, values: Vec<f64>| {
             let values: Vec<f64> = values.into_iter().filter(|v| v.is_finite()).collect();
             if !values.is_empty() {
@@ -307,6 +518,23 @@ fn bmf(
         out.entry(format!("kernels/{kernel}"))
             .or_default()
             .insert("instructions".into(), json!({ "value": *count as f64 }));
+    }
+    for b in criterion {
+        // The benches' groups measured in CPU time end in `-cpu` (benches/kernels.rs).
+        let cpu = b.id.split('/').next().is_some_and(|g| g.ends_with("-cpu"));
+        let measure = if cpu { "cpu-time" } else { "latency" };
+        let bench = format!("kernels/{}", b.id);
+        let metrics = out.entry(bench.clone()).or_default();
+        if metrics.contains_key(measure) {
+            return Err(Error::param(
+                "criterion",
+                format!("two criterion benchmarks would both be {bench} ({measure})"),
+            ));
+        }
+        metrics.insert(
+            measure.into(),
+            json!({"value": b.mean, "lower_value": b.lower, "upper_value": b.upper}),
+        );
     }
     if out.is_empty() {
         return Err(Error::param(
