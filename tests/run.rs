@@ -440,3 +440,26 @@ fn quality_run_builds_the_static_tree_once_and_movers_per_frame() {
     );
     assert!(png == png_again, "the cached references' images differ");
 }
+
+/// Catches: a terminal table over 120 columns in some timing mode (`run_ok` checks every line's
+/// width in characters: the dash of a missing cell, U+2013, is one column but three bytes, so a
+/// byte count reads 120-column lines with dashes as 124-126). Every technique at once, the
+/// widest table, in each mode, with the error columns in one.
+#[test]
+fn the_terminal_table_fits_120_columns_in_every_timing_mode() {
+    let tmp = tempfile::tempdir().unwrap();
+    let cache = tmp.path().join("cache").to_string_lossy().into_owned();
+    for (i, timing) in ["stages", "frame", "both"].into_iter().enumerate() {
+        #[rustfmt::skip]
+        let mut args = vec!["--frames", "2", "--warmup", "3", "--resolution", "64x48",
+                            "--no-images", "--timing", timing];
+        if timing == "both" {
+            args.extend(["--quality", "--spp", "4", "--cache", &cache]);
+        }
+        let out = run_ok(&args, &tmp.path().join(format!("r{i}")));
+        assert!(
+            out.contains("gaitatzes") && out.contains("barczak"),
+            "{out}"
+        );
+    }
+}

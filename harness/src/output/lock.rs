@@ -89,4 +89,3 @@ fn same_file(file: &std::fs::File, path: &Path) -> bool {
 fn same_file(_: &std::fs::File, path: &Path) -> bool {
     path.is_file()
 }
-

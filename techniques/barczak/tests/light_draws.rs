@@ -111,53 +111,13 @@ fn light_maps_minus_occluded_partials_equal_the_brute_force_gather() {
             gpu.queue.submit([enc.finish()]);
             images.push(gibench_harness::gpu::image_io::read_rgb_f32(gpu, &t).unwrap());
         }
-        // The kit's gather of every light with the same maps (1x1 tiles, no filtering, no clamp).
-        let output = gibench_harness::kit::passes::indirect_target(&gpu.device, [W, H], true);
-        let interleave = Interleave::new(
-            gpu,
-            &harness.gbuffer,
-            (1, 1),
-            FilterSettings {
-                alpha: 0.0,
-                beta: 2.0,
-            },
-            &output,
-        )
-        .unwrap();
-        let accumulation =
-            Accumulation::new(gpu, &interleave, &store, &atlas, IrradianceClamp::OFF).unwrap();
-        let mut enc = gpu.device.create_command_encoder(&Default::default());
-        interleave.encode_split(&mut enc);
-        accumulation.encode(&mut enc, &interleave, &atlas);
-        interleave.encode_combine(&mut enc);
-        interleave.encode_filter(&mut enc);
-        gpu.queue.submit([enc.finish()]);
-        let naive = gibench_harness::gpu::image_io::read_rgb_f32(gpu, &output).unwrap();
+        let naive = brute_force_gather(gpu, harness, &store, &atlas);
 
         let (opt, plain) = (&images[0], &images[1]);
-        assert!(
-            draws[0] <= draws[1] && draws[0] > 0,
-            "{backend}: draws {draws:?}"
-        );
+        assert_the_optimiser_only_rounds(backend, opt, plain, &draws);
         let close = |a: [f32; 3], b: [f32; 3], rel: f32| {
             (0..3).all(|c| (a[c] - b[c]).abs() <= rel * a[c].abs().max(b[c].abs()) + 1e-5)
         };
-        let top = opt
-            .iter()
-            .flat_map(|p| p.iter().copied())
-            .fold(0f32, f32::max);
-        let worst = opt
-            .iter()
-            .zip(plain)
-            .map(|(a, b)| (0..3).map(|c| (a[c] - b[c]).abs()).fold(0f32, f32::max))
-            .fold(0f32, f32::max);
-        eprintln!("{backend}: optimised vs not: largest difference {worst} (image maximum {top})");
-        // Blending rounds to half floats after every draw, and the optimiser changes the order
-        // of the subtractions: a few half-float steps of the largest value at most.
-        assert!(
-            worst <= 4e-3 * top,
-            "{backend}: the optimiser changed the image by {worst}"
-        );
         // Barczak = light map − occluded partial lights; the gather = every light with its
         // visibility. They differ by the light maps' interpolation (bilinear between texel
         // centres, against the exact sum of the leaf's lit lights at the pixel) and wherever a
@@ -218,4 +178,65 @@ fn light_maps_minus_occluded_partials_equal_the_brute_force_gather() {
             "{backend}: VD matches Naive on {same_vd} of {patch} pixels"
         );
     });
+}
+
+/// The kit's gather of every light with the same maps (1x1 tiles, no filtering, no clamp):
+/// Barczak's "Naive" as the VPL techniques compute it.
+fn brute_force_gather(
+    gpu: &gibench_harness::gpu::GpuContext,
+    harness: &gibench_harness::run::runner::Harness,
+    store: &VplStore,
+    atlas: &ShadowAtlas,
+) -> Vec<[f32; 3]> {
+    let output = gibench_harness::kit::passes::indirect_target(&gpu.device, [W, H], true);
+    let interleave = Interleave::new(
+        gpu,
+        &harness.gbuffer,
+        (1, 1),
+        FilterSettings {
+            alpha: 0.0,
+            beta: 2.0,
+        },
+        &output,
+    )
+    .unwrap();
+    let accumulation =
+        Accumulation::new(gpu, &interleave, store, atlas, IrradianceClamp::OFF).unwrap();
+    let mut enc = gpu.device.create_command_encoder(&Default::default());
+    interleave.encode_split(&mut enc);
+    accumulation.encode(&mut enc, &interleave, atlas);
+    interleave.encode_combine(&mut enc);
+    interleave.encode_filter(&mut enc);
+    gpu.queue.submit([enc.finish()]);
+    gibench_harness::gpu::image_io::read_rgb_f32(gpu, &output).unwrap()
+}
+
+/// Merging elements by the pass optimiser never adds draws and changes the image by blending's
+/// rounding only.
+fn assert_the_optimiser_only_rounds(
+    backend: &str,
+    opt: &[[f32; 3]],
+    plain: &[[f32; 3]],
+    draws: &[u32],
+) {
+    assert!(
+        draws[0] <= draws[1] && draws[0] > 0,
+        "{backend}: draws {draws:?}"
+    );
+    let top = opt
+        .iter()
+        .flat_map(|p| p.iter().copied())
+        .fold(0f32, f32::max);
+    let worst = opt
+        .iter()
+        .zip(plain)
+        .map(|(a, b)| (0..3).map(|c| (a[c] - b[c]).abs()).fold(0f32, f32::max))
+        .fold(0f32, f32::max);
+    eprintln!("{backend}: optimised vs not: largest difference {worst} (image maximum {top})");
+    // Blending rounds to half floats after every draw, and the optimiser changes the order
+    // of the subtractions: a few half-float steps of the largest value at most.
+    assert!(
+        worst <= 4e-3 * top,
+        "{backend}: the optimiser changed the image by {worst}"
+    );
 }

@@ -478,13 +478,16 @@ mod tests {
         }
     }
 
-    #[test]
-    fn descriptor_validation_rules() {
-        type Edit = Box<dyn Fn(&mut SceneDescriptor)>;
-        let with_mover = |d: &mut SceneDescriptor| {
-            d.movers = SceneDescriptor::resolve("cornell-bunny").unwrap().movers;
-        };
-        let cases: Vec<(&str, Edit)> = vec![
+    type Edit = Box<dyn Fn(&mut SceneDescriptor)>;
+
+    fn with_mover(d: &mut SceneDescriptor) {
+        d.movers = SceneDescriptor::resolve("cornell-bunny").unwrap().movers;
+    }
+
+    /// Invalid descriptors of the mesh, the camera and the paths' times, with the message each
+    /// must start with.
+    fn mesh_and_path_cases() -> Vec<(&'static str, Edit)> {
+        vec![
             (
                 "mesh: give either",
                 Box::new(|d| d.mesh.file = Some("a.glb".into())),
@@ -538,6 +541,12 @@ mod tests {
                 "camera.path.keys[1].time: must be a finite",
                 Box::new(|d| d.camera.path.keys[1].time = f32::NAN),
             ),
+        ]
+    }
+
+    /// Invalid descriptors of the light, the movers and the settings.
+    fn light_mover_and_settings_cases() -> Vec<(&'static str, Edit)> {
+        vec![
             (
                 "light.path.keys[2].time: key times must be strictly increasing",
                 Box::new(|d| d.light.path.keys[2].time = 1.5),
@@ -641,7 +650,14 @@ mod tests {
                 Box::new(|d| d.settings.shadow_bias = f32::NAN),
             ),
             ("fps:", Box::new(|d| d.fps = 0.0)),
-        ];
+        ]
+    }
+
+    #[test]
+    fn descriptor_validation_rules() {
+        let cases = mesh_and_path_cases()
+            .into_iter()
+            .chain(light_mover_and_settings_cases());
         for (expected, edit) in cases {
             let mut d = cornell();
             edit(&mut d);
@@ -653,6 +669,10 @@ mod tests {
             let m = message(e);
             assert!(m.starts_with(expected), "expected '{expected}…', got '{m}'");
         }
+    }
+
+    #[test]
+    fn optional_descriptor_parts_validate() {
         // Optional things that are fine: an omni light without targets, a mover without targets,
         // a single-key path, an area light with a size.
         let mut d = cornell();
