@@ -36,11 +36,17 @@ fn sources(dir: &Path, out: &mut Vec<PathBuf>) {
 /// The first path segment of every `crate::` path in `code` (comments already removed),
 /// including each item of a `crate::{a::X, b}` group.
 fn crate_modules(code: &str) -> Vec<String> {
+    paths_under(code, "crate::")
+}
+
+/// The first path segment after every `prefix` (`crate::`, `gibench_harness::`) in `code`,
+/// including each item of a `prefix{a::X, b}` group.
+fn paths_under(code: &str, prefix: &str) -> Vec<String> {
     let mut found = Vec::new();
     let mut rest = code;
-    while let Some(i) = rest.find("crate::") {
+    while let Some(i) = rest.find(prefix) {
         let preceded = rest[..i].chars().next_back();
-        rest = &rest[i + "crate::".len()..];
+        rest = &rest[i + prefix.len()..];
         if matches!(preceded, Some(c) if c == '$' || c == ':' || c.is_alphanumeric() || c == '_') {
             continue;
         }
@@ -131,5 +137,46 @@ fn every_folder_uses_only_the_folders_below_it() {
         "only {checked} source files found under {}",
         root.display()
     );
+    assert!(wrong.is_empty(), "layering broken:\n{}", wrong.join("\n"));
+}
+
+/// The technique crates build on the kit: they use the harness's `kit` folder and the layers
+/// below it, never the frame loop (`run`) or the reports (`report`) above it, so that a
+/// technique is a plug-in of the kit and not of one way of running it. Fails naming the file
+/// and the path (tried: `gibench_harness::run::quality::IndirectComponent` in keller).
+#[test]
+fn technique_crates_use_only_the_kit_and_below() {
+    let techniques = Path::new(env!("CARGO_MANIFEST_DIR")).join("../techniques");
+    let kit = layer_of("kit").unwrap();
+    let mut wrong = Vec::new();
+    let mut checked = 0;
+    for entry in std::fs::read_dir(&techniques).unwrap() {
+        let src = entry.unwrap().path().join("src");
+        // The test-support crate is no technique (it runs the frame loop for tests).
+        if !src.is_dir() || src.parent().unwrap().ends_with("support") {
+            continue;
+        }
+        let mut files = Vec::new();
+        sources(&src, &mut files);
+        for file in &files {
+            checked += 1;
+            let code = strip_comments(&std::fs::read_to_string(file).unwrap());
+            for module in paths_under(&code, "gibench_harness::") {
+                let layer = match module.as_str() {
+                    "Error" | "Result" => Some(0),
+                    // Re-exported crates, not layers.
+                    "glam" | "wgpu" => continue,
+                    m => layer_of(m),
+                };
+                if !layer.is_some_and(|l| l <= kit) {
+                    wrong.push(format!(
+                        "{}: uses `gibench_harness::{module}`, above the kit",
+                        file.strip_prefix(&techniques).unwrap().display()
+                    ));
+                }
+            }
+        }
+    }
+    assert!(checked > 30, "only {checked} technique sources found");
     assert!(wrong.is_empty(), "layering broken:\n{}", wrong.join("\n"));
 }

@@ -10,7 +10,7 @@ use std::collections::BTreeMap;
 use serde_json::Value;
 
 use crate::cpu::bvh::SceneBvh;
-use crate::cpu::reference::IndirectComponent;
+pub use crate::cpu::reference::IndirectComponent;
 use crate::gpu::profiler::Profiler;
 use crate::gpu::GpuContext;
 use crate::kit::passes::{DirectLight, FrameUniforms, GBuffer, GpuScene};

@@ -77,10 +77,10 @@ pub mod visibility;
 
 pub use params::BarczakParams;
 
+use gibench_harness::kit::technique::IndirectComponent;
 use gibench_harness::kit::technique::{
     Conformance, FrameContext, Params, PrepareContext, Prepared, Technique, TechniqueInfo,
 };
-use gibench_harness::run::quality::IndirectComponent;
 use gibench_harness::{wgpu, Error, Result};
 
 use params::PARAMS;

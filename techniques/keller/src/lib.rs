@@ -37,10 +37,10 @@ use gibench_harness::cpu::vpl::{self, Vpl};
 use gibench_harness::kit::ir::gather::{VplGather, GATHER_PARAMS};
 use gibench_harness::kit::ir::raster::AtlasClear;
 use gibench_harness::kit::passes::DrawSet;
+use gibench_harness::kit::technique::IndirectComponent;
 use gibench_harness::kit::technique::{
     Conformance, FrameContext, Params, PrepareContext, Prepared, Technique, TechniqueInfo,
 };
-use gibench_harness::run::quality::IndirectComponent;
 use gibench_harness::{wgpu, Error, Result};
 
 use params::{FULL_OWN, INCREMENTAL_OWN};
