@@ -41,7 +41,7 @@ enum Command {
     /// Run techniques on a scene and write results, images and tables.
     Run(RunArgs),
     /// List the scenes and techniques (with their parameters and defaults).
-    List,
+    List(cli::list::ListArgs),
     /// Render tables (Markdown, CSV, LaTeX) and a stacked-bar SVG from results files.
     Report(ReportArgs),
     /// Render the CPU reference (direct, one-bounce, multi-bounce) for one frame.
@@ -83,7 +83,7 @@ fn main() -> ExitCode {
     let outcome = match cli.command {
         None => cli::run::exec(&RunArgs::parse_default()),
         Some(Command::Run(args)) => cli::run::exec(&args),
-        Some(Command::List) => cli::list::exec(),
+        Some(Command::List(args)) => cli::list::exec(&args),
         Some(Command::Report(args)) => cli::report::exec(&args),
         Some(Command::Reference(args)) => cli::reference::exec(&args),
         Some(Command::Sweep(args)) => cli::sweep::exec(&args),

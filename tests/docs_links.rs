@@ -731,6 +731,35 @@ fn no_source_file_passes_900_lines() {
     );
 }
 
+/// Catches: docs/running.md's parameter table drifting from the declarations (a parameter
+/// added, renamed, its default or doc changed in the code and not in the docs): the table
+/// between the markers must equal `gibench list --markdown`.
+#[test]
+fn the_parameter_table_in_the_docs_is_the_generated_one() {
+    let doc = std::fs::read_to_string(root().join("docs/running.md")).unwrap();
+    let (start, end) = (
+        "<!-- gibench list --markdown -->\n",
+        "<!-- end of gibench list --markdown -->",
+    );
+    let from = doc.find(start).expect("docs/running.md: no start marker") + start.len();
+    let to = doc[from..]
+        .find(end)
+        .expect("docs/running.md: no end marker")
+        + from;
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_gibench"))
+        .args(["list", "--markdown"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let generated = String::from_utf8(o.stdout).unwrap();
+    assert!(generated.lines().count() > 20, "{generated}");
+    assert!(
+        doc[from..to] == generated,
+        "docs/running.md's parameter table differs from `gibench list --markdown`: paste its \
+         output between the markers.\nGenerated:\n{generated}"
+    );
+}
+
 #[test]
 fn every_link_in_the_readme_docs_and_results_readmes_is_alive() {
     let root = root();

@@ -1,13 +1,27 @@
 //! `gibench list`: the built-in scenes and the registered techniques with their parameters
-//! and defaults.
+//! and defaults; `--markdown` prints the techniques' parameter table that docs/running.md holds
+//! (a test checks that the two match), generated from the declarations.
 
+use clap::Args;
+use gibench_harness::kit::technique::{ParamKind, ParamSpec};
 use gibench_harness::scene::{descriptor, SceneDescriptor};
 use gibench_harness::Result;
 
 use crate::registry;
 
+#[derive(Args)]
+pub(crate) struct ListArgs {
+    /// Print the techniques' parameters as a Markdown table (docs/running.md holds it).
+    #[arg(long)]
+    markdown: bool,
+}
+
 /// `gibench list`: prints the scenes and techniques.
-pub(crate) fn exec() -> Result<()> {
+pub(crate) fn exec(args: &ListArgs) -> Result<()> {
+    if args.markdown {
+        print!("{}", parameter_table());
+        return Ok(());
+    }
     println!("Scenes (built-in descriptors; any descriptor JSON path also works):");
     for name in descriptor::builtin_names() {
         let d = SceneDescriptor::resolve(name)?;
@@ -40,4 +54,42 @@ pub(crate) fn exec() -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// The parameters of every registered technique as one Markdown table: a row per declaration
+/// (a parameter the kit declares once and several techniques take is one row naming them all),
+/// in the registry's order, with its default, its values and its doc.
+fn parameter_table() -> String {
+    let mut rows: Vec<(&'static ParamSpec, Vec<&'static str>)> = Vec::new();
+    for t in registry::all() {
+        for p in t.param_specs() {
+            let same =
+                |q: &&ParamSpec| q.name == p.name && q.default == p.default && q.doc == p.doc;
+            match rows.iter_mut().find(|(q, _)| same(q)) {
+                Some((_, names)) => names.push(t.name),
+                None => rows.push((p, vec![t.name])),
+            }
+        }
+    }
+    let mut out = String::from(
+        "| parameter | techniques | default | values | meaning |\n|---|---|---|---|---|\n",
+    );
+    for (p, names) in rows {
+        let values = match p.kind {
+            ParamKind::Int { min, max } => format!("{min}–{max}"),
+            ParamKind::Float { min, max } => format!("{min}–{max}"),
+            ParamKind::Bool => "true, false".into(),
+            ParamKind::Tiles => "NxM, 1–64 each".into(),
+            ParamKind::Choice(words) => words.join(", "),
+        };
+        out.push_str(&format!(
+            "| `{}` | {} | {} | {} | {} |\n",
+            p.name,
+            names.join(", "),
+            p.default,
+            values,
+            p.doc.replace('|', "\\|")
+        ));
+    }
+    out
 }

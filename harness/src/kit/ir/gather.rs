@@ -45,13 +45,13 @@ pub const GATHER_PARAMS: &[ParamSpec] = &[
         name: "vpl-map",
         kind: ParamKind::Choice(MapKind::NAMES),
         default: "paraboloid",
-        doc: "VPL shadow-map parameterisation",
+        doc: "VPL shadow-map parameterisation: paraboloid, cube (6x the memory) or octahedral (Barczak 2006: the hemisphere on four octahedron faces in one square, the memory of a paraboloid map, rasterised exactly)",
     },
     ParamSpec {
         name: "vpl-map-size",
         kind: ParamKind::Int { min: 8, max: 4096 },
         default: "128",
-        doc: "VPL shadow-map edge in texels (Laine: 256)",
+        doc: "VPL shadow-map edge in texels (Laine: 256); not the run option --shadow-size, the primary light's map",
     },
     ParamSpec {
         name: "depth-bits",
@@ -63,7 +63,7 @@ pub const GATHER_PARAMS: &[ParamSpec] = &[
         name: "clamp",
         kind: ParamKind::Float { min: 0.0, max: 1e9 },
         default: "10",
-        doc: "largest irradiance one VPL may give a receiver, in units of the mean irradiance of all VPLs (their flux spread over the scene's surface area); 0 = no clamp",
+        doc: "k: the largest irradiance one VPL may give a receiver is k x the mean irradiance of all the frame's VPLs (their summed flux over the scene's surface area, recorded as scene_surface_area); 0 = no clamp",
     },
 ];
 
