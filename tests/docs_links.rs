@@ -731,33 +731,43 @@ fn no_source_file_passes_900_lines() {
     );
 }
 
-/// Catches: docs/running.md's parameter table drifting from the declarations (a parameter
-/// added, renamed, its default or doc changed in the code and not in the docs): the table
-/// between the markers must equal `gibench list --markdown`.
+/// Catches: the README's technique table or docs/running.md's parameter table drifting from
+/// the registry's declarations (a technique or parameter added or renamed, a default, doc,
+/// paper or summary changed in the code and not in the docs): each table between its markers
+/// must equal its part of `gibench list --markdown` (techniques, a blank line, parameters).
 #[test]
-fn the_parameter_table_in_the_docs_is_the_generated_one() {
-    let doc = std::fs::read_to_string(root().join("docs/running.md")).unwrap();
-    let (start, end) = (
-        "<!-- gibench list --markdown -->\n",
-        "<!-- end of gibench list --markdown -->",
-    );
-    let from = doc.find(start).expect("docs/running.md: no start marker") + start.len();
-    let to = doc[from..]
-        .find(end)
-        .expect("docs/running.md: no end marker")
-        + from;
+fn the_generated_tables_in_the_docs_match_gibench_list_markdown() {
     let o = std::process::Command::new(env!("CARGO_BIN_EXE_gibench"))
         .args(["list", "--markdown"])
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let generated = String::from_utf8(o.stdout).unwrap();
-    assert!(generated.lines().count() > 20, "{generated}");
-    assert!(
-        doc[from..to] == generated,
-        "docs/running.md's parameter table differs from `gibench list --markdown`: paste its \
-         output between the markers.\nGenerated:\n{generated}"
-    );
+    let (techniques, parameters) = generated
+        .split_once("\n\n")
+        .expect("two tables, a blank line between them");
+    assert!(parameters.lines().count() > 20, "{generated}");
+    for (file, part, table) in [
+        ("README.md", "techniques", format!("{techniques}\n")),
+        ("docs/running.md", "parameters", parameters.to_string()),
+    ] {
+        let doc = std::fs::read_to_string(root().join(file)).unwrap();
+        let start = format!("<!-- gibench list --markdown: {part} -->\n");
+        let end = format!("<!-- end of gibench list --markdown: {part} -->");
+        let from = doc
+            .find(&start)
+            .unwrap_or_else(|| panic!("{file}: no marker {start}"))
+            + start.len();
+        let to = doc[from..]
+            .find(&end)
+            .unwrap_or_else(|| panic!("{file}: no marker {end}"))
+            + from;
+        assert!(
+            doc[from..to] == table,
+            "{file}'s {part} table differs from `gibench list --markdown`: paste its output \
+             between the markers.\nGenerated:\n{table}"
+        );
+    }
 }
 
 #[test]

@@ -1,6 +1,7 @@
 //! `gibench list`: the built-in scenes and the registered techniques with their parameters
-//! and defaults; `--markdown` prints the techniques' parameter table that docs/running.md holds
-//! (a test checks that the two match), generated from the declarations.
+//! and defaults; `--markdown` prints, from the registry's declarations, the techniques' table
+//! that the README holds and their parameter table that docs/running.md holds (a test checks
+//! that each matches).
 
 use clap::Args;
 use gibench_harness::kit::technique::{ParamKind, ParamSpec};
@@ -11,7 +12,8 @@ use crate::registry;
 
 #[derive(Args)]
 pub(crate) struct ListArgs {
-    /// Print the techniques' parameters as a Markdown table (docs/running.md holds it).
+    /// Print the techniques (the README's table) and their parameters (docs/running.md's) as
+    /// Markdown tables, a blank line between them.
     #[arg(long)]
     markdown: bool,
 }
@@ -19,7 +21,7 @@ pub(crate) struct ListArgs {
 /// `gibench list`: prints the scenes and techniques.
 pub(crate) fn exec(args: &ListArgs) -> Result<()> {
     if args.markdown {
-        print!("{}", parameter_table());
+        print!("{}\n{}", technique_table(), parameter_table());
         return Ok(());
     }
     println!("Scenes (built-in descriptors; any descriptor JSON path also works):");
@@ -89,6 +91,19 @@ fn parameter_table() -> String {
             p.default,
             values,
             p.doc.replace('|', "\\|")
+        ));
+    }
+    out
+}
+
+/// The registered techniques as the README's Markdown table: each name linking its section of
+/// docs/techniques.md, its paper and what it is.
+fn technique_table() -> String {
+    let mut out = String::from("| technique | paper | what it is |\n|---|---|---|\n");
+    for t in registry::all() {
+        out.push_str(&format!(
+            "| [`{0}`](docs/techniques.md#{0}) | {1} | {2} |\n",
+            t.name, t.paper, t.summary
         ));
     }
     out

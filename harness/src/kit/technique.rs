@@ -265,6 +265,11 @@ pub struct Conformance {
 /// A registry entry: how to list and build a technique.
 pub struct TechniqueInfo {
     pub name: &'static str,
+    /// The paper it implements, as the README's table names it (`Laine et al. 2007`; `—` for a
+    /// baseline).
+    pub paper: &'static str,
+    /// What it is, in a few words (the README's table; `gibench list --markdown`).
+    pub summary: &'static str,
     pub description: &'static str,
     /// Declared parameters, composed from shared sets (e.g. the kit's gather parameters) and
     /// the technique's own; names are unique across the groups.

@@ -129,6 +129,8 @@ fn computed_component(params: &Params) -> IndirectComponent {
 /// Registry entry.
 pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "barczak",
+    paper: "Barczak 2006",
+    summary: "light-mapped, visibility-culled instant radiosity",
     description: "Barczak 2006 light-mapped, visibility-culled instant radiosity with octahedral shadow maps, a low-resolution pass and PRT movers (level=full|vd-lp|vd|naive)",
     params: &[PARAMS],
     required_features: wgpu::Features::empty(),

@@ -18,6 +18,8 @@ use params::PARAMS;
 /// Registry entry.
 pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "direct",
+    paper: "—",
+    summary: "baseline: direct light only",
     description: "direct light only (shadow-mapped primary light); indirect irradiance is zero",
     params: &[PARAMS],
     required_features: wgpu::Features::empty(),

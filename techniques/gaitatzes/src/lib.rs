@@ -78,6 +78,8 @@ pub const STAGE_RECONSTRUCTION: &str = "reconstruction";
 /// Registry entry.
 pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "gaitatzes",
+    paper: "Gaitatzes et al. 2010",
+    summary: "voxel SH propagation of indirect light",
     description: "Gaitatzes et al. 2010 voxel SH light propagation with occlusion and multiple bounces (mode=lpv: plain LPV)",
     params: &[PARAMS],
     required_features: wgpu::Features::empty(),

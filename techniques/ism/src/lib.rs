@@ -64,6 +64,8 @@ pub const STAGE_PULL_PUSH: &str = "pull-push";
 /// `ism-classic` registry entry.
 pub const INFO_CLASSIC: TechniqueInfo = TechniqueInfo {
     name: "ism-classic",
+    paper: "Ritschel et al. 2008",
+    summary: "`ism`'s VPLs with classic, rasterised maps",
     description:
         "ism's RSM-sampled VPLs with classic triangle-rasterised maps (the slides' comparison)",
     params: &[CLASSIC_PARAMS, GATHER],
@@ -82,6 +84,8 @@ pub const INFO_CLASSIC: TechniqueInfo = TechniqueInfo {
 /// `ism` registry entry.
 pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "ism",
+    paper: "Ritschel et al. 2008",
+    summary: "imperfect shadow maps",
     description:
         "Ritschel et al. 2008 imperfect shadow maps: RSM-sampled VPLs, point splats, pull-push",
     params: &[OWN_PARAMS, GATHER],

@@ -69,6 +69,8 @@ fn computed_component(params: &Params) -> IndirectComponent {
 /// `keller-full` registry entry.
 pub const FULL: TechniqueInfo = TechniqueInfo {
     name: "keller-full",
+    paper: "Keller 1997",
+    summary: "instant radiosity, every VPL map every frame",
     description: "Keller instant radiosity: all VPLs and their shadow maps recomputed every frame",
     params: &[FULL_OWN, GATHER_PARAMS],
     required_features: wgpu::Features::empty(),
@@ -82,6 +84,8 @@ pub const FULL: TechniqueInfo = TechniqueInfo {
 /// `keller-incremental` registry entry.
 pub const INCREMENTAL: TechniqueInfo = TechniqueInfo {
     name: "keller-incremental",
+    paper: "Keller 1997",
+    summary: "a ring of light paths, oldest replaced",
     description: "Keller instant radiosity: keep the last N paths, replace the oldest `budget` per frame, accumulate",
     params: &[INCREMENTAL_OWN, GATHER_PARAMS],
     required_features: wgpu::Features::empty(),

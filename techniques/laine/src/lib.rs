@@ -66,6 +66,8 @@ pub const STAGE_VPL_MANAGEMENT: &str = "vpl-management";
 /// `laine` registry entry.
 pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "laine",
+    paper: "Laine et al. 2007",
+    summary: "incremental instant radiosity",
     description: "Laine et al. 2007 incremental instant radiosity: reuse valid VPLs, recompute a few per frame",
     params: &[OWN_PARAMS, GATHER_PARAMS],
     required_features: wgpu::Features::empty(),
