@@ -114,7 +114,8 @@ fn detail(dir: &Path, base: &str, current: &str) -> String {
         .join("; ")
 }
 
-const STAGES: [&str; 4] = ["gbuffer", "direct-shadow-map", "direct-light", "compose"];
+/// The stages of a `direct` run: the run's own (direct has none).
+const STAGES: [&str; 4] = gibench_harness::run::runner::RUN_STAGES;
 
 #[test]
 fn verdicts_on_synthetic_results_are_exact() {

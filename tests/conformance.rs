@@ -12,9 +12,9 @@
 //!    (`TechniqueInfo::conformance`). The mean ratio is the energy check: halving a
 //!    technique's VPL intensities moves it to about 0.5.
 //!
-//! 5. every GPU stage it times declares its minimum cost (`Profiler::stage_cost`, the
-//!    roofline's input, docs/roofline.md), so `gibench report --detailed` has a fraction for
-//!    each.
+//! 5. every stage it times is declared in `TechniqueInfo::stages` (name and GPU or CPU), and
+//!    every GPU stage declares its minimum cost (`Profiler::stage_cost`, the roofline's input,
+//!    docs/roofline.md), so `gibench report --detailed` has a fraction for each.
 //!
 //! Runs on the best adapter there is (Vulkan, else GL).
 
@@ -23,7 +23,7 @@ mod registry;
 
 use gibench_harness::cpu::reference::{render_reference, ReferenceSettings};
 use gibench_harness::glam::Vec3;
-use gibench_harness::gpu::profiler::{ProfileMode, Profiler};
+use gibench_harness::gpu::profiler::ProfileMode;
 use gibench_harness::gpu::{GpuContext, GpuOptions};
 use gibench_harness::kit::technique::TechniqueInfo;
 use gibench_harness::measure::results::StageKind;
@@ -49,7 +49,7 @@ fn render(
     let (mut t, compose) = h
         .build(info, &params, config, &prepared)
         .expect("technique builds");
-    let mut profiler = Profiler::new(gpu, ProfileMode::Frame);
+    let mut profiler = h.profiler(info, ProfileMode::Frame);
     for f in 0..FRAMES {
         let frame = h.clock.frame(f);
         h.render_frame(t.as_mut(), &compose, &mut profiler, &frame, true)
@@ -61,7 +61,13 @@ fn render(
         .stage_results()
         .into_iter()
         .filter(|s| s.kind == StageKind::Gpu && !costs.contains_key(&s.name))
-        .map(|s| s.name)
+        .map(|s| format!("{} without a declared cost", s.name))
+        .chain(
+            profiler
+                .undeclared()
+                .iter()
+                .map(|s| format!("{s} not in TechniqueInfo.stages")),
+        )
         .collect();
     let output = gibench_harness::gpu::image_io::read_rgb_f32(gpu, t.output().texture())
         .expect("output reads back")
@@ -165,7 +171,7 @@ fn conform_on<'a>(
         // dropped) without a `stage_cost` beside its `gpu_stage`: the roofline would show "–".
         if !undeclared.is_empty() {
             failures.push(format!(
-                "{name}: GPU stages without a declared cost: {}",
+                "{name}: stages not declared: {}",
                 undeclared.join(", ")
             ));
         }
@@ -228,4 +234,44 @@ fn conform_on<'a>(
             ));
         }
     }
+}
+
+/// Catches: a technique timing a stage its `TechniqueInfo::stages` does not declare (or
+/// declares as the other kind) without an error: keller-full declared without its own CPU
+/// stage and its maps' stage is refused by name when run.
+#[test]
+fn a_stage_the_technique_does_not_declare_is_refused() {
+    let gpu = GpuContext::new(&GpuOptions::default()).expect("a GPU adapter (Vulkan or GL)");
+    let scene = Scene::load_named("cornell", &AssetPaths::standard(None)).unwrap();
+    let config = RunConfig {
+        resolution: [64, 48],
+        frames: 1,
+        warmup: 3,
+        first_frame: 0,
+        timing: TimingMode::Stages,
+        seed: 1,
+        shadow_size: 128,
+    };
+    let h = Harness::new(&gpu, &scene, &config).unwrap();
+    let keller = TechniqueInfo::find(registry::all(), "keller-full").unwrap();
+    let partial = TechniqueInfo {
+        stages: &[gibench_harness::kit::ir::gather::GATHER_STAGES],
+        ..*keller
+    };
+    let params = partial.parse_params(&[]).unwrap();
+    let prepared = h.prepare(&partial, &params, &config).unwrap();
+    let e = h
+        .run(&partial, &params, &config, &prepared, &mut || {})
+        .err()
+        .expect("an undeclared stage is refused");
+    let e = e.to_string();
+    assert!(
+        e.contains("'keller-full'")
+            && e.contains("vpl-generation (CPU)")
+            && e.contains("vpl-shadow-maps (GPU)"),
+        "{e}"
+    );
+    // Declared in full, the same run goes through.
+    h.run(keller, &params, &config, &prepared, &mut || {})
+        .expect("declared stages run");
 }

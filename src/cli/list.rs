@@ -5,6 +5,7 @@
 
 use clap::Args;
 use gibench_harness::kit::technique::{ParamKind, ParamSpec};
+use gibench_harness::measure::results::StageKind;
 use gibench_harness::scene::{descriptor, SceneDescriptor};
 use gibench_harness::Result;
 
@@ -47,6 +48,21 @@ pub(crate) fn exec(args: &ListArgs) -> Result<()> {
             t.conformance.max_relative_l1,
             t.conformance.mean_ratio.0,
             t.conformance.mean_ratio.1
+        );
+        let stages: Vec<String> = t
+            .stages()
+            .map(|s| match s.kind {
+                StageKind::Gpu => s.name.to_string(),
+                StageKind::Cpu => format!("{} (CPU)", s.name),
+            })
+            .collect();
+        println!(
+            "      stages: {}",
+            if stages.is_empty() {
+                "none of its own".to_string()
+            } else {
+                stages.join(", ")
+            }
         );
         if t.param_specs().next().is_none() {
             println!("      (no parameters)");

@@ -154,6 +154,10 @@ pub struct Profiler {
     frames_begun: u64,
     /// Sum of the first frame's stage times (stages mode): the fill frame.
     first_frame_ms: f64,
+    /// The stages that may be timed ([`Profiler::declare_stages`]); `None`: any.
+    declared: Option<Vec<(&'static str, StageKind)>>,
+    /// Stages timed that were not declared, or declared of the other kind, as "name (kind)".
+    undeclared: Vec<String>,
 }
 
 impl Profiler {
@@ -206,6 +210,8 @@ impl Profiler {
             frame_times: Vec::new(),
             frames_begun: 0,
             first_frame_ms: 0.0,
+            declared: None,
+            undeclared: Vec::new(),
         }
     }
 
@@ -213,9 +219,27 @@ impl Profiler {
         self.mode
     }
 
+    /// Declares the stages (name and kind) that may be timed: any other is recorded as
+    /// undeclared ([`Profiler::undeclared`]), for the runner to refuse.
+    pub fn declare_stages(&mut self, stages: Vec<(&'static str, StageKind)>) {
+        self.declared = Some(stages);
+    }
+
+    /// The stages timed that were not declared (or declared as the other kind), as
+    /// "name (GPU)" / "name (CPU)".
+    pub fn undeclared(&self) -> &[String] {
+        &self.undeclared
+    }
+
     fn series_index(&mut self, name: &str, kind: StageKind) -> usize {
         if let Some(i) = self.series.iter().position(|s| s.name == name) {
             return i;
+        }
+        if let Some(declared) = &self.declared {
+            if !declared.iter().any(|&(n, k)| n == name && k == kind) {
+                let which = if kind == StageKind::Gpu { "GPU" } else { "CPU" };
+                self.undeclared.push(format!("{name} ({which})"));
+            }
         }
         self.series.push(StageSeries {
             name: name.to_string(),

@@ -14,6 +14,7 @@ pub use crate::cpu::reference::IndirectComponent;
 use crate::gpu::profiler::Profiler;
 use crate::gpu::GpuContext;
 use crate::kit::passes::{DirectLight, FrameUniforms, GBuffer, GpuScene};
+use crate::measure::results::StageKind;
 use crate::scene::anim::FrameState;
 use crate::scene::Scene;
 use crate::{Error, Result};
@@ -262,6 +263,31 @@ pub struct Conformance {
     pub mean_ratio: (f64, f64),
 }
 
+/// A stage a technique times (the name its `gpu_stage` / `cpu_stage` calls give, as the tables
+/// print it) and where it runs. Declared in [`TechniqueInfo::stages`]: a run refuses a stage
+/// that is not declared, `gibench list` prints them, and the conformance test checks that every
+/// declared GPU stage that runs has a declared cost.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Stage {
+    pub name: &'static str,
+    pub kind: StageKind,
+}
+
+impl Stage {
+    pub const fn gpu(name: &'static str) -> Stage {
+        Stage {
+            name,
+            kind: StageKind::Gpu,
+        }
+    }
+    pub const fn cpu(name: &'static str) -> Stage {
+        Stage {
+            name,
+            kind: StageKind::Cpu,
+        }
+    }
+}
+
 /// A registry entry: how to list and build a technique.
 pub struct TechniqueInfo {
     pub name: &'static str,
@@ -271,6 +297,10 @@ pub struct TechniqueInfo {
     /// What it is, in a few words (the README's table; `gibench list --markdown`).
     pub summary: &'static str,
     pub description: &'static str,
+    /// The stages it times, in frame order, composed from shared sets (the kit's
+    /// [`crate::kit::ir::gather::GATHER_STAGES`]) and its own: every name its `render` passes to
+    /// the profiler, some only under some parameters.
+    pub stages: &'static [&'static [Stage]],
     /// Declared parameters, composed from shared sets (e.g. the kit's gather parameters) and
     /// the technique's own; names are unique across the groups.
     pub params: &'static [&'static [ParamSpec]],
@@ -303,6 +333,10 @@ impl TechniqueInfo {
     }
 
     /// Every declared parameter, in declaration order.
+    pub fn stages(&self) -> impl Iterator<Item = &'static Stage> + '_ {
+        self.stages.iter().flat_map(|g| g.iter())
+    }
+
     pub fn param_specs(&self) -> impl Iterator<Item = &'static ParamSpec> + '_ {
         self.params.iter().flat_map(|g| g.iter())
     }

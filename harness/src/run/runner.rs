@@ -19,7 +19,7 @@ use crate::kit::technique::{
     FrameContext, Params, PrepareContext, Prepared, SceneContext, Technique, TechniqueInfo,
 };
 use crate::measure::metrics::{QualitySummary, ReferenceWork};
-use crate::measure::results::{FrameRange, RunResult, SCHEMA_VERSION};
+use crate::measure::results::{FrameRange, RunResult, StageKind, SCHEMA_VERSION};
 use crate::measure::roofline::{DeviceBounds, StageCost};
 use crate::run::bounds::measure_bounds;
 use crate::run::quality::{CapturedFrame, QualityConfig, QualityImages, ReferenceCache};
@@ -35,6 +35,13 @@ pub const STAGE_DIRECT_SHADOW_MAP: &str = "direct-shadow-map";
 pub const STAGE_DIRECT_LIGHT: &str = "direct-light";
 /// Stage: composing radiance and its display image.
 pub const STAGE_COMPOSE: &str = "compose";
+/// The stages every run times around the technique's, in frame order (all on the GPU).
+pub const RUN_STAGES: [&str; 4] = [
+    STAGE_GBUFFER,
+    STAGE_DIRECT_SHADOW_MAP,
+    STAGE_DIRECT_LIGHT,
+    STAGE_COMPOSE,
+];
 
 /// The shared GPU stages' declared minimum costs ([`crate::measure::roofline`]), computed once per
 /// harness.
@@ -498,6 +505,21 @@ impl<'a> Harness<'a> {
         })
     }
 
+    /// A profiler for `info`'s frames that records any stage it times beyond the run's own
+    /// ([`RUN_STAGES`]) and the ones it declares ([`TechniqueInfo::stages`]) as undeclared
+    /// ([`Profiler::undeclared`]), which [`Harness::run`] refuses.
+    pub fn profiler(&self, info: &TechniqueInfo, mode: ProfileMode) -> Profiler {
+        let mut profiler = Profiler::new(self.gpu, mode);
+        profiler.declare_stages(
+            RUN_STAGES
+                .iter()
+                .map(|&n| (n, StageKind::Gpu))
+                .chain(info.stages().map(|s| (s.name, s.kind)))
+                .collect(),
+        );
+        profiler
+    }
+
     /// Records one frame: shared passes, the technique's stages, compose.
     pub fn render_frame(
         &self,
@@ -593,7 +615,7 @@ impl<'a> Harness<'a> {
         let mut hook_warning = None;
         for &mode in config.timing.passes() {
             let (mut technique, compose) = self.build(info, params, config, prepared)?;
-            let mut profiler = Profiler::new(self.gpu, mode);
+            let mut profiler = self.profiler(info, mode);
             let total = config.warmup + config.frames;
             for i in 0..total {
                 let frame = self.clock.frame(config.first_frame + i);
@@ -607,6 +629,15 @@ impl<'a> Harness<'a> {
                 progress();
             }
             profiler.finish(self.gpu)?;
+            if !profiler.undeclared().is_empty() {
+                return Err(Error::Invalid(format!(
+                    "technique '{}' timed stage(s) {} that its TechniqueInfo.stages does not \
+                     declare (declared: {})",
+                    info.name,
+                    profiler.undeclared().join(", "),
+                    info.stages().map(|s| s.name).collect::<Vec<_>>().join(", ")
+                )));
+            }
             hook_warning = profiler.test_hook_warning();
             match mode {
                 ProfileMode::Stages => {

@@ -104,16 +104,17 @@ pub const STAGE_LIGHTS: &str = "lights";
 pub const STAGE_PRT_LIGHTING: &str = "prt-lighting";
 /// Stage: the movers drawn by PRT.
 pub const STAGE_PRT: &str = "prt";
-/// Every stage, in frame order.
-pub const STAGES: [&str; 8] = [
-    STAGE_VISIBILITY,
-    STAGE_SHADOW_MAPS,
-    STAGE_LIGHT_MAPS,
-    STAGE_EDGES,
-    STAGE_LOW_RES,
-    STAGE_LIGHTS,
-    STAGE_PRT_LIGHTING,
-    STAGE_PRT,
+/// Every stage, declared, in frame order (the low-resolution ones only at levels `full` and
+/// `vd-lp`, the light maps only at `full`).
+pub const STAGES: &[gibench_harness::kit::technique::Stage] = &[
+    gibench_harness::kit::technique::Stage::cpu(STAGE_VISIBILITY),
+    gibench_harness::kit::technique::Stage::gpu(STAGE_SHADOW_MAPS),
+    gibench_harness::kit::technique::Stage::gpu(STAGE_LIGHT_MAPS),
+    gibench_harness::kit::technique::Stage::gpu(STAGE_EDGES),
+    gibench_harness::kit::technique::Stage::gpu(STAGE_LOW_RES),
+    gibench_harness::kit::technique::Stage::gpu(STAGE_LIGHTS),
+    gibench_harness::kit::technique::Stage::cpu(STAGE_PRT_LIGHTING),
+    gibench_harness::kit::technique::Stage::gpu(STAGE_PRT),
 ];
 
 /// What barczak's light samples light with `params`: the area light's direct light
@@ -132,6 +133,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     paper: "Barczak 2006",
     summary: "light-mapped, visibility-culled instant radiosity",
     description: "Barczak 2006 light-mapped, visibility-culled instant radiosity with octahedral shadow maps, a low-resolution pass and PRT movers (level=full|vd-lp|vd|naive)",
+    stages: &[STAGES],
     params: &[PARAMS],
     required_features: wgpu::Features::empty(),
     required_limits: wgpu::Limits::downlevel_defaults,

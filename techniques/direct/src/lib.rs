@@ -21,6 +21,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     paper: "—",
     summary: "baseline: direct light only",
     description: "direct light only (shadow-mapped primary light); indirect irradiance is zero",
+    stages: &[],
     params: &[PARAMS],
     required_features: wgpu::Features::empty(),
     required_limits: wgpu::Limits::downlevel_webgl2_defaults,

@@ -74,6 +74,12 @@ pub const STAGE_VOXELIZATION: &str = "voxelization";
 pub const STAGE_PROPAGATION: &str = "propagation";
 /// Stage: the per-pixel reconstruction.
 pub const STAGE_RECONSTRUCTION: &str = "reconstruction";
+/// Every stage, declared, in frame order.
+const STAGES: &[gibench_harness::kit::technique::Stage] = &[
+    gibench_harness::kit::technique::Stage::gpu(STAGE_VOXELIZATION),
+    gibench_harness::kit::technique::Stage::gpu(STAGE_PROPAGATION),
+    gibench_harness::kit::technique::Stage::gpu(STAGE_RECONSTRUCTION),
+];
 
 /// Registry entry.
 pub const INFO: TechniqueInfo = TechniqueInfo {
@@ -81,6 +87,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     paper: "Gaitatzes et al. 2010",
     summary: "voxel SH propagation of indirect light",
     description: "Gaitatzes et al. 2010 voxel SH light propagation with occlusion and multiple bounces (mode=lpv: plain LPV)",
+    stages: &[STAGES],
     params: &[PARAMS],
     required_features: wgpu::Features::empty(),
     required_limits: wgpu::Limits::downlevel_defaults,

@@ -60,6 +60,16 @@ pub const STAGE_VPL_SAMPLING: &str = "vpl-sampling";
 pub const STAGE_POINT_SPLAT: &str = "point-splat";
 /// Stage: pull-push over all maps, into the atlas.
 pub const STAGE_PULL_PUSH: &str = "pull-push";
+/// The VPLs' stages both variants share, declared.
+const VPL_STAGES: &[gibench_harness::kit::technique::Stage] = &[
+    gibench_harness::kit::technique::Stage::gpu(STAGE_RSM),
+    gibench_harness::kit::technique::Stage::gpu(STAGE_VPL_SAMPLING),
+];
+/// The imperfect maps' stages, declared.
+const IMPERFECT_STAGES: &[gibench_harness::kit::technique::Stage] = &[
+    gibench_harness::kit::technique::Stage::gpu(STAGE_POINT_SPLAT),
+    gibench_harness::kit::technique::Stage::gpu(STAGE_PULL_PUSH),
+];
 
 /// `ism-classic` registry entry.
 pub const INFO_CLASSIC: TechniqueInfo = TechniqueInfo {
@@ -68,6 +78,11 @@ pub const INFO_CLASSIC: TechniqueInfo = TechniqueInfo {
     summary: "`ism`'s VPLs with classic, rasterised maps",
     description:
         "ism's RSM-sampled VPLs with classic triangle-rasterised maps (the slides' comparison)",
+    stages: &[
+        VPL_STAGES,
+        gibench_harness::kit::ir::gather::SHADOW_MAP_STAGES,
+        gibench_harness::kit::ir::gather::GATHER_STAGES,
+    ],
     params: &[CLASSIC_PARAMS, GATHER],
     required_features: wgpu::Features::empty(),
     required_limits: wgpu::Limits::downlevel_defaults,
@@ -88,6 +103,11 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     summary: "imperfect shadow maps",
     description:
         "Ritschel et al. 2008 imperfect shadow maps: RSM-sampled VPLs, point splats, pull-push",
+    stages: &[
+        VPL_STAGES,
+        IMPERFECT_STAGES,
+        gibench_harness::kit::ir::gather::GATHER_STAGES,
+    ],
     params: &[OWN_PARAMS, GATHER],
     required_features: wgpu::Features::empty(),
     required_limits: wgpu::Limits::downlevel_defaults,

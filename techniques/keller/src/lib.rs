@@ -47,6 +47,11 @@ use params::{FULL_OWN, INCREMENTAL_OWN};
 
 /// Stage: tracing light paths and placing VPLs on the CPU.
 pub const STAGE_VPL_GENERATION: &str = "vpl-generation";
+/// Keller's own stage, declared.
+const OWN_STAGES: &[gibench_harness::kit::technique::Stage] =
+    &[gibench_harness::kit::technique::Stage::cpu(
+        STAGE_VPL_GENERATION,
+    )];
 
 /// Conformance on the Cornell boxes against the one-bounce reference (64 VPLs, 4x4 tiles):
 /// measured relative L1 0.30–0.72 and mean ratio 0.96–1.05 over the spot, area, omni and sun
@@ -72,6 +77,11 @@ pub const FULL: TechniqueInfo = TechniqueInfo {
     paper: "Keller 1997",
     summary: "instant radiosity, every VPL map every frame",
     description: "Keller instant radiosity: all VPLs and their shadow maps recomputed every frame",
+    stages: &[
+        OWN_STAGES,
+        gibench_harness::kit::ir::gather::SHADOW_MAP_STAGES,
+        gibench_harness::kit::ir::gather::GATHER_STAGES,
+    ],
     params: &[FULL_OWN, GATHER_PARAMS],
     required_features: wgpu::Features::empty(),
     required_limits: wgpu::Limits::downlevel_defaults,
@@ -87,6 +97,7 @@ pub const INCREMENTAL: TechniqueInfo = TechniqueInfo {
     paper: "Keller 1997",
     summary: "a ring of light paths, oldest replaced",
     description: "Keller instant radiosity: keep the last N paths, replace the oldest `budget` per frame, accumulate",
+    stages: &[OWN_STAGES, gibench_harness::kit::ir::gather::SHADOW_MAP_STAGES, gibench_harness::kit::ir::gather::GATHER_STAGES],
     params: &[INCREMENTAL_OWN, GATHER_PARAMS],
     required_features: wgpu::Features::empty(),
     required_limits: wgpu::Limits::downlevel_defaults,

@@ -62,6 +62,11 @@ use params::OWN_PARAMS;
 
 /// Stage: the CPU VPL management of §4 (validity, deletion, creation, intensities).
 pub const STAGE_VPL_MANAGEMENT: &str = "vpl-management";
+/// Laine's own stage, declared.
+const OWN_STAGES: &[gibench_harness::kit::technique::Stage] =
+    &[gibench_harness::kit::technique::Stage::cpu(
+        STAGE_VPL_MANAGEMENT,
+    )];
 
 /// `laine` registry entry.
 pub const INFO: TechniqueInfo = TechniqueInfo {
@@ -69,6 +74,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     paper: "Laine et al. 2007",
     summary: "incremental instant radiosity",
     description: "Laine et al. 2007 incremental instant radiosity: reuse valid VPLs, recompute a few per frame",
+    stages: &[OWN_STAGES, gibench_harness::kit::ir::gather::SHADOW_MAP_STAGES, gibench_harness::kit::ir::gather::GATHER_STAGES],
     params: &[OWN_PARAMS, GATHER_PARAMS],
     required_features: wgpu::Features::empty(),
     required_limits: wgpu::Limits::downlevel_defaults,

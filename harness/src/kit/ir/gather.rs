@@ -16,7 +16,7 @@ use super::raster::{AtlasClear, AtlasRasteriser, StoreViews};
 use super::store::VplStore;
 use crate::cpu::vpl::Vpl;
 use crate::kit::passes::DrawSet;
-use crate::kit::technique::{FrameContext, ParamKind, ParamSpec, Params, PrepareContext};
+use crate::kit::technique::{FrameContext, ParamKind, ParamSpec, Params, PrepareContext, Stage};
 use crate::measure::roofline::StageCost;
 use crate::Result;
 
@@ -30,6 +30,15 @@ pub const STAGE_ACCUMULATE: &str = "accumulate";
 pub const STAGE_COMBINE: &str = "combine";
 /// Stage: the geometry-aware filter.
 pub const STAGE_FILTER: &str = "filter";
+/// The VPL shadow maps' stage, declared (techniques that draw the kit's maps).
+pub const SHADOW_MAP_STAGES: &[Stage] = &[Stage::gpu(STAGE_VPL_SHADOW_MAPS)];
+/// The gathering's stages, declared, in order (every VPL technique).
+pub const GATHER_STAGES: &[Stage] = &[
+    Stage::gpu(STAGE_SPLIT),
+    Stage::gpu(STAGE_ACCUMULATE),
+    Stage::gpu(STAGE_COMBINE),
+    Stage::gpu(STAGE_FILTER),
+];
 /// The gathering stages Laine et al. 2007's Table 2 sums as "Σ common", in order.
 pub const COMMON_STAGES: [&str; 4] = [STAGE_SPLIT, STAGE_ACCUMULATE, STAGE_COMBINE, STAGE_FILTER];
 

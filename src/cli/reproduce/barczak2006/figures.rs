@@ -187,7 +187,7 @@ fn still_name(room: &str) -> String {
 fn present(r: &RunResult) -> Vec<&'static str> {
     STAGES
         .iter()
-        .copied()
+        .map(|s| s.name)
         .filter(|s| r.stage(s).is_some())
         .collect()
 }
