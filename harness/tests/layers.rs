@@ -168,7 +168,7 @@ fn technique_crates_use_only_the_kit_and_below() {
                     "glam" | "wgpu" => continue,
                     m => layer_of(m),
                 };
-                if !layer.is_some_and(|l| l <= kit) {
+                if layer.is_none_or(|l| l > kit) {
                     wrong.push(format!(
                         "{}: uses `gibench_harness::{module}`, above the kit",
                         file.strip_prefix(&techniques).unwrap().display()
