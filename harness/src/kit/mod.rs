@@ -7,3 +7,4 @@
 pub mod ir;
 pub mod passes;
 pub mod technique;
+pub mod wgsl;

@@ -421,8 +421,7 @@ fn voxelize_pipeline(
     direct: &DirectLight,
 ) -> wgpu::RenderPipeline {
     let source = format!(
-        "{}\n{}\n{}",
-        gibench_harness::kit::passes::MESH_WGSL,
+        "{}\n{}",
         DirectLight::wgsl(3),
         include_str!("shaders/voxelize.wgsl")
     );

@@ -381,16 +381,10 @@ impl ShadowAtlas {
 
     /// The lookup for a shader binding [`ShadowAtlas::group`] at `group`: the bindings
     /// `atlas_params` and `vpl_atlas`, then `vpl_visibility(v: GpuVpl, p, n) -> f32`. Needs
-    /// `GpuVpl` ([`super::store::VPL_STORE_WGSL`]) before it.
+    /// `GpuVpl`, which the module imports.
     pub fn wgsl(group: u32) -> String {
-        let lookup = include_str!("shaders/atlas_lookup.wgsl");
-        let split = lookup
-            .find("// Top-left texel")
-            .expect("atlas_lookup.wgsl declares AtlasParams first");
         format!(
-            "{}\n@group({group}) @binding(0) var<storage, read> atlas_params: AtlasParams;\n@group({group}) @binding(1) var vpl_atlas: texture_2d<f32>;\n{}",
-            &lookup[..split],
-            &lookup[split..]
+            "#import gibench::atlas_lookup\n@group({group}) @binding(0) var<storage, read> atlas_params: AtlasParams;\n@group({group}) @binding(1) var vpl_atlas: texture_2d<f32>;\n"
         )
     }
 }

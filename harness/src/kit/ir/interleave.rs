@@ -48,15 +48,12 @@ use crate::kit::passes::{
     HDR_FORMAT, PARAMS_USAGE,
 };
 
-/// WGSL declarations a technique prepends to its accumulate shader (after `common.wgsl`, which
-/// [`crate::kit::passes::shader_module`] adds): `struct InterleaveParams { full, tiles, tile_size, split:
+/// WGSL a technique composes into its accumulate shader (its bindings, and the import of the
+/// module `gibench::interleave`, resolved by [`crate::kit::passes::shader_module`]): `struct InterleaveParams { full, tiles, tile_size, split:
 /// vec2<u32>, thresholds: vec4<f32> }`, the group-0 bindings `interleave`, `split_position`,
 /// `split_normal`, `split_irradiance`, and the helpers `split_in_range`, `split_index`,
 /// `split_tile`, `split_original_pixel`, `split_valid` and `split_texel_of_pixel`.
-pub const INTERLEAVE_WGSL: &str = concat!(
-    include_str!("shaders/interleave.wgsl"),
-    include_str!("shaders/interleave_bindings.wgsl")
-);
+pub const INTERLEAVE_WGSL: &str = include_str!("shaders/interleave_bindings.wgsl");
 
 /// Thresholds of the geometry-aware filter (Laine et al. 2007, Figure 5).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -299,11 +296,7 @@ fn pipelines(
     let module = shader_module(
         device,
         "interleave",
-        &format!(
-            "{}\n{}",
-            include_str!("shaders/interleave.wgsl"),
-            include_str!("shaders/interleave_passes.wgsl")
-        ),
+        include_str!("shaders/interleave_passes.wgsl"),
     );
     let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some("interleave"),

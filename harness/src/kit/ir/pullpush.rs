@@ -120,7 +120,7 @@ impl PullPush {
             pipeline(&layout, common.to_string(), "push"),
             pipeline(
                 &store_layout,
-                format!("{common}\n{}", include_str!("shaders/pullpush_store.wgsl")),
+                include_str!("shaders/pullpush_store.wgsl").to_string(),
                 "store",
             ),
         ];

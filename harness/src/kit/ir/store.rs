@@ -20,7 +20,7 @@ use crate::cpu::vpl::{frame_from_normal, Vpl};
 use crate::gpu::GpuContext;
 use crate::{Error, Result};
 
-/// GPU layout of `GpuVpl` (see [`VPL_STORE_WGSL`]).
+/// GPU layout of `GpuVpl` (the WGSL module `gibench::vpl_store`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable, PartialEq)]
 pub struct GpuVpl {
@@ -48,9 +48,6 @@ impl GpuVpl {
         }
     }
 }
-
-/// WGSL of the store: `struct GpuVpl` and `struct VplStoreData { header, items }`.
-pub const VPL_STORE_WGSL: &str = include_str!("shaders/vpl_store.wgsl");
 
 /// Bytes before the first item.
 const HEADER: u64 = 16;
@@ -128,7 +125,7 @@ impl VplStore {
     pub fn wgsl(group: u32, binding: u32, read_write: bool) -> String {
         let access = if read_write { "read_write" } else { "read" };
         format!(
-            "{VPL_STORE_WGSL}\n@group({group}) @binding({binding}) var<storage, {access}> vpl_store: VplStoreData;\n"
+            "#import gibench::vpl_store\n@group({group}) @binding({binding}) var<storage, {access}> vpl_store: VplStoreData;\n"
         )
     }
 

@@ -53,10 +53,6 @@ pub fn needed_cube_faces(light: &LightPose) -> [bool; 6] {
     out
 }
 
-/// The direct light's WGSL for any shader: `direct_shadow(p, n)` (PCF visibility) and
-/// `direct_irradiance(p, n)`; it expects the bindings [`DirectLight::wgsl`] declares.
-pub const DIRECT_LIGHT_WGSL: &str = include_str!("shaders/direct_light.wgsl");
-
 /// The direct-light passes and their targets.
 pub struct DirectLight {
     pub shadow_map: wgpu::Texture,
@@ -182,13 +178,13 @@ impl DirectLight {
     }
 
     /// The direct light for a technique's shader that binds [`DirectLight::light_group`] at
-    /// `group`: the bindings `light` and `direct_shadow_map`, then [`DIRECT_LIGHT_WGSL`]
-    /// (`direct_shadow(p, n)`, `direct_irradiance(p, n)`). Prepend it after `common.wgsl`.
+    /// `group`: the bindings `light` and `direct_shadow_map` beside the import of `gibench::direct_light`
+    /// (`direct_shadow(p, n)`, `direct_irradiance(p, n)`); composed anywhere in the shader.
     pub fn wgsl(group: u32) -> String {
         format!(
-            "@group({group}) @binding(0) var<storage, read> light: Light;\n\
-             @group({group}) @binding(1) var direct_shadow_map: texture_2d<f32>;\n\
-             {DIRECT_LIGHT_WGSL}"
+            "#import gibench::direct_light\n\
+             @group({group}) @binding(0) var<storage, read> light: Light;\n\
+             @group({group}) @binding(1) var direct_shadow_map: texture_2d<f32>;\n"
         )
     }
 

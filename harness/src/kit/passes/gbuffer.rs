@@ -61,12 +61,7 @@ pub fn scene_pipeline(
     vertex_entry: &str,
     fragment: Option<(&str, &[wgpu::TextureFormat])>,
 ) -> wgpu::RenderPipeline {
-    let source = format!(
-        "{}\n{}",
-        super::MESH_WGSL,
-        include_str!("shaders/geometry.wgsl")
-    );
-    let module = shader_module(device, label, &source);
+    let module = shader_module(device, label, include_str!("shaders/geometry.wgsl"));
     let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some(label),
         bind_group_layouts: &[

@@ -25,7 +25,7 @@ pub use bind::{
     storage_entry, storage_texture_entry, texture_entry, uniform_entry, PARAMS_USAGE,
 };
 pub use compose::Compose;
-pub use direct::{draw_light_faces, needed_cube_faces, DirectLight, CUBE_FACES, DIRECT_LIGHT_WGSL};
+pub use direct::{draw_light_faces, needed_cube_faces, DirectLight, CUBE_FACES};
 pub use gbuffer::{
     begin_gbuffer_pass, scene_pipeline, GBuffer, GBufferTexels, ALBEDO_FORMAT, DEPTH_FORMAT,
     NORMAL_FORMAT,
@@ -35,25 +35,18 @@ pub use scene_gpu::{
     CAMERA_SLOT, MAX_MATERIALS,
 };
 
-/// The scene's meshes as every rasterising pass draws them (`shaders/mesh.wgsl`): the object
-/// and material bindings (groups 1 and 2), the vertex layout, the vertex transform and a
-/// fragment's albedo. Prepended, after [`COMMON_WGSL`], by [`scene_pipeline`]'s shader and by any
-/// technique's own pass over the scene's meshes (Gaitatzes' voxelization).
-pub const MESH_WGSL: &str = include_str!("shaders/mesh.wgsl");
-
-/// WGSL declared once and prepended to every shader (View, Light, helpers).
-pub const COMMON_WGSL: &str = include_str!("shaders/common.wgsl");
-
-/// Creates a shader module from `source` with [`COMMON_WGSL`] prepended.
+/// Creates a shader module from `source`, its `#import`s and the prelude resolved
+/// ([`crate::kit::wgsl::compose`]). An unknown import is a bug of ours: it panics, naming it
+/// (the test over every shader finds it first).
 pub fn shader_module(device: &wgpu::Device, label: &str, source: &str) -> wgpu::ShaderModule {
-    let full = format!("{COMMON_WGSL}\n{source}");
+    let full = crate::kit::wgsl::compose(source).unwrap_or_else(|e| panic!("{label}: {e}"));
     device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some(label),
         source: wgpu::ShaderSource::Wgsl(full.into()),
     })
 }
 
-/// A compute pipeline: `entry` of `source` (with [`COMMON_WGSL`] prepended) over `layouts`
+/// A compute pipeline: `entry` of `source` (imports resolved, [`shader_module`]) over `layouts`
 /// (bind groups 0, 1, ... in order).
 pub fn compute_pipeline(
     device: &wgpu::Device,

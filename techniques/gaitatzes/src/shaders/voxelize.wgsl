@@ -3,8 +3,8 @@
 // of the axis's atlas, depth-clipped to the slice; the fragments that land are the slice's
 // voxels. Additive blending sums, per voxel, the direct radiosity, the normal and the albedo of
 // every fragment, and counts them (alpha). The combine pass averages them and merges the three
-// axes. Expects the harness's mesh module (`passes::MESH_WGSL`) and DirectLight::wgsl(3)
-// prepended.
+// axes. Imports the harness's mesh module; DirectLight::wgsl(3) is composed beside it.
+#import gibench::mesh
 
 struct Slice {
     // World -> clip for this slice: x, y over the slice's N x N tile; z = the position along

@@ -1,9 +1,10 @@
+#import gibench::vpl_store
 // Visibility lookups in a VPL shadow atlas (ShadowAtlas): one map per slot, paraboloid
 // (Brabec et al. 2002, as Laine et al. 2007 use), cube (3x2 faces) or octahedral (Barczak 2006:
 // four octahedron faces unfolded to a square). Stored values are reversed depth: 1 near,
 // 0 far/empty (paraboloid, octahedral: 1 - distance / far; cube: reversed-Z NDC depth).
-// Expects `GpuVpl` (VPL_STORE_WGSL) and the bindings `atlas_params` and `vpl_atlas` that
-// ShadowAtlas::wgsl declares.
+// The module `gibench::atlas_lookup`: uses the bindings `atlas_params` and `vpl_atlas` that
+// ShadowAtlas::wgsl declares beside its import.
 
 struct AtlasParams {
     // x: slots per atlas row; y: map size (texels); z: parameterisation (0 paraboloid, 1 cube,

@@ -1,3 +1,4 @@
+#import gibench::interleave
 
 // The accumulate step's bindings (Interleave::split_layout / split_group). split_position: world
 // position, w = 1 where valid geometry, 0 for background or outside the image; split_normal:

@@ -2,7 +2,7 @@
 // The harness's interleave passes: split (G-buffer → split buffers), combine (split_irradiance →
 // combined) and the geometry-aware box filter of Laine et al. 2007, Figure 5 (split position and
 // normal, combined → output).
-// Prepended: common.wgsl and interleave.wgsl.
+#import gibench::interleave
 
 @group(0) @binding(0) var<storage, read> interleave: InterleaveParams;
 @group(0) @binding(1) var<storage, read_write> split_position: array<vec4<f32>>;

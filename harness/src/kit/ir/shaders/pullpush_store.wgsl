@@ -1,6 +1,7 @@
 // The last push: level 0 into the atlas. A texel where a point landed keeps its depth exactly;
 // a hole takes its filled parent's depth (level 1), or stays empty (0) where nothing was
-// within the levels pulled. Expects pullpush.wgsl's bindings.
+// within the levels pulled. Adds a binding to pullpush.wgsl's.
+#import gibench::pullpush
 
 @group(0) @binding(3) var atlas_out: texture_storage_2d<r32float, write>;
 

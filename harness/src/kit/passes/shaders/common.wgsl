@@ -1,4 +1,5 @@
-// Shared declarations, prepended to every harness and technique shader.
+// Shared declarations: the module `gibench::common`, the prelude of every harness and technique
+// shader (kit::wgsl).
 
 struct View {
     view_proj: mat4x4<f32>,

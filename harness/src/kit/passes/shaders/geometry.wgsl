@@ -1,5 +1,5 @@
-// G-buffer and depth-only (shadow map) rendering of the scene's meshes. Expects mesh.wgsl
-// prepended.
+// G-buffer and depth-only (shadow map) rendering of the scene's meshes.
+#import gibench::mesh
 
 @group(0) @binding(0) var<uniform> view: View;
 @vertex

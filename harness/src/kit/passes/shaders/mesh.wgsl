@@ -1,7 +1,7 @@
 // The scene's meshes as every rasterising pass draws them: the object and material bindings
 // (groups 1 and 2, the shared layouts of `FrameUniforms` and `GpuScene`), the vertex layout of
 // `GpuScene::vertex_layout`, the vertex transform to any clip space, and a fragment's albedo.
-// Prepended (after COMMON_WGSL) by the G-buffer and shadow-map passes and by Gaitatzes'
+// The module `gibench::mesh`: imported by the G-buffer and shadow-map passes and by Gaitatzes'
 // voxelization; each declares its own group 0 (the view or the slice).
 
 @group(1) @binding(0) var<uniform> object: Object;
