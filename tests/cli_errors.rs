@@ -29,7 +29,8 @@ fn root() -> PathBuf {
 fn fails(args: &[&str], expect: &str) {
     let tmp = tempfile::tempdir().unwrap();
     let out = tmp.path().join("out");
-    let o = support::gibench()
+    let o = support::GIBENCH
+        .command()
         .arg("run")
         .args(args)
         .arg("--out")
@@ -77,7 +78,7 @@ fn one_direct_frame(
     scene: Option<&Path>,
     out: impl AsRef<std::ffi::OsStr>,
 ) -> std::process::Output {
-    let mut c = support::gibench();
+    let mut c = support::GIBENCH.command();
     c.args([
         "run",
         "--technique",
@@ -128,7 +129,8 @@ fn corners(p: [[f32; 3]; 3]) -> Vec<u8> {
 /// Runs `gibench ARGS` in folder `dir` with `env` set, expects failure whose stderr contains
 /// every string of `expect` and no panic, and returns the stderr.
 fn command_fails(dir: &Path, env: &[(&str, &str)], args: &[&str], expect: &[&str]) -> String {
-    let o = support::gibench()
+    let o = support::GIBENCH
+        .command()
         .current_dir(dir)
         .env_remove("GIBENCH_BACKEND")
         .envs(env.iter().copied())

@@ -68,7 +68,8 @@ fn compare_with(
     options: &[&str],
 ) -> (bool, Vec<(String, String)>, String) {
     let out = dir.join(format!("cmp-{base}-{current}").replace('/', "-"));
-    let o = support::gibench()
+    let o = support::GIBENCH
+        .command()
         .arg("compare")
         .arg(dir.join(base))
         .arg(dir.join(current))
@@ -181,7 +182,8 @@ fn compare_markdown(
     options: &[&str],
 ) -> (Option<i32>, String, String) {
     let out = dir.join(format!("md-{base}-{current}").replace('/', "-"));
-    let o = support::gibench()
+    let o = support::GIBENCH
+        .command()
         .arg("compare")
         .arg(dir.join(base))
         .arg(dir.join(current))
@@ -263,7 +265,8 @@ fn markdown_lists_regressions_first_and_fail_on_sets_the_status() {
         "{md}"
     );
     // The default output is the terminal table, as before.
-    let o = support::gibench()
+    let o = support::GIBENCH
+        .command()
         .arg("compare")
         .arg(dir.join("base"))
         .arg(dir.join("mixed"))
@@ -336,7 +339,8 @@ fn a_run_on_one_side_only_is_listed_and_fails_require_all() {
     assert!(md.contains("Not compared (on one side only)"), "{md}");
 
     let out = dir.join("strict");
-    let o = support::gibench()
+    let o = support::GIBENCH
+        .command()
         .arg("compare")
         .arg(dir.join("base"))
         .arg(dir.join("current"))
@@ -504,7 +508,7 @@ fn compare_runs_end_to_end() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path();
     let run_into = |out: &Path, slow: bool| {
-        let mut c = support::gibench();
+        let mut c = support::GIBENCH.command();
         c.args(["run", "--technique", "direct", "--frames", "30"])
             .args([
                 "--warmup",

@@ -28,7 +28,7 @@ use gibench_harness::gpu::{GpuContext, GpuOptions};
 use gibench_harness::kit::technique::TechniqueInfo;
 use gibench_harness::measure::results::StageKind;
 use gibench_harness::run::quality::IndirectComponent;
-use gibench_harness::run::runner::{Harness, RunConfig, TimingMode};
+use gibench_harness::run::runner::{Harness, RunConfig};
 use gibench_harness::scene::assets::AssetPaths;
 use gibench_harness::scene::Scene;
 
@@ -119,15 +119,7 @@ fn conform_on<'a>(
     failures: &mut Vec<String>,
 ) {
     let scene = Scene::load_named(scene_name, &AssetPaths::standard(None)).unwrap();
-    let config = RunConfig {
-        resolution: SIZE,
-        frames: FRAMES,
-        warmup: 0,
-        first_frame: 0,
-        timing: TimingMode::Stages,
-        seed: 1,
-        shadow_size: 256,
-    };
+    let config = gibench_test_support::one_frame(SIZE).frames(FRAMES).build();
     let h = Harness::new(gpu, &scene, &config).unwrap();
     let frame = h.clock.frame(FRAMES - 1);
     let mut references = Vec::new();

@@ -110,7 +110,7 @@ fn export_writes_bmf_that_bencher_documents() {
     inputs(&dir.join("runs"));
     let out = dir.join("bmf/history.json");
     let instructions = root().join("results/baseline/instructions.json");
-    let o = support::run_ok(&[
+    let o = support::GIBENCH.run_ok(&[
         "export".as_ref(),
         "--format".as_ref(),
         "bmf".as_ref(),
@@ -160,7 +160,7 @@ fn export_writes_bmf_that_bencher_documents() {
         );
     }
 
-    let o = support::run_ok(&[
+    let o = support::GIBENCH.run_ok(&[
         "export".as_ref(),
         "--format".as_ref(),
         "bmf".as_ref(),
@@ -211,7 +211,7 @@ fn export_names_bad_input() {
     std::fs::write(&f, serde_json::to_vec(&v).unwrap()).unwrap();
     let out = dir.join("out.json");
     let run = |args: &[&std::ffi::OsStr]| {
-        let o = support::gibench().args(args).output().unwrap();
+        let o = support::GIBENCH.command().args(args).output().unwrap();
         assert!(!o.status.success());
         String::from_utf8_lossy(&o.stderr).into_owned()
     };
@@ -281,7 +281,7 @@ fn export(dirs: &[&Path]) -> Value {
     let mut args: Vec<&std::ffi::OsStr> =
         vec!["export".as_ref(), "--format".as_ref(), "bmf".as_ref()];
     args.extend(dirs.iter().map(|d| d.as_os_str()));
-    let o = support::run_ok(&args);
+    let o = support::GIBENCH.run_ok(&args);
     serde_json::from_slice(&o.stdout).unwrap()
 }
 
@@ -409,7 +409,7 @@ fn criterion_benchmarks_export_as_kernels() {
     }
     assert_eq!(estimates.len(), 3);
     let out = tmp.path().join("bmf.json");
-    support::run_ok(&[
+    support::GIBENCH.run_ok(&[
         "export".as_ref(),
         "--format".as_ref(),
         "bmf".as_ref(),
@@ -448,7 +448,8 @@ fn criterion_benchmarks_export_as_kernels() {
     let empty = tmp.path().join("empty");
     std::fs::create_dir_all(&empty).unwrap();
     for bad in [&empty, &tmp.path().join("missing")] {
-        let o = support::gibench()
+        let o = support::GIBENCH
+            .command()
             .args(["export", "--format", "bmf", "--criterion"])
             .arg(bad)
             .output()

@@ -24,7 +24,7 @@ const SHARD_VARS: &[&str] = &[
 /// `gibench reproduce all --quick --quiet --only ONLY --out OUT` at the tiny test size, with
 /// `vars` as its job system's environment, started (not waited for).
 fn start(only: &str, out: &Path, vars: &[(&str, String)]) -> Child {
-    let mut c: Command = support::gibench();
+    let mut c: Command = support::GIBENCH.command();
     for v in SHARD_VARS {
         c.env_remove(v);
     }
@@ -214,7 +214,7 @@ fn shards_match_one_run(
     args.extend(shard_dirs.iter().cloned());
     args.push("--out".into());
     args.push(merged.clone());
-    support::run_ok(&args);
+    support::GIBENCH.run_ok(&args);
     assert_same_tables(&single, &merged);
     logs
 }
@@ -266,7 +266,7 @@ fn shards_from_slurm_and_kubernetes_merge_to_the_unsharded_tables() {
         let mut args: Vec<PathBuf> = vec!["merge".into()];
         args.extend(dirs.iter().map(|d| d.to_path_buf()));
         args.extend(["--out".into(), out.clone()]);
-        let o = support::run(&args);
+        let o = support::GIBENCH.run(&args);
         let stderr = String::from_utf8_lossy(&o.stderr);
         assert!(
             !o.status.success() && stderr.contains(expect),
@@ -316,7 +316,7 @@ fn merge_refuses_mixed_settings_and_duplicates() {
         ("missing", "reproduce-all.json"),
     ] {
         let out = d("out");
-        let o = support::run(&[
+        let o = support::GIBENCH.run(&[
             "merge".as_ref(),
             d("a").as_os_str(),
             d(other).as_os_str(),
@@ -333,7 +333,7 @@ fn merge_refuses_mixed_settings_and_duplicates() {
     // Different targets of one mode and commit pool (the control: the refusals above are
     // about the settings, not about merging at all).
     let out = d("out");
-    support::run_ok(&[
+    support::GIBENCH.run_ok(&[
         "merge".as_ref(),
         d("a").as_os_str(),
         d("ok").as_os_str(),
@@ -374,7 +374,7 @@ fn a_budget_runs_what_fits_and_lists_what_it_left_out() {
     .unwrap();
     // keller-tiles has no estimate there: left out too.
     let began = std::time::Instant::now();
-    let mut c = support::gibench();
+    let mut c = support::GIBENCH.command();
     for v in SHARD_VARS {
         c.env_remove(v);
     }
@@ -468,7 +468,7 @@ fn a_target_failing_within_a_budget_is_left_out_and_the_rest_published() {
         serde_json::to_vec(&m).unwrap(),
     )
     .unwrap();
-    let mut c = support::gibench();
+    let mut c = support::GIBENCH.command();
     for v in SHARD_VARS {
         c.env_remove(v);
     }
@@ -552,7 +552,7 @@ fn bad_shards_and_budgets_are_refused_before_any_work() {
         (vec!["--budget", "9x"], vec![], "--budget"),
         (vec!["--budget", "0s"], vec![], "--budget"),
     ] {
-        let mut c = support::gibench();
+        let mut c = support::GIBENCH.command();
         for v in SHARD_VARS {
             c.env_remove(v);
         }
@@ -583,7 +583,7 @@ fn start_run(
     vars: &[(&str, String)],
     extra: &[&str],
 ) -> Child {
-    let mut c: Command = support::gibench();
+    let mut c: Command = support::GIBENCH.command();
     for v in SHARD_VARS {
         c.env_remove(v);
     }
@@ -633,7 +633,7 @@ fn merge(dirs: &[PathBuf], out: &Path) -> (bool, String) {
     let mut args: Vec<PathBuf> = vec!["merge".into()];
     args.extend(dirs.iter().cloned());
     args.extend(["--out".into(), out.to_path_buf()]);
-    let o = support::run(&args);
+    let o = support::GIBENCH.run(&args);
     (
         o.status.success(),
         String::from_utf8_lossy(&o.stderr).into_owned(),
@@ -643,7 +643,7 @@ fn merge(dirs: &[PathBuf], out: &Path) -> (bool, String) {
 /// `gibench sweep` of laine's tiles over three points at 64x48, two frames, into `out` with
 /// `extra` added: its exit status and standard error.
 fn sweep(out: &Path, extra: &[&str]) -> (bool, String) {
-    let mut c: Command = support::gibench();
+    let mut c: Command = support::GIBENCH.command();
     for v in SHARD_VARS {
         c.env_remove(v);
     }

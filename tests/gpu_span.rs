@@ -26,7 +26,7 @@ use gibench_harness::measure::results::RunResult;
 #[test]
 fn gpu_frame_span_lies_between_the_longest_stage_and_three_frame_intervals() {
     let tmp = tempfile::tempdir().unwrap();
-    let o = support::run_ok(&[
+    let o = support::GIBENCH.run_ok(&[
         "run",
         "--technique",
         "laine",

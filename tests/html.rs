@@ -10,7 +10,10 @@ mod support;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use support::run_ok as gibench;
+/// Runs `gibench ARGS`, which must succeed.
+fn gibench<S: AsRef<std::ffi::OsStr> + std::fmt::Debug>(args: &[S]) -> std::process::Output {
+    support::GIBENCH.run_ok(args)
+}
 
 /// The Chromium binary (`GIBENCH_CHROMIUM`, else `chromium` or `chromium-browser` on PATH);
 /// `None` only when the user skips browser checks with `GIBENCH_NO_BROWSER=1`.

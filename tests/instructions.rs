@@ -11,7 +11,7 @@ use std::process::Command;
 const KERNELS: &str = "domain-delete-insert-disc-256,bvh-shadow-cornell";
 
 fn gate(baseline: &std::path::Path, slow: Option<&str>, write: bool) -> (bool, String) {
-    let mut c = support::gibench();
+    let mut c = support::GIBENCH.command();
     c.args(["instructions", "--kernels", KERNELS, "--baseline"])
         .arg(baseline);
     if write {
@@ -35,7 +35,7 @@ fn gate(baseline: &std::path::Path, slow: Option<&str>, write: bool) -> (bool, S
 #[test]
 fn the_gate_reports_a_slowed_kernel_and_nothing_else() {
     if Command::new("valgrind").arg("--version").output().is_err() {
-        gibench_harness::gpu::say_uncaptured(
+        gibench_test_support::say_uncaptured(
             "instructions: valgrind is not installed; the instruction-count gate was not checked",
         );
         return;

@@ -7,7 +7,7 @@
 use gibench_harness::cpu::reference::{render_reference, ReferenceSettings};
 use gibench_harness::glam::Vec3;
 use gibench_harness::gpu::{GpuContext, GpuOptions};
-use gibench_harness::run::runner::{Harness, RunConfig, TimingMode};
+use gibench_harness::run::runner::Harness;
 use gibench_harness::scene::assets::AssetPaths;
 use gibench_harness::scene::Scene;
 
@@ -16,15 +16,7 @@ fn keller_full_matches_the_reference_one_bounce() {
     let scene = Scene::load_named("cornell", &AssetPaths::standard(None)).unwrap();
     let gpu = GpuContext::new(&GpuOptions::default()).expect("a GPU adapter (Vulkan or GL)");
     let size = [128u32, 96];
-    let config = RunConfig {
-        resolution: size,
-        frames: 1,
-        warmup: 0,
-        first_frame: 0,
-        timing: TimingMode::Stages,
-        seed: 1,
-        shadow_size: 256,
-    };
+    let config = gibench_test_support::one_frame(size).build();
     let h = Harness::new(&gpu, &scene, &config).unwrap();
     let frame = h.clock.frame(0);
     let r = render_reference(

@@ -11,7 +11,7 @@ use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
 fn gibench() -> Command {
-    let mut c = support::gibench();
+    let mut c = support::GIBENCH.command();
     c.stdout(Stdio::null()).stderr(Stdio::piped());
     c
 }

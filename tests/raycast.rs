@@ -6,10 +6,13 @@ mod support;
 
 use std::path::Path;
 
-use support::run as gibench;
+/// Runs `gibench ARGS` to the end.
+fn gibench<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> std::process::Output {
+    support::GIBENCH.run(args)
+}
 
 fn ok(args: &[&str]) {
-    support::run_ok(args);
+    support::GIBENCH.run_ok(args);
 }
 
 /// Seven little-endian f32 per ray.

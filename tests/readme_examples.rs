@@ -72,7 +72,8 @@ fn shrunk(words: &[String]) -> Vec<String> {
 }
 
 fn gibench(dir: &Path, args: &[String]) -> std::process::Output {
-    support::gibench()
+    support::GIBENCH
+        .command()
         .args(args)
         // The scenes are found from the workspace root compiled in, wherever the command runs.
         .current_dir(dir)

@@ -5,7 +5,8 @@
 mod support;
 
 fn reproduce(target: &str, out: &std::path::Path) {
-    let o = support::gibench()
+    let o = support::GIBENCH
+        .command()
         .args([
             "reproduce",
             target,
@@ -256,7 +257,8 @@ fn ism_breakdown_has_the_stages_the_published_figures_and_the_ratios() {
 #[test]
 fn gaitatzes_table1_has_the_papers_rows_and_the_scaling_figure() {
     let tmp = tempfile::tempdir().unwrap();
-    let o = support::gibench()
+    let o = support::GIBENCH
+        .command()
         .args([
             "reproduce",
             "gaitatzes-table1",
@@ -393,7 +395,8 @@ fn gibench_row(csv: &std::path::Path) -> std::collections::HashMap<String, f64> 
 }
 
 fn gibench(args: &[&str], out: &std::path::Path) -> std::process::Output {
-    support::gibench()
+    support::GIBENCH
+        .command()
         .args(args)
         .arg("--out")
         .arg(out)
@@ -403,7 +406,8 @@ fn gibench(args: &[&str], out: &std::path::Path) -> std::process::Output {
 
 /// [`gibench`] run from `dir`, where no committed `results/reproduce-all.json` is found.
 fn gibench_in(dir: &std::path::Path, args: &[&str], out: &std::path::Path) -> std::process::Output {
-    support::gibench()
+    support::GIBENCH
+        .command()
         .current_dir(dir)
         .args(args)
         .arg("--out")
@@ -558,7 +562,8 @@ fn reproduce_all_refuses_bad_input_before_any_work() {
 #[test]
 fn barczak2006_writes_five_figures_and_their_tables() {
     let tmp = tempfile::tempdir().unwrap();
-    let o = support::gibench()
+    let o = support::GIBENCH
+        .command()
         .args([
             "reproduce",
             "barczak2006",

@@ -13,7 +13,7 @@ use gibench_harness::measure::roofline::roofline;
 /// `direct` on the Cornell box, 3 frames of stage timing at 64x48, into `out`; with the hook
 /// adding `slow_ms` to `direct-light` when given.
 fn run_direct(out: &Path, slow_ms: Option<u32>) -> RunResult {
-    let mut c = support::gibench();
+    let mut c = support::GIBENCH.command();
     c.args([
         "run",
         "--technique",
@@ -38,7 +38,7 @@ fn run_direct(out: &Path, slow_ms: Option<u32>) -> RunResult {
 /// `gibench report --detailed` of the run in `dir`: its text, and the last column ("eff %") of
 /// `stage`'s row in the roofline table (`None` for "–").
 fn reported_efficiency(dir: &Path, out: &Path, stage: &str) -> (String, Option<f64>) {
-    let o = support::run_ok(&[
+    let o = support::GIBENCH.run_ok(&[
         "report".as_ref(),
         dir.as_os_str(),
         "--detailed".as_ref(),

@@ -5,7 +5,8 @@ mod support;
 use gibench_harness::measure::results::RunResult;
 
 fn run_ok(args: &[&str], out: &std::path::Path) -> String {
-    let o = support::gibench()
+    let o = support::GIBENCH
+        .command()
         .arg("run")
         .args(args)
         .arg("--out")
@@ -165,7 +166,8 @@ fn quality_columns_and_results() {
 #[test]
 fn reference_two_seeds_agree_at_default_spp() {
     let tmp = tempfile::tempdir().unwrap();
-    let o = support::gibench()
+    let o = support::GIBENCH
+        .command()
         .args([
             "reference",
             "--scene",
@@ -309,7 +311,8 @@ fn a_run_over_every_technique_skips_one_that_cannot_take_the_scene() {
         "barczak.max-charts=10",
     ];
     let dir = tempfile::tempdir().unwrap();
-    let o = support::gibench()
+    let o = support::GIBENCH
+        .command()
         .arg("run")
         .args(small)
         .arg("--out")
@@ -340,7 +343,8 @@ fn a_run_over_every_technique_skips_one_that_cannot_take_the_scene() {
         "{text}"
     );
     // The folder's results are still read as results (the list is not one).
-    let o = support::gibench()
+    let o = support::GIBENCH
+        .command()
         .arg("report")
         .arg(dir.path())
         .arg("--out")
@@ -349,7 +353,8 @@ fn a_run_over_every_technique_skips_one_that_cannot_take_the_scene() {
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let named = tempfile::tempdir().unwrap();
-    let o = support::gibench()
+    let o = support::GIBENCH
+        .command()
         .arg("run")
         .args(small)
         .args(["--technique", "barczak", "--out"])
@@ -373,7 +378,8 @@ fn a_run_that_skips_nothing_leaves_no_list_of_skipped_techniques() {
     let dir = tempfile::tempdir().unwrap();
     let stale = dir.path().join("cornell-skipped.json");
     std::fs::write(&stale, r#"{"scene": "cornell", "skipped": []}"#).unwrap();
-    let o = support::gibench()
+    let o = support::GIBENCH
+        .command()
         .arg("run")
         .args(["--resolution", "64x48", "--frames", "1", "--warmup", "0"])
         .args(["--timing", "stages", "--no-images", "--quiet", "--out"])

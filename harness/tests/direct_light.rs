@@ -5,7 +5,7 @@
 use gibench_harness::gpu::{GpuContext, GpuOptions};
 use gibench_harness::scene::assets::AssetPaths;
 
-use gibench_harness::run::runner::{Harness, RunConfig, TimingMode};
+use gibench_harness::run::runner::Harness;
 use gibench_harness::scene::descriptor::LightKind;
 use gibench_harness::scene::Scene;
 
@@ -17,15 +17,7 @@ fn direct_irradiance(backend: &str, frame_index: u32) -> Vec<Option<(f32, f32)>>
         ..Default::default()
     })
     .expect("a GPU adapter (install mesa-vulkan-drivers)");
-    let config = RunConfig {
-        resolution: [96, 72],
-        frames: 1,
-        warmup: 0,
-        first_frame: 0,
-        timing: TimingMode::Stages,
-        seed: 1,
-        shadow_size: 256,
-    };
+    let config = gibench_test_support::one_frame([96, 72]).build();
     let h = Harness::new(&gpu, &scene, &config).unwrap();
     let frame = h.clock.frame(frame_index);
     h.uniforms.write(&gpu.queue, &frame);
@@ -80,15 +72,9 @@ fn direct_pass_matches_reference_direct_on(scene_name: &str) {
     let scene = Scene::load_named(scene_name, &AssetPaths::standard(None)).unwrap();
     let gpu = GpuContext::new(&GpuOptions::default()).expect("a GPU adapter (Vulkan or GL)");
     let [w, h] = [128u32, 96];
-    let config = RunConfig {
-        resolution: [w, h],
-        frames: 1,
-        warmup: 0,
-        first_frame: 0,
-        timing: TimingMode::Stages,
-        seed: 1,
-        shadow_size: 512,
-    };
+    let config = gibench_test_support::one_frame([w, h])
+        .shadow_size(512)
+        .build();
     let harness = Harness::new(&gpu, &scene, &config).unwrap();
     let info = gibench_direct_info();
     let params = info.parse_params(&[]).unwrap();
@@ -155,9 +141,9 @@ fn gibench_direct_info() -> gibench_harness::kit::technique::TechniqueInfo {
 
 #[test]
 fn vulkan_and_gl_agree() {
-    let present = gibench_harness::gpu::available_backends();
+    let present = gibench_test_support::available_backends();
     if present.len() < 2 {
-        gibench_harness::gpu::say_uncaptured(&format!("vulkan_and_gl_agree: only {present:?} present on this machine; the backends are not compared"));
+        gibench_test_support::say_uncaptured(&format!("vulkan_and_gl_agree: only {present:?} present on this machine; the backends are not compared"));
         return;
     }
     let a = direct_irradiance("vulkan", 25);

@@ -6,7 +6,7 @@
 use gibench_harness::gpu::{GpuContext, GpuOptions};
 use gibench_harness::kit::ir::edges::{EdgeMask, EdgeSettings};
 use gibench_harness::kit::passes::GBufferTexels;
-use gibench_harness::run::runner::{Harness, RunConfig, TimingMode};
+use gibench_harness::run::runner::Harness;
 use gibench_harness::scene::assets::AssetPaths;
 use gibench_harness::scene::Scene;
 
@@ -55,17 +55,11 @@ fn cpu_mask(g: &GBufferTexels, s: EdgeSettings) -> Vec<u32> {
 #[test]
 fn edge_mask_matches_the_rule_and_finds_the_boundaries() {
     let scene = Scene::load_named("cornell", &AssetPaths::standard(None)).unwrap();
-    for backend in gibench_harness::gpu::backends_for("edges") {
-        let gpu = gibench_harness::gpu::backend_context(backend);
-        let config = RunConfig {
-            resolution: [W, H],
-            frames: 1,
-            warmup: 0,
-            first_frame: 0,
-            timing: TimingMode::Stages,
-            seed: 1,
-            shadow_size: 64,
-        };
+    for backend in gibench_test_support::backends_for("edges") {
+        let gpu = gibench_test_support::backend_context(backend);
+        let config = gibench_test_support::one_frame([W, H])
+            .shadow_size(64)
+            .build();
         let harness = Harness::new(&gpu, &scene, &config).unwrap();
         harness.uniforms.write(&gpu.queue, &harness.clock.frame(0));
         let mut counts = Vec::new();
@@ -113,15 +107,9 @@ fn edge_mask_matches_the_rule_and_finds_the_boundaries() {
 fn bad_edge_settings_name_the_setting() {
     let scene = Scene::load_named("cornell", &AssetPaths::standard(None)).unwrap();
     let gpu = GpuContext::new(&GpuOptions::default()).unwrap();
-    let config = RunConfig {
-        resolution: [W, H],
-        frames: 1,
-        warmup: 0,
-        first_frame: 0,
-        timing: TimingMode::Stages,
-        seed: 1,
-        shadow_size: 64,
-    };
+    let config = gibench_test_support::one_frame([W, H])
+        .shadow_size(64)
+        .build();
     let harness = Harness::new(&gpu, &scene, &config).unwrap();
     let err = EdgeMask::new(
         &gpu,

@@ -3,7 +3,7 @@
 
 use gibench_harness::glam::{Vec3, Vec4};
 use gibench_harness::gpu::{GpuContext, GpuOptions};
-use gibench_harness::run::runner::{Harness, RunConfig, TimingMode};
+use gibench_harness::run::runner::Harness;
 use gibench_harness::scene::assets::AssetPaths;
 use gibench_harness::scene::Scene;
 
@@ -14,15 +14,9 @@ fn check_backend(backend: Option<&str>) {
         ..Default::default()
     })
     .expect("a GPU adapter (install mesa-vulkan-drivers)");
-    let config = RunConfig {
-        resolution: [96, 72],
-        frames: 1,
-        warmup: 0,
-        first_frame: 0,
-        timing: TimingMode::Stages,
-        seed: 1,
-        shadow_size: 64,
-    };
+    let config = gibench_test_support::one_frame([96, 72])
+        .shadow_size(64)
+        .build();
     let h = Harness::new(&gpu, &scene, &config).unwrap();
     // Frame 17: camera and light away from their first keys.
     let frame = h.clock.frame(17);
@@ -92,13 +86,13 @@ fn check_backend(backend: Option<&str>) {
 /// On each portable backend present (Vulkan, GL); an absent one is named, not failed.
 #[test]
 fn gbuffer_matches_ray_casts_on_every_backend() {
-    let present = gibench_harness::gpu::available_backends();
+    let present = gibench_test_support::available_backends();
     assert!(!present.is_empty(), "no Vulkan or GL adapter");
     for backend in ["vulkan", "gl"] {
         if present.contains(&backend) {
             check_backend(Some(backend));
         } else {
-            gibench_harness::gpu::say_uncaptured(&format!(
+            gibench_test_support::say_uncaptured(&format!(
                 "gbuffer_matches_ray_casts: {backend} is absent on this machine; not checked"
             ));
         }

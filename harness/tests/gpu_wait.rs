@@ -5,11 +5,12 @@
 
 use std::time::{Duration, Instant};
 
-use gibench_harness::gpu::{available_backends, say_uncaptured, GpuContext, GpuOptions};
+use gibench_harness::gpu::{GpuContext, GpuOptions};
 use gibench_harness::kit::passes::{
     draw_fullscreen, fullscreen_pipeline, render_target, shader_module,
 };
 use gibench_harness::wgpu;
+use gibench_test_support::{available_backends, say_uncaptured};
 
 /// Each pixel of a fullscreen draw steps a linear congruential generator [`STEPS`] times from
 /// the seed plus its index (work that cannot be folded away) and stores the result; the work is

@@ -5,14 +5,14 @@
 
 use gibench_harness::glam::Vec3;
 use gibench_harness::gpu::GpuContext;
-use gibench_harness::gpu::{backend_context, backends_for};
 use gibench_harness::kit::ir::interleave::{FilterSettings, Interleave, INTERLEAVE_WGSL};
 use gibench_harness::kit::passes::{shader_module, GBufferTexels};
-use gibench_harness::run::runner::{Harness, RunConfig, TimingMode};
+use gibench_harness::run::runner::Harness;
 use gibench_harness::scene::assets::AssetPaths;
 use gibench_harness::scene::Scene;
 use gibench_harness::wgpu;
 use gibench_harness::Error;
+use gibench_test_support::{backend_context, backends_for};
 
 const CORNELL: FilterSettings = FilterSettings {
     alpha: 30.0,
@@ -28,15 +28,9 @@ const PERMISSIVE: FilterSettings = FilterSettings {
 /// hands the harness and the exported G-buffer to `f`.
 fn with_cornell(gpu: &GpuContext, resolution: [u32; 2], f: impl FnOnce(&Harness, &GBufferTexels)) {
     let scene = Scene::load_named("cornell", &AssetPaths::standard(None)).unwrap();
-    let config = RunConfig {
-        resolution,
-        frames: 1,
-        warmup: 0,
-        first_frame: 0,
-        timing: TimingMode::Stages,
-        seed: 1,
-        shadow_size: 64,
-    };
+    let config = gibench_test_support::one_frame(resolution)
+        .shadow_size(64)
+        .build();
     let h = Harness::new(gpu, &scene, &config).unwrap();
     let frame = h.clock.frame(17);
     h.uniforms.write(&gpu.queue, &frame);

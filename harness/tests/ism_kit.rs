@@ -9,13 +9,13 @@ use gibench_test_support::scene as support;
 use gibench_harness::cpu::vpl::{frame_from_normal, Vpl};
 use gibench_harness::glam::Vec3;
 use gibench_harness::gpu::GpuContext;
-use gibench_harness::gpu::{backend_context, backends_for};
 use gibench_harness::kit::ir::atlas::{AtlasFormat, AtlasSettings, MapKind, ShadowAtlas};
 use gibench_harness::kit::ir::pullpush::PullPush;
 use gibench_harness::kit::ir::splat::PointSplat;
 use gibench_harness::kit::ir::store::VplStore;
 use gibench_harness::scene::{Mesh, SceneExtent};
 use gibench_harness::wgpu;
+use gibench_test_support::{backend_context, backends_for};
 
 /// The plane z = 1, x and y in [-2, 2], as a mesh (for the scene extent the atlas's far
 /// distance and lift come from).
@@ -498,7 +498,7 @@ fn the_row_column_warp_keeps_vpls_in_place_when_the_light_changes_a_little() {
 fn reflective_shadow_map_carries_the_first_bounce_flux() {
     use gibench_harness::cpu::vpl::{self, VplSettings};
     use gibench_harness::kit::ir::rsm::ReflectiveShadowMap;
-    use gibench_harness::run::runner::{Harness, RunConfig, TimingMode};
+    use gibench_harness::run::runner::Harness;
     use gibench_harness::scene::assets::AssetPaths;
     use gibench_harness::scene::Scene;
     for backend in backends_for("ism_kit") {
@@ -507,15 +507,9 @@ fn reflective_shadow_map_carries_the_first_bounce_flux() {
             let mut scene = Scene::load_named(name, &AssetPaths::standard(None)).unwrap();
             scene.movers.clear();
             scene.descriptor.movers.clear();
-            let config = RunConfig {
-                resolution: [32, 24],
-                frames: 1,
-                warmup: 0,
-                first_frame: 0,
-                timing: TimingMode::Stages,
-                seed: 1,
-                shadow_size: 64,
-            };
+            let config = gibench_test_support::one_frame([32, 24])
+                .shadow_size(64)
+                .build();
             let harness = Harness::new(&gpu, &scene, &config).unwrap();
             let frame = harness.clock.frame(0);
             harness.uniforms.write(&gpu.queue, &frame);

@@ -7,17 +7,17 @@
 use gibench_harness::cpu::light::point_irradiance;
 use gibench_harness::cpu::vpl::{frame_from_normal, Vpl};
 use gibench_harness::glam::Vec3;
-use gibench_harness::gpu::{backend_context, backends_for};
 use gibench_harness::kit::ir::accumulate::{Accumulation, IrradianceClamp};
 use gibench_harness::kit::ir::atlas::{AtlasFormat, AtlasSettings, MapKind, ShadowAtlas};
 use gibench_harness::kit::ir::interleave::{FilterSettings, Interleave};
 use gibench_harness::kit::ir::raster::{AtlasClear, AtlasRasteriser};
 use gibench_harness::kit::ir::store::VplStore;
 use gibench_harness::kit::passes::DrawSet;
-use gibench_harness::run::runner::{Harness, RunConfig, TimingMode};
+use gibench_harness::run::runner::Harness;
 use gibench_harness::scene::assets::AssetPaths;
 use gibench_harness::scene::Scene;
 use gibench_harness::wgpu;
+use gibench_test_support::{backend_context, backends_for};
 
 use gibench_test_support::scene as support;
 
@@ -70,15 +70,9 @@ fn one_vpl_in(
     let off = 5e-4 * scene.extent.diagonal;
     let gpu = backend_context(backend);
     let [w, h] = [96u32, 72];
-    let config = RunConfig {
-        resolution: [w, h],
-        frames: 1,
-        warmup: 0,
-        first_frame: 0,
-        timing: TimingMode::Stages,
-        seed: 1,
-        shadow_size: 64,
-    };
+    let config = gibench_test_support::one_frame([w, h])
+        .shadow_size(64)
+        .build();
     let harness = Harness::new(&gpu, scene, &config).unwrap();
     let frame = harness.clock.frame(0);
     harness.uniforms.write(&gpu.queue, &frame);
@@ -539,7 +533,7 @@ fn octahedral_maps_do_not_leak_under_a_large_wall() {
             assert!(facing > 1000, "{backend} {kind:?}: {facing} facing pixels");
             wrong.push((kind, leaked, over, facing));
         }
-        gibench_harness::gpu::say_uncaptured(&format!(
+        gibench_test_support::say_uncaptured(&format!(
             "vpl_maps: a large wall on {backend} (kind, lit where shadowed, shadowed where lit, facing pixels): {wrong:?}"
         ));
         let share = |i: usize| (wrong[i].1 + wrong[i].2) as f64 / wrong[i].3 as f64;

@@ -42,7 +42,8 @@ fn half_float_saturation_is_reported() {
 fn device_limits_are_checked_before_any_frame() {
     let tmp = tempfile::tempdir().unwrap();
     let start = std::time::Instant::now();
-    let o = support::gibench()
+    let o = support::GIBENCH
+        .command()
         .args([
             "run",
             "--technique",
@@ -126,7 +127,7 @@ fn parameters_past_the_image_or_the_device() {
             "parameter 'point-pool'",
         );
     } else {
-        gibench_harness::gpu::say_uncaptured(&format!(
+        gibench_test_support::say_uncaptured(&format!(
             "cli_errors: this adapter's storage buffers ({max} bytes) take ism's largest point pool; the pool's check was not tried"
         ));
     }

@@ -9,7 +9,8 @@ fn unwritable_output_folder() {
     let tmp = tempfile::tempdir().unwrap();
     let file = tmp.path().join("a-file");
     std::fs::write(&file, b"not a folder").unwrap();
-    let o = support::gibench()
+    let o = support::GIBENCH
+        .command()
         .args(["run", "--frames", "2", "--quiet", "--out"])
         .arg(file.join("sub"))
         .output()
@@ -34,7 +35,8 @@ fn out_with_a_dot_and_a_bad_stem() {
     let o = one_direct_frame("32x24", None, tmp.path().join("new/."));
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(tmp.path().join("new/cornell-direct.json").exists());
-    let o = support::gibench()
+    let o = support::GIBENCH
+        .command()
         .arg("report")
         .arg(tmp.path().join("new"))
         .args(["--stem", "../x", "--out"])
@@ -55,7 +57,8 @@ fn out_with_a_dot_and_a_bad_stem() {
 fn a_failed_run_leaves_no_new_folder() {
     let tmp = tempfile::tempdir().unwrap();
     let out = tmp.path().join("a/b");
-    let o = support::gibench()
+    let o = support::GIBENCH
+        .command()
         .args(["run", "--technique", "laine", "--frames", "1", "--quiet"])
         .args([
             "--param",
@@ -77,7 +80,8 @@ fn a_failed_run_leaves_no_new_folder() {
 fn files_named_like_journal_directives_are_published() {
     let tmp = tempfile::tempdir().unwrap();
     copy_baseline(tmp.path());
-    let o = support::gibench()
+    let o = support::GIBENCH
+        .command()
         .current_dir(tmp.path())
         .args(["report", "r1", "--stem", "replaced", "--out", "o"])
         .output()

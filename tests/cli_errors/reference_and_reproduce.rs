@@ -5,7 +5,8 @@ use super::*;
 #[test]
 fn dispersion_needs_two_frames() {
     let tmp = tempfile::tempdir().unwrap();
-    let o = support::gibench()
+    let o = support::GIBENCH
+        .command()
         .args(["reproduce", "laine-dispersion", "--frames", "1", "--out"])
         .arg(tmp.path().join("d"))
         .output()

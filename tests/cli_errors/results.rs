@@ -102,7 +102,8 @@ fn plot_quality_inputs_out_and_metrics() {
         &["plot-quality", "r1", "--metric", "nope"],
         &["parameter 'metric'"],
     );
-    let help = support::gibench()
+    let help = support::GIBENCH
+        .command()
         .args(["plot-quality", "--help"])
         .output()
         .unwrap();

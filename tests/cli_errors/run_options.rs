@@ -27,7 +27,8 @@ fn bad_resolutions() {
 #[test]
 fn zero_frames() {
     let tmp = tempfile::tempdir().unwrap();
-    let o = support::gibench()
+    let o = support::GIBENCH
+        .command()
         .args(["run", "--frames", "0", "--quiet", "--out"])
         .arg(tmp.path().join("out"))
         .output()
@@ -85,7 +86,8 @@ fn overflow_names_duplicates_and_assets() {
     let file = tmp.path().join("not-a-folder");
     std::fs::write(&file, b"x").unwrap();
     fails(&["--assets", file.to_str().unwrap()], "not a folder");
-    let o = support::gibench()
+    let o = support::GIBENCH
+        .command()
         .args([
             "sweep",
             "--technique",
@@ -101,7 +103,8 @@ fn overflow_names_duplicates_and_assets() {
         .unwrap();
     assert!(!o.status.success());
     assert!(String::from_utf8_lossy(&o.stderr).contains("listed twice"));
-    let o = support::gibench()
+    let o = support::GIBENCH
+        .command()
         .args(["reproduce", "laine-dispersion", "--frames", "0"])
         .arg("--out")
         .arg(tmp.path().join("repro"))

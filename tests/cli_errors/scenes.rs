@@ -193,7 +193,8 @@ fn hostile_review_cases() {
     fails(&["--scene", d.to_str().unwrap()], "mover 'big'");
     let file = tmp.path().join("cache-file");
     std::fs::write(&file, b"x").unwrap();
-    let o = support::gibench()
+    let o = support::GIBENCH
+        .command()
         .args([
             "reference",
             "--resolution",

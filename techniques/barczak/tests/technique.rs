@@ -5,14 +5,10 @@
 use gibench_harness::cpu::reference::{render_reference, ReferenceSettings};
 use gibench_harness::gpu::profiler::{ProfileMode, Profiler};
 use gibench_harness::gpu::{GpuContext, GpuOptions};
-use gibench_harness::run::runner::{Harness, RunConfig};
+use gibench_harness::run::runner::Harness;
 use gibench_test_support::kv;
 
 const SIZE: [u32; 2] = [96, 72];
-
-fn config(resolution: [u32; 2]) -> RunConfig {
-    gibench_test_support::run_config(resolution, 256)
-}
 
 /// 256 points on the Cornell box's area light against the reference's direct irradiance: the
 /// mean within 3 %, the relative L1 error below 0.12 (measured: ratio 0.996, L1 0.026 on lavapipe;
@@ -23,7 +19,7 @@ fn direct_samples_match_the_reference_direct_light() {
     let info = &gibench_barczak::INFO;
     let scene = gibench_test_support::load("cornell-area");
     let gpu = GpuContext::new(&GpuOptions::default()).unwrap();
-    let config = config(SIZE);
+    let config = gibench_test_support::one_frame(SIZE).build();
     let h = Harness::new(&gpu, &scene, &config).unwrap();
     let params = info
         .parse_params(&kv(&[("set", "direct"), ("vpls", "256")]))
@@ -68,7 +64,7 @@ fn bad_parameters_are_refused_by_name() {
     let gpu = GpuContext::new(&GpuOptions::default()).unwrap();
     let err = |scene: &str, resolution: [u32; 2], pairs: &[(&str, &str)]| -> String {
         let scene = gibench_test_support::load(scene);
-        let config = config(resolution);
+        let config = gibench_test_support::one_frame(resolution).build();
         let h = Harness::new(&gpu, &scene, &config).unwrap();
         let params = info.parse_params(&kv(pairs)).unwrap();
         match h.prepare(info, &params, &config) {
@@ -85,7 +81,7 @@ fn bad_parameters_are_refused_by_name() {
     assert!(e.contains("edge-step") && e.contains("factor 2"), "{e}");
     // VD has no low-resolution pass: any resolution.
     let scene = gibench_test_support::load("cornell-area");
-    let config = config([97, 72]);
+    let config = gibench_test_support::one_frame([97, 72]).build();
     let h = Harness::new(&gpu, &scene, &config).unwrap();
     let params = info.parse_params(&kv(&[("level", "vd")])).unwrap();
     assert!(h.prepare(info, &params, &config).is_ok());
