@@ -9,6 +9,11 @@
 //! Hostile results files are named: a side holding a results file that cannot be read (an
 //! impossible calibration, a negative time, an unknown stage kind, truncated, a newer schema)
 //! says which, and fails when that file's run is in no other file of the side.
+//!
+//! A test binary of its own, not a module of `tests/it/`: it needs its own process, since
+//! [`compare_runs_end_to_end`] judges real runs' stage times, and the other root tests' runs
+//! (browsers, reproductions, shards) beside it in one process would load the machine past what
+//! it was sized for.
 
 mod support;
 

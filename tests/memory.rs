@@ -11,6 +11,9 @@
 //! (`direct`) to 1.7 MB per frame (`laine`) before parameter blocks became read-only storage
 //! buffers (`passes::params_entry`); also any per-frame resource a technique forgets to reuse.
 //! Linux only (reads `/proc/self/status`).
+//!
+//! A test binary of its own, not a module of `tests/it/`: it needs its own process, since it
+//! measures the process's resident set, which every other test running beside it would grow.
 
 #[path = "../src/registry.rs"]
 mod registry;

@@ -2,6 +2,10 @@
 //! nanoseconds, about 4.3 s, even for `wait_indefinitely`) completes: `GpuContext::flush` keeps
 //! waiting instead of failing with "The requested Wait timed out" (seen on llvmpipe with a
 //! Sibenik frame of `keller-full`). A `--gpu-timeout` shorter than the work fails, naming it.
+//!
+//! A test binary of its own, not a module of `tests/it/`: it needs its own process, since it
+//! sizes the work by timing a short run and then times the waits, which other tests' GPU work
+//! beside it (on the same llvmpipe threads) would throw off.
 
 use std::time::{Duration, Instant};
 

@@ -7,7 +7,7 @@ use gibench_harness::rng::SplitMix64 as Rng;
 use gibench_laine::domain::{DomainKind, SamplingDomain};
 use glam::{DVec2, DVec3};
 
-use crate::{build, point_set, to_disc, to_sphere};
+use super::{build, point_set, to_disc, to_sphere};
 
 /// Disc points of the deletion test around `origin`, scaled: A–B is the shortest edge; B's
 /// second-closest neighbour (E, 0.15 away) is closer than A's (C, 0.30 away), so §4.5 deletes

@@ -3,7 +3,7 @@
 //! slowed on purpose (the test hook `GIBENCH_TEST_SLOW_STAGE`, which adds to the stage's
 //! flushed wall time) shows a lower fraction.
 
-mod support;
+use crate::support;
 
 use std::path::Path;
 

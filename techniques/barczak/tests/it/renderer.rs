@@ -6,7 +6,7 @@
 use gibench_barczak::renderer::{Optimisation, Renderer, RendererSettings};
 use gibench_barczak::samples::SampleSettings;
 
-mod support;
+use crate::support;
 
 const SETTINGS: RendererSettings = RendererSettings {
     samples: SampleSettings {

@@ -5,7 +5,7 @@
 //! it these tests fail and say so, unless `GIBENCH_NO_BROWSER=1` asks to skip them knowingly.
 //! A screenshot of the run page is kept in the target folder (`html-report/screenshot.png`).
 
-mod support;
+use crate::support;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;

@@ -3,7 +3,7 @@
 //! gives the tables of one unsharded run; `--budget` leaves out what does not fit and says so.
 //! Runs at `GIBENCH_TEST_SIZE=tiny` (docs/fleet.md): the manifests record it.
 
-mod support;
+use crate::support;
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};

@@ -15,7 +15,7 @@
 use gibench_barczak::renderer::{FrameCounts, Optimisation, Renderer, RendererSettings};
 use gibench_barczak::samples::SampleSettings;
 
-mod support;
+use crate::support;
 
 const W: u32 = 96;
 const H: u32 = 72;

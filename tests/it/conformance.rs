@@ -18,7 +18,7 @@
 //!
 //! Runs on the best adapter there is (Vulkan, else GL).
 
-#[path = "../src/registry.rs"]
+#[path = "../../src/registry.rs"]
 mod registry;
 
 use gibench_harness::cpu::reference::{render_reference, ReferenceSettings};

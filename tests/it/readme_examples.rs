@@ -6,7 +6,7 @@
 //! copied in. A README example that names a removed option, a scene that is gone or a
 //! technique that dies on a scene fails here.
 
-mod support;
+use crate::support;
 
 use std::path::{Path, PathBuf};
 

@@ -7,7 +7,7 @@ use gibench_barczak::samples::SampleSettings;
 use gibench_harness::glam::Vec3;
 use gibench_harness::kit::passes::{render_target, HDR_FORMAT};
 
-mod support;
+use crate::support;
 
 const W: u32 = 96;
 const H: u32 = 72;

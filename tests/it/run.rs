@@ -1,6 +1,6 @@
 //! End to end: `gibench run` writes a complete results file, images and tables.
 
-mod support;
+use crate::support;
 
 use gibench_harness::measure::results::RunResult;
 

@@ -7,7 +7,7 @@ use gibench_barczak::lightmap::{contribution, texel_position, LightMaps};
 use gibench_barczak::visibility::{segment_hits, LightState};
 use glam::{Mat3, Vec3};
 
-mod support;
+use crate::support;
 use support::{lights, room};
 
 const RES: u32 = 4;

@@ -20,7 +20,7 @@ use gibench_harness::kit::ir::raster::{AtlasClear, AtlasRasteriser};
 use gibench_harness::kit::ir::store::VplStore;
 use gibench_harness::kit::passes::{render_target, DrawSet, HDR_FORMAT};
 
-mod support;
+use crate::support;
 
 const W: u32 = 96;
 const H: u32 = 72;

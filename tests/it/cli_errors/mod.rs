@@ -1,22 +1,15 @@
 //! Bad input gets a clear error, a non-zero exit and no results file.
 //!
-//! One test binary: this file holds the helpers; the tests are in `tests/cli_errors/`, a module
-//! per kind of input (scenes, run options, limits, outputs, results files, reference and
+//! This file holds the helpers; the tests are in its submodules, one per kind of input (scenes, run options, limits, outputs, results files, reference and
 //! reproduce).
 
-#[path = "cli_errors/limits.rs"]
 mod limits;
-#[path = "cli_errors/outputs.rs"]
 mod outputs;
-#[path = "cli_errors/reference_and_reproduce.rs"]
 mod reference_and_reproduce;
-#[path = "cli_errors/results.rs"]
 mod results;
-#[path = "cli_errors/run_options.rs"]
 mod run_options;
-#[path = "cli_errors/scenes.rs"]
 mod scenes;
-mod support;
+use crate::support;
 
 use std::path::{Path, PathBuf};
 

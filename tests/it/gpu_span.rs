@@ -1,6 +1,6 @@
 //! The GPU frame span (`frame.gpu_span_ms`, `frame.gpu_spans` in results files) on a real run.
 
-mod support;
+use crate::support;
 
 use gibench_harness::measure::results::RunResult;
 

@@ -1,7 +1,7 @@
 //! `gibench export --format bmf`: Bencher Metric Format JSON from results folders and
 //! instruction counts.
 
-mod support;
+use crate::support;
 
 use std::path::{Path, PathBuf};
 

@@ -2,7 +2,7 @@
 //! paper's figures beside ours, and its numbers say what the paper's say where a CPU adapter
 //! must agree (a small run: Cornell only, a few frames).
 
-mod support;
+use crate::support;
 
 fn reproduce(target: &str, out: &std::path::Path) {
     let o = support::GIBENCH

@@ -3,7 +3,7 @@
 //! (staging folder, lock, temporary cache files), and a second command into a folder in use is
 //! refused.
 
-mod support;
+use crate::support;
 
 use std::collections::BTreeMap;
 use std::path::Path;

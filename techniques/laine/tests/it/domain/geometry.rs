@@ -8,7 +8,7 @@ use gibench_harness::rng::SplitMix64 as Rng;
 use gibench_laine::domain::{DomainKind, SamplingDomain};
 use glam::{DVec2, DVec3};
 
-use crate::{build, point_set};
+use super::{build, point_set};
 
 const SIZES: [usize; 3] = [16, 256, 1024];
 

@@ -10,7 +10,7 @@ use gibench_harness::glam::{Mat3, Vec3};
 use gibench_harness::kit::passes::{render_target, HDR_FORMAT};
 use gibench_harness::wgpu;
 
-mod support;
+use crate::support;
 
 const W: u32 = 160;
 const H: u32 = 120;

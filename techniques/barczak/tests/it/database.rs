@@ -7,7 +7,7 @@ use gibench_barczak::database::{ReceiverShape, VisibilityDatabase};
 use gibench_barczak::visibility::LightState;
 use glam::{Mat3, Vec3};
 
-mod support;
+use crate::support;
 use support::{lights, room};
 
 fn leaf_lit(db: &VisibilityDatabase) -> Vec<bool> {

@@ -4,7 +4,7 @@
 //! only it. Needs valgrind; without it the test says so on standard error and checks nothing
 //! else.
 
-mod support;
+use crate::support;
 
 use std::process::Command;
 

@@ -645,7 +645,8 @@ fn relative_mse(a: &[Vec3], b: &[Vec3], mask: &[bool]) -> f64 {
 }
 
 /// Timing and noise of the default settings on the Cornell box at 256 × 192 (frame 0): run with
-/// `cargo test --release -p gibench-harness --test reference -- --ignored --nocapture`.
+/// `cargo test --release -p gibench-harness --test it --
+/// reference::reference_default_settings_timing_and_noise --ignored --nocapture`.
 #[test]
 #[ignore = "slow: measures the default settings"]
 fn reference_default_settings_timing_and_noise() {

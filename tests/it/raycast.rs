@@ -2,7 +2,7 @@
 //! (shadow rays end at the light, closest-hit rays are unit directions from the same origins),
 //! raycast's answers are consistent with the files, and bad ray folders are refused by name.
 
-mod support;
+use crate::support;
 
 use std::path::Path;
 
