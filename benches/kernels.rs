@@ -14,7 +14,7 @@ use criterion::{criterion_group, Criterion, Throughput};
 use gibench_harness::glam::Vec3;
 use gibench_harness::gpu::profiler::{ProfileMode, Profiler};
 use gibench_harness::gpu::{GpuContext, GpuOptions};
-use gibench_harness::run::runner::{Harness, RunConfig, TimingMode};
+use gibench_harness::run::runner::Harness;
 use gibench_harness::scene::assets::AssetPaths;
 use gibench_harness::scene::Scene;
 
@@ -291,15 +291,7 @@ fn frames(c: &mut Criterion) {
     };
     let scene =
         Scene::load_named("cornell", &AssetPaths::standard(None)).expect("cornell is generated");
-    let config = RunConfig {
-        resolution: [256, 192],
-        frames: 1,
-        warmup: 0,
-        first_frame: 0,
-        timing: TimingMode::Stages,
-        seed: 1,
-        shadow_size: 256,
-    };
+    let config = gibench_test_support::one_frame([256, 192]).build();
     let h = Harness::new(&gpu, &scene, &config).expect("harness");
     for info in registry::all() {
         let params = info.parse_params(&[]).expect("defaults");

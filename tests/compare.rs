@@ -9,6 +9,11 @@
 //! Hostile results files are named: a side holding a results file that cannot be read (an
 //! impossible calibration, a negative time, an unknown stage kind, truncated, a newer schema)
 //! says which, and fails when that file's run is in no other file of the side.
+//!
+//! A test binary of its own, not a module of `tests/it/`: it needs its own process, since
+//! [`compare_runs_end_to_end`] judges real runs' stage times, and the other root tests' runs
+//! (browsers, reproductions, shards) beside it in one process would load the machine past what
+//! it was sized for.
 
 mod support;
 
@@ -68,7 +73,8 @@ fn compare_with(
     options: &[&str],
 ) -> (bool, Vec<(String, String)>, String) {
     let out = dir.join(format!("cmp-{base}-{current}").replace('/', "-"));
-    let o = support::gibench()
+    let o = support::GIBENCH
+        .command()
         .arg("compare")
         .arg(dir.join(base))
         .arg(dir.join(current))
@@ -182,7 +188,8 @@ fn compare_markdown(
     options: &[&str],
 ) -> (Option<i32>, String, String) {
     let out = dir.join(format!("md-{base}-{current}").replace('/', "-"));
-    let o = support::gibench()
+    let o = support::GIBENCH
+        .command()
         .arg("compare")
         .arg(dir.join(base))
         .arg(dir.join(current))
@@ -264,7 +271,8 @@ fn markdown_lists_regressions_first_and_fail_on_sets_the_status() {
         "{md}"
     );
     // The default output is the terminal table, as before.
-    let o = support::gibench()
+    let o = support::GIBENCH
+        .command()
         .arg("compare")
         .arg(dir.join("base"))
         .arg(dir.join("mixed"))
@@ -337,7 +345,8 @@ fn a_run_on_one_side_only_is_listed_and_fails_require_all() {
     assert!(md.contains("Not compared (on one side only)"), "{md}");
 
     let out = dir.join("strict");
-    let o = support::gibench()
+    let o = support::GIBENCH
+        .command()
         .arg("compare")
         .arg(dir.join("base"))
         .arg(dir.join("current"))
@@ -505,7 +514,7 @@ fn compare_runs_end_to_end() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path();
     let run_into = |out: &Path, slow: bool| {
-        let mut c = support::gibench();
+        let mut c = support::GIBENCH.command();
         c.args(["run", "--technique", "direct", "--frames", "30"])
             .args([
                 "--warmup",

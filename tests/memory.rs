@@ -11,12 +11,15 @@
 //! (`direct`) to 1.7 MB per frame (`laine`) before parameter blocks became read-only storage
 //! buffers (`passes::params_entry`); also any per-frame resource a technique forgets to reuse.
 //! Linux only (reads `/proc/self/status`).
+//!
+//! A test binary of its own, not a module of `tests/it/`: it needs its own process, since it
+//! measures the process's resident set, which every other test running beside it would grow.
 
 #[path = "../src/registry.rs"]
 mod registry;
 
 use gibench_harness::gpu::profiler::{ProfileMode, Profiler};
-use gibench_harness::run::runner::{process_memory_mb, Harness, RunConfig, TimingMode};
+use gibench_harness::run::runner::{process_memory_mb, Harness, TimingMode};
 use gibench_harness::scene::assets::AssetPaths;
 use gibench_harness::scene::Scene;
 
@@ -32,20 +35,17 @@ fn rss_mb() -> f64 {
 
 #[test]
 fn memory_stays_flat_over_long_runs() {
-    let present = gibench_harness::gpu::backends_for("memory");
+    let present = gibench_test_support::backends_for("memory");
     let scene = Scene::load_named("cornell", &AssetPaths::standard(None)).unwrap();
-    let config = RunConfig {
-        resolution: [96, 72],
-        frames: MEASURED,
-        warmup: SETTLE,
-        first_frame: 0,
-        timing: TimingMode::Frame,
-        seed: 1,
-        shadow_size: 128,
-    };
+    let config = gibench_test_support::one_frame([96, 72])
+        .frames(MEASURED)
+        .warmup(SETTLE)
+        .timing(TimingMode::Frame)
+        .shadow_size(128)
+        .build();
     let mut failures = Vec::new();
     for backend in present {
-        let gpu = gibench_harness::gpu::backend_context(backend);
+        let gpu = gibench_test_support::backend_context(backend);
         let h = Harness::new(&gpu, &scene, &config).unwrap();
         for info in registry::all() {
             let params = info.parse_params(&[]).expect("defaults parse");

@@ -1,7 +1,7 @@
 //! # gibench-harness
 //!
 //! Everything the techniques share, written once, in folders by concern. Each folder uses only
-//! the ones above it in this list (`harness/tests/layers.rs` checks it):
+//! the ones above it in this list (`harness/tests/it/layers.rs` checks it):
 //!
 //! * [`error`], [`output`] and [`rng`]: errors; atomic files and output sets; random numbers;
 //! * [`measure`]: statistics, image metrics, the timer calibration, the results file model,

@@ -2,14 +2,19 @@
 //! nanoseconds, about 4.3 s, even for `wait_indefinitely`) completes: `GpuContext::flush` keeps
 //! waiting instead of failing with "The requested Wait timed out" (seen on llvmpipe with a
 //! Sibenik frame of `keller-full`). A `--gpu-timeout` shorter than the work fails, naming it.
+//!
+//! A test binary of its own, not a module of `tests/it/`: it needs its own process, since it
+//! sizes the work by timing a short run and then times the waits, which other tests' GPU work
+//! beside it (on the same llvmpipe threads) would throw off.
 
 use std::time::{Duration, Instant};
 
-use gibench_harness::gpu::{available_backends, say_uncaptured, GpuContext, GpuOptions};
+use gibench_harness::gpu::{GpuContext, GpuOptions};
 use gibench_harness::kit::passes::{
     draw_fullscreen, fullscreen_pipeline, render_target, shader_module,
 };
 use gibench_harness::wgpu;
+use gibench_test_support::{available_backends, say_uncaptured};
 
 /// Each pixel of a fullscreen draw steps a linear congruential generator [`STEPS`] times from
 /// the seed plus its index (work that cannot be folded away) and stores the result; the work is

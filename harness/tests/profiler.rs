@@ -2,6 +2,10 @@
 //! every worker of rayon's pool (a stage whose work runs across cores, as `laine`'s management
 //! does), and no other thread of the process (the GPU driver's, which on lavapipe and llvmpipe
 //! run the GPU's work on the CPU).
+//!
+//! A test binary of its own, not a module of `tests/it/`: it needs its own process, since it
+//! sums the CPU time of every worker of rayon's global pool, to which any other test's parallel
+//! work in the same process would add.
 
 use gibench_harness::gpu::profiler::{ProfileMode, Profiler};
 use gibench_harness::gpu::{GpuContext, GpuOptions};

@@ -1,4 +1,6 @@
-//! `threads::join_global_pool` (its own test binary: the global pool is built once per process).
+//! `threads::join_global_pool`. A test binary of its own, not a module of `tests/it/`: it needs
+//! its own process, since rayon's global pool is built once per process, and must not have been
+//! built by another test first.
 
 use rayon::prelude::*;
 

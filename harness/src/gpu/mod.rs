@@ -124,51 +124,6 @@ const NO_ADAPTER_HELP: &str = "no GPU adapter found. gibench needs a Vulkan driv
 on a machine without a GPU install Mesa's CPU drivers (Debian/Ubuntu: \
 `apt-get install mesa-vulkan-drivers` for lavapipe; llvmpipe GL comes with libgl1-mesa-dri)";
 
-/// The portable backends (`vulkan`, `gl`) that offer an adapter on this machine, in that order:
-/// tests that compare backends run on the ones present and say which are absent.
-pub fn available_backends() -> Vec<&'static str> {
-    ["vulkan", "gl"]
-        .into_iter()
-        .filter(|b| {
-            GpuContext::new(&GpuOptions {
-                backend: Some(b.to_string()),
-                ..Default::default()
-            })
-            .is_ok()
-        })
-        .collect()
-}
-
-/// The portable backends present ([`available_backends`]) for a check that must hold on each
-/// (the tests' backend loop): at least one, else it panics; when only one is, `check` says so
-/// past the test harness's capture, so that a machine without the other is never silent.
-pub fn backends_for(check: &str) -> Vec<&'static str> {
-    let present = available_backends();
-    assert!(!present.is_empty(), "{check}: no Vulkan or GL adapter");
-    if present.len() < 2 {
-        say_uncaptured(&format!(
-            "{check}: only {present:?} present on this machine"
-        ));
-    }
-    present
-}
-
-/// A context on `backend`, one of [`available_backends`].
-pub fn backend_context(backend: &str) -> GpuContext {
-    GpuContext::new(&GpuOptions {
-        backend: Some(backend.into()),
-        ..Default::default()
-    })
-    .unwrap_or_else(|e| panic!("a {backend} adapter: {e}"))
-}
-
-/// Writes `message` to the process's standard error directly, past the test harness's output
-/// capture: for a test that must say plainly what it could not check on this machine.
-pub fn say_uncaptured(message: &str) {
-    use std::io::Write;
-    let _ = writeln!(std::io::stderr(), "note: {message}");
-}
-
 impl GpuContext {
     /// The largest buffer this device can create and bind whole as storage, bytes (the
     /// smaller of the two limits): what every storage buffer sized by a parameter is checked

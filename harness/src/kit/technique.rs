@@ -250,7 +250,7 @@ pub fn prepare_nothing(_: &Params, _: &PrepareContext) -> Result<Prepared> {
     Ok(Box::new(()))
 }
 
-/// What the conformance test (`tests/conformance.rs`) demands of a technique on the Cornell box
+/// What the conformance test (`tests/it/conformance.rs`) demands of a technique on the Cornell box
 /// under each kind of light (defaults, 96x72, after three frames),
 /// beyond finite output, zero where no geometry is hit and identical output from two builds:
 /// its indirect irradiance against its [`TechniqueInfo::reference`] component.

@@ -18,7 +18,7 @@
 //! `console.error` may occur; it records the outcome on its root element
 //! (`data-selfcheck="ok N"` for N images, else `fail …`), and whether every frame player
 //! advances to another tile of strips of the expected size (`data-players="ok N"`), which
-//! `tests/html.rs` reads from headless Chromium. A failed check also shows a warning at the top
+//! `tests/it/html.rs` reads from headless Chromium. A failed check also shows a warning at the top
 //! of the page (a checkout keeps only some of the images: `results/.gitignore`).
 
 use std::fmt::Write as _;

@@ -93,7 +93,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     required_limits: wgpu::Limits::downlevel_defaults,
     reference: gibench_harness::kit::technique::multi_bounce,
     // On the Cornell boxes against the multi-bounce reference at the defaults (32³, 12
-    // iterations, `transport=cosine`), measured (tests/conformance.rs, 96x72): mean ratio 0.315
+    // iterations, `transport=cosine`), measured (tests/it/conformance.rs, 96x72): mean ratio 0.315
     // (spot), 0.322 (area), 0.321 (omni), 0.570 (sun); relative L1 0.72, 0.72, 0.94, 0.77. The
     // darkness is the propagation's (README, *Voxel SH propagation*: light diffuses back to its
     // source instead of crossing the box, and 12 iterations reach a third of it). These bounds

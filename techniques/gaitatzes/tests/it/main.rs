@@ -1,0 +1,5 @@
+//! `gaitatzes`' integration tests, one binary (`cargo test --release -p gibench-gaitatzes --test
+//! it`): the SH transfer and the propagation volume.
+
+mod transfer;
+mod volume;

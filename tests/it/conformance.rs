@@ -1,0 +1,269 @@
+//! The conformance entry every registered technique gets by registering (like wgpu's example
+//! tests): on the generated Cornell box at 96x72, lit by each kind of light there is a scene for
+//! (`cornell` spot, `cornell-area` area light, `cornell-omni`, `cornell-sun`), after three
+//! animation frames,
+//!
+//! 1. its indirect irradiance is finite everywhere;
+//! 2. it is exactly zero where no geometry is hit;
+//! 3. two builds with the same seed (each from its own preparation) give bit-identical output;
+//! 4. against the reference component it declares (`TechniqueInfo::reference`), its relative
+//!    L1 error (Σ|t − r| / Σr over pixels that hit geometry, RGB summed: 1 for an all-zero
+//!    output) and its mean relative to the reference's lie within the bounds it declares
+//!    (`TechniqueInfo::conformance`). The mean ratio is the energy check: halving a
+//!    technique's VPL intensities moves it to about 0.5.
+//!
+//! 5. every stage it times is declared in `TechniqueInfo::stages` (name and GPU or CPU), and
+//!    every GPU stage declares its minimum cost (`Profiler::stage_cost`, the roofline's input,
+//!    docs/roofline.md), so `gibench report --detailed` has a fraction for each.
+//!
+//! Runs on the best adapter there is (Vulkan, else GL).
+
+#[path = "../../src/registry.rs"]
+mod registry;
+
+use gibench_harness::cpu::reference::{render_reference, ReferenceSettings};
+use gibench_harness::glam::Vec3;
+use gibench_harness::gpu::profiler::ProfileMode;
+use gibench_harness::gpu::{GpuContext, GpuOptions};
+use gibench_harness::kit::technique::TechniqueInfo;
+use gibench_harness::measure::results::StageKind;
+use gibench_harness::run::quality::IndirectComponent;
+use gibench_harness::run::runner::{Harness, RunConfig};
+use gibench_harness::scene::assets::AssetPaths;
+use gibench_harness::scene::Scene;
+
+const SIZE: [u32; 2] = [96, 72];
+const FRAMES: u32 = 3;
+
+/// The technique's indirect irradiance after frames 0..FRAMES, from a fresh build, and the GPU
+/// stages it timed without declaring a cost (the frames are recorded, so the profiler keeps
+/// the costs declared).
+fn render(
+    gpu: &GpuContext,
+    h: &Harness,
+    info: &TechniqueInfo,
+    config: &RunConfig,
+) -> (Vec<Vec3>, Vec<String>) {
+    let params = info.parse_params(&[]).expect("defaults parse");
+    let prepared = h.prepare(info, &params, config).expect("prepare");
+    let (mut t, compose) = h
+        .build(info, &params, config, &prepared)
+        .expect("technique builds");
+    let mut profiler = h.profiler(info, ProfileMode::Frame);
+    for f in 0..FRAMES {
+        let frame = h.clock.frame(f);
+        h.render_frame(t.as_mut(), &compose, &mut profiler, &frame, true)
+            .expect("frame renders");
+    }
+    profiler.finish(gpu).expect("frames finish");
+    let costs = profiler.stage_costs();
+    let undeclared = profiler
+        .stage_results()
+        .into_iter()
+        .filter(|s| s.kind == StageKind::Gpu && !costs.contains_key(&s.name))
+        .map(|s| format!("{} without a declared cost", s.name))
+        .chain(
+            profiler
+                .undeclared()
+                .iter()
+                .map(|s| format!("{s} not in TechniqueInfo.stages")),
+        )
+        .collect();
+    let output = gibench_harness::gpu::image_io::read_rgb_f32(gpu, t.output().texture())
+        .expect("output reads back")
+        .into_iter()
+        .map(Vec3::from)
+        .collect();
+    (output, undeclared)
+}
+
+#[test]
+fn every_registered_technique_conforms() {
+    let gpu = GpuContext::new(&GpuOptions::default()).expect("a GPU adapter (Vulkan or GL)");
+    let mut failures = Vec::new();
+    for scene_name in ["cornell", "cornell-area", "cornell-omni", "cornell-sun"] {
+        conform_on(
+            &gpu,
+            scene_name,
+            registry::all().iter(),
+            true,
+            &mut failures,
+        );
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// Barczak's receivers on scenes that record no patches are generated charts (issue 37): its
+/// entry also covers the papers' large scenes, with one build each (the Cornell entries check
+/// determinism; a build here takes most of a minute on two cores).
+#[test]
+fn barczak_conforms_on_the_papers_scenes() {
+    let gpu = GpuContext::new(&GpuOptions::default()).expect("a GPU adapter (Vulkan or GL)");
+    let barczak: Vec<&TechniqueInfo> = registry::all()
+        .iter()
+        .filter(|t| t.name == "barczak")
+        .collect();
+    assert_eq!(barczak.len(), 1, "barczak is registered");
+    let mut failures = Vec::new();
+    for scene_name in ["sibenik", "sponza", "maze"] {
+        conform_on(
+            &gpu,
+            scene_name,
+            barczak.iter().copied(),
+            false,
+            &mut failures,
+        );
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+fn conform_on<'a>(
+    gpu: &GpuContext,
+    scene_name: &str,
+    techniques: impl Iterator<Item = &'a TechniqueInfo>,
+    twice: bool,
+    failures: &mut Vec<String>,
+) {
+    let scene = Scene::load_named(scene_name, &AssetPaths::standard(None)).unwrap();
+    let config = gibench_test_support::one_frame(SIZE).frames(FRAMES).build();
+    let h = Harness::new(gpu, &scene, &config).unwrap();
+    let frame = h.clock.frame(FRAMES - 1);
+    let mut references = Vec::new();
+    for info in techniques {
+        let component = info.default_reference();
+        let reference = match references.iter().position(|(c, _)| *c == component) {
+            Some(i) => &references[i].1,
+            None => {
+                let bounces = match component {
+                    IndirectComponent::OneBounce => 1,
+                    IndirectComponent::MultiBounce | IndirectComponent::Direct => 8,
+                };
+                let r = render_reference(
+                    &scene,
+                    &frame,
+                    SIZE,
+                    &ReferenceSettings {
+                        spp: 256,
+                        bounces,
+                        seed: 0,
+                    },
+                );
+                references.push((component, r));
+                &references.last().unwrap().1
+            }
+        };
+        let (a, undeclared) = render(gpu, &h, info, &config);
+        let b = if twice {
+            render(gpu, &h, info, &config).0
+        } else {
+            a.clone()
+        };
+        let name = format!("{} on {scene_name}", info.name);
+        // 5. Every GPU stage declares its cost. Catches a GPU stage added (or a declaration
+        // dropped) without a `stage_cost` beside its `gpu_stage`: the roofline would show "–".
+        if !undeclared.is_empty() {
+            failures.push(format!(
+                "{name}: stages not declared: {}",
+                undeclared.join(", ")
+            ));
+        }
+        // 1. Finite.
+        if let Some(i) = a.iter().position(|e| !e.is_finite()) {
+            failures.push(format!("{name}: non-finite output {} at pixel {i}", a[i]));
+        }
+        // 2. Zero where the camera sees no geometry (the reference's hit mask, the same camera).
+        let misses: Vec<usize> = (0..a.len()).filter(|&i| !reference.hit[i]).collect();
+        assert!(
+            !misses.is_empty() || !scene_name.starts_with("cornell"),
+            "the Cornell view shows background"
+        );
+        if let Some(&i) = misses.iter().find(|&&i| a[i] != Vec3::ZERO) {
+            failures.push(format!(
+                "{name}: {} where no geometry is hit (pixel {i})",
+                a[i]
+            ));
+        }
+        // 3. Deterministic across builds (where built twice).
+        if a != b {
+            let n = a.iter().zip(&b).filter(|(x, y)| x != y).count();
+            failures.push(format!("{name}: two builds differ in {n} pixels"));
+        }
+        // 4. Against the declared reference component.
+        let want = component.of(reference);
+        let (mut sum_t, mut sum_r) = (0.0f64, 0.0f64);
+        for ((t, r), hit) in a.iter().zip(want).zip(&reference.hit) {
+            if *hit {
+                sum_t += t.element_sum() as f64;
+                sum_r += r.element_sum() as f64;
+            }
+        }
+        let ratio = sum_t / sum_r;
+        let rel_l1 = a
+            .iter()
+            .zip(want)
+            .zip(&reference.hit)
+            .filter(|(_, h)| **h)
+            .map(|((t, r), _)| (*t - *r).abs().element_sum() as f64)
+            .sum::<f64>()
+            / sum_r;
+        let c = info.conformance;
+        eprintln!(
+            "{name}: relative L1 error {rel_l1:.4} (bound {}), mean ratio {ratio:.4} (bounds {:?}) against the {} reference",
+            c.max_relative_l1,
+            c.mean_ratio,
+            component.name()
+        );
+        if rel_l1.is_nan() || rel_l1 > c.max_relative_l1 {
+            failures.push(format!(
+                "{name}: relative L1 error {rel_l1:.4} above its bound {}",
+                c.max_relative_l1
+            ));
+        }
+        if !(c.mean_ratio.0..=c.mean_ratio.1).contains(&ratio) {
+            failures.push(format!(
+                "{name}: mean ratio {ratio:.4} outside its bounds {:?}",
+                c.mean_ratio
+            ));
+        }
+    }
+}
+
+/// Catches: a technique timing a stage its `TechniqueInfo::stages` does not declare (or
+/// declares as the other kind) without an error: keller-full declared without its own CPU
+/// stage and its maps' stage is refused by name when run.
+#[test]
+fn a_stage_the_technique_does_not_declare_is_refused() {
+    let gpu = GpuContext::new(&GpuOptions::default()).expect("a GPU adapter (Vulkan or GL)");
+    let scene = Scene::load_named("cornell", &AssetPaths::standard(None)).unwrap();
+    let config = RunConfig {
+        resolution: [64, 48],
+        frames: 1,
+        warmup: 3,
+        first_frame: 0,
+        timing: TimingMode::Stages,
+        seed: 1,
+        shadow_size: 128,
+    };
+    let h = Harness::new(&gpu, &scene, &config).unwrap();
+    let keller = TechniqueInfo::find(registry::all(), "keller-full").unwrap();
+    let partial = TechniqueInfo {
+        stages: &[gibench_harness::kit::ir::gather::GATHER_STAGES],
+        ..*keller
+    };
+    let params = partial.parse_params(&[]).unwrap();
+    let prepared = h.prepare(&partial, &params, &config).unwrap();
+    let e = h
+        .run(&partial, &params, &config, &prepared, &mut || {})
+        .err()
+        .expect("an undeclared stage is refused");
+    let e = e.to_string();
+    assert!(
+        e.contains("'keller-full'")
+            && e.contains("vpl-generation (CPU)")
+            && e.contains("vpl-shadow-maps (GPU)"),
+        "{e}"
+    );
+    // Declared in full, the same run goes through.
+    h.run(keller, &params, &config, &prepared, &mut || {})
+        .expect("declared stages run");
+}
