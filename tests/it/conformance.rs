@@ -235,15 +235,10 @@ fn conform_on<'a>(
 fn a_stage_the_technique_does_not_declare_is_refused() {
     let gpu = GpuContext::new(&GpuOptions::default()).expect("a GPU adapter (Vulkan or GL)");
     let scene = Scene::load_named("cornell", &AssetPaths::standard(None)).unwrap();
-    let config = RunConfig {
-        resolution: [64, 48],
-        frames: 1,
-        warmup: 3,
-        first_frame: 0,
-        timing: TimingMode::Stages,
-        seed: 1,
-        shadow_size: 128,
-    };
+    let config = gibench_test_support::one_frame([64, 48])
+        .warmup(3)
+        .shadow_size(128)
+        .build();
     let h = Harness::new(&gpu, &scene, &config).unwrap();
     let keller = TechniqueInfo::find(registry::all(), "keller-full").unwrap();
     let partial = TechniqueInfo {
