@@ -29,3 +29,4 @@ mod readme_examples;
 mod reproduce;
 mod roofline;
 mod run;
+mod src_layers;

@@ -1,5 +1,6 @@
-//! A run, sweep or reference command as a target of `gibench reproduce`: parsed with the
-//! top-level command line, checked before anything runs, then run into its `--out`.
+//! A run, sweep or reference command as a target of `gibench reproduce`: parsed on its own (the
+//! three subcommands a target may be, with the top-level command line's argument types, not
+//! through it), checked before anything runs, then run into its `--out`.
 
 use clap::Parser;
 use gibench_harness::gpu::GpuContext;
@@ -10,7 +11,15 @@ use crate::cli::progress::Bars;
 use crate::cli::reference::{reference_plan, reference_planned, ReferenceArgs, ReferencePlan};
 use crate::cli::run::{plan, run_planned, Plan, RunArgs};
 use crate::cli::sweep::{sweep_plan, sweep_planned, SweepArgs, SweepPlan};
-use crate::{Cli, Command};
+
+/// The commands a target may be, parsed as `gibench run|sweep|reference ...` is.
+#[derive(Parser)]
+#[command(name = "gibench")]
+enum TargetCommand {
+    Run(RunArgs),
+    Sweep(SweepArgs),
+    Reference(ReferenceArgs),
+}
 
 /// A gibench command run as a target of `gibench reproduce`, checked before anything runs.
 pub(crate) enum Job {
@@ -22,27 +31,33 @@ pub(crate) enum Job {
 impl Job {
     /// Parses and checks `gibench ARGV...` (run, sweep or reference).
     pub(crate) fn plan(argv: &[String]) -> Result<Job> {
-        let cli =
-            Cli::try_parse_from(std::iter::once("gibench").chain(argv.iter().map(String::as_str)))
-                .map_err(|e| Error::Invalid(e.to_string().trim().to_string()))?;
-        match cli.command {
-            Some(Command::Run(a)) => {
+        if !matches!(
+            argv.first().map(String::as_str),
+            Some("run" | "sweep" | "reference")
+        ) {
+            return Err(Error::Invalid(format!(
+                "`gibench {}` is not a run, sweep or reference command",
+                argv.join(" ")
+            )));
+        }
+        let command = TargetCommand::try_parse_from(
+            std::iter::once("gibench").chain(argv.iter().map(String::as_str)),
+        )
+        .map_err(|e| Error::Invalid(e.to_string().trim().to_string()))?;
+        match command {
+            TargetCommand::Run(a) => {
                 let p = plan(&a, &[])?;
                 p.spec(&a).validate()?;
                 Ok(Job::Run(Box::new(a), Box::new(p)))
             }
-            Some(Command::Sweep(a)) => {
+            TargetCommand::Sweep(a) => {
                 let p = sweep_plan(&a)?;
                 Ok(Job::Sweep(Box::new(a), Box::new(p)))
             }
-            Some(Command::Reference(a)) => {
+            TargetCommand::Reference(a) => {
                 let p = reference_plan(&a)?;
                 Ok(Job::Reference(Box::new(a), Box::new(p)))
             }
-            _ => Err(Error::Invalid(format!(
-                "`gibench {}` is not a run, sweep or reference command",
-                argv.join(" ")
-            ))),
         }
     }
 

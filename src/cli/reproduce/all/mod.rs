@@ -17,12 +17,11 @@
 //! measured on. A target never timed before has no estimate, and the printout says so.
 //!
 //! This file runs the command (one target, or all of them) and prints the plan; [`targets`]
-//! lists the targets, [`planned`] checks and runs one, [`overall`] is the shared progress bar
+//! lists the targets, [`planned`] checks and runs one, [`Overall`] (in `cli::progress`) is the shared progress bar
 //! and [`manifest`] the record of what ran.
 
 mod manifest;
 mod merge;
-mod overall;
 mod planned;
 mod targets;
 
@@ -35,10 +34,9 @@ use gibench_harness::{Error, Result};
 
 use super::{out_dir, ReproduceArgs};
 use crate::cli::files::writable_dir;
-use crate::cli::progress::Bars;
+use crate::cli::progress::{Bars, Overall};
 use manifest::{duration, Manifest, Record, MANIFEST};
 pub use merge::merge;
-pub use overall::Overall;
 use planned::Planned;
 pub use targets::{find, Kind, Target, TARGETS};
 

@@ -7,7 +7,8 @@ use gibench_harness::report;
 use gibench_harness::run::session::{self, Progress, RunSpec};
 use gibench_harness::Result;
 
-use super::reproduce;
+mod overall;
+pub use overall::Overall;
 
 /// Runs `spec` with a progress bar (hidden when `quiet`).
 pub(crate) fn execute_with_bar(
@@ -61,7 +62,7 @@ pub(crate) fn execute_skipping_with_bar(
 /// `gibench reproduce all`'s bar.
 pub(crate) enum Bars<'a> {
     Own(bool),
-    Shared(&'a reproduce::all::Overall),
+    Shared(&'a Overall),
 }
 
 impl Bars<'_> {

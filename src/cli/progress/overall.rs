@@ -1,4 +1,5 @@
-//! `reproduce all`'s progress bar ([`Overall`]): one span per target, advanced by its frames.
+//! `reproduce all`'s progress bar ([`Overall`]): one span per target, advanced by its frames; it
+//! draws what it is given (labels, spans, frames), not a command's types.
 
 use std::sync::Mutex;
 
@@ -18,7 +19,7 @@ struct Span {
 }
 
 impl Overall {
-    pub(super) fn new(quiet: bool, total: u64) -> Overall {
+    pub(crate) fn new(quiet: bool, total: u64) -> Overall {
         let bar = if quiet {
             indicatif::ProgressBar::hidden()
         } else {
@@ -37,7 +38,7 @@ impl Overall {
     }
 
     /// The next target: `len` of the bar, `frames` frames.
-    pub(super) fn start(&self, label: &str, len: u64, frames: u64) {
+    pub(crate) fn start(&self, label: &str, len: u64, frames: u64) {
         if let Ok(mut s) = self.state.lock() {
             let start = s.start + s.len;
             *s = Span {
@@ -79,7 +80,7 @@ impl Overall {
         }
     }
 
-    pub(super) fn finish(&self) {
+    pub(crate) fn finish(&self) {
         self.bar.finish_and_clear();
     }
 }
