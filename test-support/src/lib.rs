@@ -12,6 +12,7 @@ pub mod gpu;
 pub mod readback;
 pub mod rng;
 pub mod scene;
+pub mod source;
 pub mod technique;
 
 pub use bin::{reference_image, Gibench};

@@ -6,6 +6,8 @@
 
 use std::path::{Path, PathBuf};
 
+use gibench_test_support::source::{rust_files, without_comments};
+
 /// The shared modules of `src/cli/`.
 const SHARED: &[&str] = &[
     "options",
@@ -16,17 +18,6 @@ const SHARED: &[&str] = &[
     "page",
     "shard",
 ];
-
-fn sources(dir: &Path, out: &mut Vec<PathBuf>) {
-    for e in std::fs::read_dir(dir).unwrap().flatten() {
-        let p = e.path();
-        if p.is_dir() {
-            sources(&p, out);
-        } else if p.extension().is_some_and(|x| x == "rs") {
-            out.push(p);
-        }
-    }
-}
 
 /// The command modules: every module of `src/cli/` that is not shared.
 fn commands(cli: &Path) -> Vec<String> {
@@ -80,16 +71,6 @@ fn breaches(rel: &str, code: &str, commands: &[String]) -> Vec<String> {
     out
 }
 
-fn without_comments(code: &str) -> String {
-    code.lines()
-        .map(|l| match l.find("//") {
-            Some(i) if !l[..i].contains('"') => &l[..i],
-            _ => l,
-        })
-        .collect::<Vec<_>>()
-        .join("\n")
-}
-
 #[test]
 fn shared_modules_never_use_a_command_and_nothing_uses_main() {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
@@ -98,8 +79,7 @@ fn shared_modules_never_use_a_command_and_nothing_uses_main() {
         commands.iter().any(|c| c == "reproduce") && commands.len() > 10,
         "{commands:?}"
     );
-    let mut files = Vec::new();
-    sources(&root.join("src"), &mut files);
+    let files = rust_files(&root.join("src"));
     let mut wrong = Vec::new();
     for f in &files {
         let rel = f

@@ -4,7 +4,9 @@
 //! path, which is how an import circle between folders would start (for example the results
 //! model in `measure/` reaching up into `report/`).
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
+
+use gibench_test_support::source::{rust_files, without_comments};
 
 /// The folders from the bottom up; `error`, `output` and `rng` are the files every layer may use.
 const LAYERS: &[&[&str]] = &[
@@ -20,17 +22,6 @@ const LAYERS: &[&[&str]] = &[
 
 fn layer_of(module: &str) -> Option<usize> {
     LAYERS.iter().position(|l| l.contains(&module))
-}
-
-fn sources(dir: &Path, out: &mut Vec<PathBuf>) {
-    for entry in std::fs::read_dir(dir).unwrap() {
-        let path = entry.unwrap().path();
-        if path.is_dir() {
-            sources(&path, out);
-        } else if path.extension().is_some_and(|e| e == "rs") {
-            out.push(path);
-        }
-    }
 }
 
 /// The first path segment of every `crate::` path in `code` (comments already removed),
@@ -79,22 +70,10 @@ fn ident(s: &str) -> String {
         .collect()
 }
 
-/// `code` without `//` comments (doc links may point anywhere; only code is a dependency).
-fn strip_comments(code: &str) -> String {
-    code.lines()
-        .map(|l| match l.find("//") {
-            Some(i) if !l[..i].contains('"') => &l[..i],
-            _ => l,
-        })
-        .collect::<Vec<_>>()
-        .join("\n")
-}
-
 #[test]
 fn every_folder_uses_only_the_folders_below_it() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
-    let mut files = Vec::new();
-    sources(&root, &mut files);
+    let files = rust_files(&root);
     let mut wrong = Vec::new();
     let mut checked = 0;
     for file in &files {
@@ -112,7 +91,7 @@ fn every_folder_uses_only_the_folders_below_it() {
             continue;
         };
         checked += 1;
-        let code = strip_comments(&std::fs::read_to_string(file).unwrap());
+        let code = without_comments(&std::fs::read_to_string(file).unwrap());
         for module in crate_modules(&code) {
             // `crate::Error` / `crate::Result` are lib.rs's re-exports of `error`.
             let module = match module.as_str() {
@@ -156,11 +135,10 @@ fn technique_crates_use_only_the_kit_and_below() {
         if !src.is_dir() || src.parent().unwrap().ends_with("support") {
             continue;
         }
-        let mut files = Vec::new();
-        sources(&src, &mut files);
+        let files = rust_files(&src);
         for file in &files {
             checked += 1;
-            let code = strip_comments(&std::fs::read_to_string(file).unwrap());
+            let code = without_comments(&std::fs::read_to_string(file).unwrap());
             for module in paths_under(&code, "gibench_harness::") {
                 let layer = match module.as_str() {
                     "Error" | "Result" => Some(0),
