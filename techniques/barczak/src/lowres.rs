@@ -20,8 +20,8 @@ use bytemuck::{Pod, Zeroable};
 use gibench_harness::gpu::GpuContext;
 use gibench_harness::kit::ir::edges::{EdgeMask, EdgeSettings};
 use gibench_harness::kit::passes::{
-    bind_buffer, fullscreen_pipeline_with, params_buffer, params_entry, render_target,
-    shader_module, texture_entry, GBuffer, HDR_FORMAT,
+    fullscreen_pipeline_with, params_buffer, render_target, shader_module, Bindings, Bound,
+    GBuffer, HDR_FORMAT,
 };
 use gibench_harness::{wgpu, Error, Result};
 
@@ -91,31 +91,11 @@ impl LowRes {
             },
         );
         let frag = wgpu::ShaderStages::FRAGMENT;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("barczak low resolution"),
-            entries: &[
-                params_entry(0, frag),
-                params_entry(1, frag),
-                texture_entry(
-                    2,
-                    frag,
-                    wgpu::TextureSampleType::Float { filterable: false },
-                    wgpu::TextureViewDimension::D2,
-                ),
-            ],
-        });
-        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("barczak low resolution"),
-            layout: &layout,
-            entries: &[
-                bind_buffer(0, &params),
-                bind_buffer(1, edges.mask()),
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: wgpu::BindingResource::TextureView(&low_view),
-                },
-            ],
-        });
+        let Bound { layout, group } = Bindings::new("barczak low resolution", frag)
+            .params(&params)
+            .params(edges.mask())
+            .texture(&low_view)
+            .build(device);
         let module = shader_module(
             device,
             "barczak low resolution",

@@ -17,9 +17,8 @@
 use gibench_harness::glam::{Mat4, Vec3, Vec4};
 use gibench_harness::gpu::GpuContext;
 use gibench_harness::kit::passes::{
-    bind_buffer, compute_pipeline, shader_module, storage_entry, storage_texture_entry,
-    texture_entry, uniform_entry, DirectLight, DrawSet, FrameUniforms, GBuffer, GpuScene, Vertex,
-    HDR_FORMAT,
+    compute_pipeline, shader_module, Bindings, Bound, DirectLight, DrawSet, FrameUniforms, GBuffer,
+    GpuScene, Vertex, HDR_FORMAT,
 };
 use gibench_harness::scene::SceneExtent;
 use gibench_harness::{wgpu, Error, Result};
@@ -392,22 +391,15 @@ fn slice_matrices(
         }
     }
     gpu.queue.write_buffer(&slices, 0, &bytes);
-    let slice_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("voxel slice"),
-        entries: &[uniform_entry(0, wgpu::ShaderStages::VERTEX, true)],
+    let first_slice = wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+        buffer: &slices,
+        offset: 0,
+        size: wgpu::BufferSize::new(64),
     });
-    let slice_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("voxel slice"),
-        layout: &slice_layout,
-        entries: &[wgpu::BindGroupEntry {
-            binding: 0,
-            resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                buffer: &slices,
-                offset: 0,
-                size: wgpu::BufferSize::new(64),
-            }),
-        }],
-    });
+    let slice = Bindings::new("voxel slice", wgpu::ShaderStages::VERTEX)
+        .dynamic_uniform(first_slice)
+        .build(device);
+    let (slice_layout, slice_group) = (slice.layout, slice.group);
     (slices, slice_layout, slice_group)
 }
 
@@ -483,39 +475,19 @@ fn combine_pass(
     targets: &[[wgpu::TextureView; 3]],
     volumes: &Volumes,
 ) -> (wgpu::ComputePipeline, wgpu::BindGroup) {
-    let c = wgpu::ShaderStages::COMPUTE;
-    let unfilterable = wgpu::TextureSampleType::Float { filterable: false };
-    let mut entries: Vec<wgpu::BindGroupLayoutEntry> = (0..9)
-        .map(|b| texture_entry(b, c, unfilterable, wgpu::TextureViewDimension::D2))
-        .collect();
-    entries.extend([
-        storage_entry(9, false),
-        storage_entry(10, false),
-        storage_entry(11, false),
-    ]);
-    let combine_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("voxel combine"),
-        entries: &entries,
-    });
-    let mut group_entries: Vec<wgpu::BindGroupEntry> = targets
-        .iter()
-        .flatten()
-        .enumerate()
-        .map(|(i, v)| wgpu::BindGroupEntry {
-            binding: i as u32,
-            resource: wgpu::BindingResource::TextureView(v),
-        })
-        .collect();
-    group_entries.extend([
-        bind_buffer(9, &volumes.voxels),
-        bind_buffer(10, &volumes.propagation[0]),
-        bind_buffer(11, &volumes.accumulation),
-    ]);
-    let combine_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("voxel combine"),
-        layout: &combine_layout,
-        entries: &group_entries,
-    });
+    // The slices' nine targets (three per axis), then the volumes written.
+    let targets = (targets.iter().flatten()).fold(
+        Bindings::new("voxel combine", wgpu::ShaderStages::COMPUTE),
+        |g, view| g.texture(view),
+    );
+    let Bound {
+        layout: combine_layout,
+        group: combine_group,
+    } = targets
+        .write(&volumes.voxels)
+        .write(&volumes.propagation[0])
+        .write(&volumes.accumulation)
+        .build(device);
     let combine = compute_pipeline(
         device,
         "voxel combine",
@@ -574,54 +546,36 @@ impl Propagation {
             sender("propagation senders +"),
             sender("propagation senders -"),
         ];
-        let faces_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("propagation faces"),
-            entries: &[
-                storage_entry(0, true),
-                storage_entry(1, true),
-                storage_entry(2, false),
-                storage_entry(3, false),
-            ],
-        });
-        let mut gather_entries = vec![
-            storage_entry(4, true),
-            storage_entry(5, true),
-            storage_entry(6, false),
-            storage_entry(7, false),
-        ];
-        if carries {
-            gather_entries.push(storage_entry(8, true));
-        }
-        let gather_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("propagation"),
-            entries: &gather_entries,
-        });
-        let groups = |from: usize| {
-            let faces = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("propagation faces"),
-                layout: &faces_layout,
-                entries: &[
-                    bind_buffer(0, &volumes.voxels),
-                    bind_buffer(1, &volumes.propagation[from]),
-                    bind_buffer(2, &senders[0]),
-                    bind_buffer(3, &senders[1]),
-                ],
-            });
-            let mut entries = vec![
-                bind_buffer(4, &senders[0]),
-                bind_buffer(5, &senders[1]),
-                bind_buffer(6, &volumes.propagation[1 - from]),
-                bind_buffer(7, &volumes.accumulation),
-            ];
-            if carries {
-                entries.push(bind_buffer(8, &volumes.propagation[from]));
+        let c = wgpu::ShaderStages::COMPUTE;
+        // From the volume `from` to the other: `faces` reads the voxels and the source and
+        // writes the senders; the gather (bindings 4.. of the same shader) reads the senders and
+        // writes the other volume and the accumulation (and with `carry`, reads the source).
+        let faces_of = |from: usize| {
+            Bindings::new("propagation faces", c)
+                .read(&volumes.voxels)
+                .read(&volumes.propagation[from])
+                .write(&senders[0])
+                .write(&senders[1])
+        };
+        let gather_of = |from: usize| {
+            let gather = Bindings::new("propagation", c)
+                .first_binding(4)
+                .read(&senders[0])
+                .read(&senders[1])
+                .write(&volumes.propagation[1 - from])
+                .write(&volumes.accumulation);
+            match carries {
+                true => gather.read(&volumes.propagation[from]),
+                false => gather,
             }
-            let gather = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("propagation"),
-                layout: &gather_layout,
-                entries: &entries,
-            });
-            (faces, gather)
+        };
+        let (faces_layout, gather_layout) =
+            (faces_of(0).layout(device), gather_of(0).layout(device));
+        let groups = |from: usize| {
+            (
+                faces_of(from).group(device, &faces_layout),
+                gather_of(from).group(device, &gather_layout),
+            )
         };
         // The senders' SH, read by the gather with `transport=carry` and `pyramid` only (with
         // `cosine` the binding is left out of the shader and its layout).
@@ -702,26 +656,11 @@ impl Reconstruction {
         output: &wgpu::TextureView,
     ) -> Result<Reconstruction> {
         let device = &gpu.device;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("reconstruction"),
-            entries: &[
-                storage_entry(0, true),
-                storage_entry(1, true),
-                storage_texture_entry(2, HDR_FORMAT),
-            ],
-        });
-        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("reconstruction"),
-            layout: &layout,
-            entries: &[
-                bind_buffer(0, &volumes.voxels),
-                bind_buffer(1, &volumes.accumulation),
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: wgpu::BindingResource::TextureView(output),
-                },
-            ],
-        });
+        let Bound { layout, group } = Bindings::new("reconstruction", wgpu::ShaderStages::COMPUTE)
+            .read(&volumes.voxels)
+            .read(&volumes.accumulation)
+            .storage_texture(output, HDR_FORMAT)
+            .build(device);
         let pipeline = compute_pipeline(
             device,
             "reconstruction",

@@ -29,9 +29,7 @@ use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec2, Vec3};
 
 use crate::gpu::GpuContext;
-use crate::kit::passes::{
-    bind_buffer, cube_face_matrix, params_entry, texture_entry, PARAMS_USAGE,
-};
+use crate::kit::passes::{cube_face_matrix, Bindings, Bound, PARAMS_USAGE};
 use crate::scene::SceneExtent;
 use crate::{Error, Result};
 
@@ -251,29 +249,10 @@ impl ShadowAtlas {
             mapped_at_creation: false,
         });
         let stages = wgpu::ShaderStages::COMPUTE | wgpu::ShaderStages::FRAGMENT;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("vpl atlas"),
-            entries: &[
-                params_entry(0, stages),
-                texture_entry(
-                    1,
-                    stages,
-                    wgpu::TextureSampleType::Float { filterable: false },
-                    wgpu::TextureViewDimension::D2,
-                ),
-            ],
-        });
-        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("vpl atlas"),
-            layout: &layout,
-            entries: &[
-                bind_buffer(0, &params),
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: wgpu::BindingResource::TextureView(&view),
-                },
-            ],
-        });
+        let Bound { layout, group } = Bindings::new("vpl atlas", stages)
+            .params(&params)
+            .texture(&view)
+            .build(device);
         let atlas = ShadowAtlas {
             settings,
             texture,

@@ -22,10 +22,7 @@ use bytemuck::{Pod, Zeroable};
 use super::atlas::{AtlasFormat, ShadowAtlas};
 use super::splat::{texel_buffer_size, PointSplat};
 use crate::gpu::GpuContext;
-use crate::kit::passes::{
-    bind_buffer, compute_pipeline, params_buffer, params_entry, storage_entry,
-    storage_texture_entry,
-};
+use crate::kit::passes::{compute_pipeline, params_buffer, Bindings};
 use crate::measure::roofline::StageCost;
 use crate::{Error, Result};
 
@@ -96,21 +93,10 @@ impl PullPush {
             usage: wgpu::BufferUsages::STORAGE,
             mapped_at_creation: false,
         });
-        let base = [
-            params_entry(0, wgpu::ShaderStages::COMPUTE),
-            storage_entry(1, true),
-            storage_entry(2, false),
-        ];
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("pull-push"),
-            entries: &base,
-        });
-        let mut with_atlas = base.to_vec();
-        with_atlas.push(storage_texture_entry(3, wgpu::TextureFormat::R32Float));
-        let store_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("pull-push store"),
-            entries: &with_atlas,
-        });
+        let atlas_view = atlas.texture().create_view(&Default::default());
+        let (depth, store) = (splat.depth(), Some(&atlas_view));
+        let layout = declare(&pyramid, depth, &pyramid, None).layout(device);
+        let store_layout = declare(&pyramid, depth, &pyramid, store).layout(device);
         let common = include_str!("shaders/pullpush.wgsl");
         let pipeline = |layout: &wgpu::BindGroupLayout, source: String, entry: &str| {
             compute_pipeline(device, entry, &source, &[layout], entry)
@@ -124,7 +110,6 @@ impl PullPush {
                 "store",
             ),
         ];
-        let atlas_view = atlas.texture().create_view(&Default::default());
         let columns = atlas.columns();
         let pass = |kind: usize, level: u32, source: u32| -> Pass {
             let s = size >> level;
@@ -136,22 +121,9 @@ impl PullPush {
                     offsets: [offsets[level as usize], source, 0, 0],
                 },
             );
-            let mut entries = vec![
-                bind_buffer(0, &params),
-                bind_buffer(1, splat.depth()),
-                bind_buffer(2, &pyramid),
-            ];
-            if kind == 2 {
-                entries.push(wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: wgpu::BindingResource::TextureView(&atlas_view),
-                });
-            }
-            let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("pull-push"),
-                layout: if kind == 2 { &store_layout } else { &layout },
-                entries: &entries,
-            });
+            let layout = if kind == 2 { &store_layout } else { &layout };
+            let atlas = if kind == 2 { store } else { None };
+            let group = declare(&params, depth, &pyramid, atlas).group(device, layout);
             Pass {
                 pipeline: kind,
                 group,
@@ -213,5 +185,23 @@ impl PullPush {
             pass.set_bind_group(0, &p.group, &[]);
             pass.dispatch_workgroups(p.texels.div_ceil(64), self.slots, 1);
         }
+    }
+}
+
+/// A pass's group: its parameters, the splat's depths read, the pyramid written, and for the
+/// last pass (the store) the atlas written.
+fn declare<'a>(
+    params: &'a wgpu::Buffer,
+    depth: &'a wgpu::Buffer,
+    pyramid: &'a wgpu::Buffer,
+    atlas: Option<&'a wgpu::TextureView>,
+) -> Bindings<'a> {
+    let group = Bindings::new("pull-push", wgpu::ShaderStages::COMPUTE)
+        .params(params)
+        .read(depth)
+        .write(pyramid);
+    match atlas {
+        Some(view) => group.storage_texture(view, wgpu::TextureFormat::R32Float),
+        None => group,
     }
 }

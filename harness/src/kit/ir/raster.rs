@@ -31,7 +31,7 @@ use super::store::VplStore;
 use crate::cpu::vpl::{frame_from_normal, Vpl};
 use crate::gpu::GpuContext;
 use crate::kit::passes::{
-    bind_buffer, compute_pipeline, cube_face_matrix, shader_module, storage_entry, uniform_entry,
+    bind_buffer, compute_pipeline, cube_face_matrix, shader_module, storage_entry, Bindings, Bound,
     DrawSet, FrameUniforms, GpuScene, Vertex,
 };
 use crate::measure::roofline::StageCost;
@@ -101,22 +101,17 @@ impl AtlasRasteriser {
                 | wgpu::BufferUsages::STORAGE,
             mapped_at_creation: false,
         });
-        let view_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("vpl view"),
-            entries: &[uniform_entry(0, wgpu::ShaderStages::VERTEX_FRAGMENT, true)],
+        let first_view = wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+            buffer: &view_buffer,
+            offset: 0,
+            size: wgpu::BufferSize::new(std::mem::size_of::<ViewData>() as u64),
         });
-        let view_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("vpl views"),
-            layout: &view_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                    buffer: &view_buffer,
-                    offset: 0,
-                    size: wgpu::BufferSize::new(std::mem::size_of::<ViewData>() as u64),
-                }),
-            }],
-        });
+        let Bound {
+            layout: view_layout,
+            group: view_group,
+        } = Bindings::new("vpl views", wgpu::ShaderStages::VERTEX_FRAGMENT)
+            .dynamic_uniform(first_view)
+            .build(device);
         let module = shader_module(
             device,
             "vpl shadow maps",

@@ -19,9 +19,8 @@
 use super::splat::texel_buffer_size;
 use crate::gpu::GpuContext;
 use crate::kit::passes::{
-    begin_gbuffer_pass, bind_buffer, compute_pipeline, draw_light_faces, params_entry,
-    render_target, scene_pipeline, storage_entry, texture_entry, uniform_entry, FrameUniforms,
-    GpuScene, ALBEDO_FORMAT, DEPTH_FORMAT, NORMAL_FORMAT, PARAMS_USAGE,
+    begin_gbuffer_pass, compute_pipeline, draw_light_faces, render_target, scene_pipeline,
+    Bindings, FrameUniforms, GpuScene, ALBEDO_FORMAT, DEPTH_FORMAT, NORMAL_FORMAT, PARAMS_USAGE,
 };
 use crate::measure::roofline::StageCost;
 use crate::Result;
@@ -93,65 +92,25 @@ impl ReflectiveShadowMap {
             mapped_at_creation: false,
         });
         let c = wgpu::ShaderStages::COMPUTE;
-        let unfilterable = wgpu::TextureSampleType::Float { filterable: false };
-        let d2 = wgpu::TextureViewDimension::D2;
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("rsm export"),
-            entries: &[
-                params_entry(0, c),
-                params_entry(1, c),
-                texture_entry(2, c, unfilterable, d2),
-                texture_entry(3, c, unfilterable, d2),
-                texture_entry(4, c, unfilterable, d2),
-                storage_entry(5, false),
-                storage_entry(6, false),
-                storage_entry(7, false),
-            ],
+        let export_group = Bindings::new("rsm export", c)
+            .params(&params)
+            .params(&uniforms.light_buffer)
+            .texture(&depth_view)
+            .texture(&normal_view)
+            .texture(&albedo_view)
+            .write(&buffers[0])
+            .write(&buffers[1])
+            .write(&buffers[2])
+            .build(device);
+        let faces = (1..=6).fold(Bindings::new("rsm faces", c), |g, f| {
+            g.uniform(uniforms.views.binding(f))
         });
-        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("rsm export"),
-            layout: &layout,
-            entries: &[
-                bind_buffer(0, &params),
-                bind_buffer(1, &uniforms.light_buffer),
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: wgpu::BindingResource::TextureView(&depth_view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: wgpu::BindingResource::TextureView(&normal_view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 4,
-                    resource: wgpu::BindingResource::TextureView(&albedo_view),
-                },
-                bind_buffer(5, &buffers[0]),
-                bind_buffer(6, &buffers[1]),
-                bind_buffer(7, &buffers[2]),
-            ],
-        });
-        let face_entries: Vec<wgpu::BindGroupLayoutEntry> =
-            (0..6).map(|f| uniform_entry(f, c, false)).collect();
-        let faces_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("rsm faces"),
-            entries: &face_entries,
-        });
-        let faces_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("rsm faces"),
-            layout: &faces_layout,
-            entries: &(0..6)
-                .map(|f| wgpu::BindGroupEntry {
-                    binding: f,
-                    resource: uniforms.views.binding(1 + f as usize),
-                })
-                .collect::<Vec<_>>(),
-        });
+        let faces = faces.build(device);
         let export = compute_pipeline(
             device,
             "rsm export",
             include_str!("shaders/rsm_export.wgsl"),
-            &[&layout, &faces_layout],
+            &[&export_group.layout, &faces.layout],
             "export_texels",
         );
         gpu.check_errors()?;
@@ -174,8 +133,8 @@ impl ReflectiveShadowMap {
             albedo_view,
             pipeline,
             export,
-            group,
-            faces_group,
+            group: export_group.group,
+            faces_group: faces.group,
             params,
             buffers,
             _textures: [depth, normal, albedo],

@@ -28,9 +28,7 @@ use bytemuck::{Pod, Zeroable};
 
 use super::store::VplStore;
 use crate::gpu::GpuContext;
-use crate::kit::passes::{
-    bind_buffer, compute_pipeline, params_buffer, params_entry, storage_entry,
-};
+use crate::kit::passes::{compute_pipeline, params_buffer, Bindings};
 use crate::measure::roofline::StageCost;
 use crate::{Error, Result};
 
@@ -136,37 +134,17 @@ impl VplSampler {
         };
         let cdf = buffer("vpl sample cdf", rsm.texels as u64 * 4);
         let totals = buffer("vpl sample totals", 16);
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("vpl sample"),
-            entries: &[
-                VplStore::layout_entry(0, true),
-                params_entry(1, wgpu::ShaderStages::COMPUTE),
-                storage_entry(2, true),
-                storage_entry(3, true),
-                storage_entry(4, true),
-                storage_entry(5, false),
-                storage_entry(6, false),
-            ],
-        });
-        let resources = [
-            store.buffer(),
-            &params,
-            rsm.position,
-            rsm.normal,
-            rsm.flux,
-            &cdf,
-            &totals,
-        ];
-        let entries: Vec<wgpu::BindGroupEntry> = resources
-            .iter()
-            .enumerate()
-            .map(|(i, b)| bind_buffer(i as u32, b))
-            .collect();
-        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("vpl sample"),
-            layout: &layout,
-            entries: &entries,
-        });
+        // The store is written (VplStore::layout_entry(_, true)); the map's texels are read.
+        let bound = Bindings::new("vpl sample", wgpu::ShaderStages::COMPUTE)
+            .write(store.buffer())
+            .params(&params)
+            .read(rsm.position)
+            .read(rsm.normal)
+            .read(rsm.flux)
+            .write(&cdf)
+            .write(&totals)
+            .build(device);
+        let (layout, group) = (bound.layout, bound.group);
         let source = format!(
             "{}\n{}",
             VplStore::wgsl(0, 0, true),

@@ -22,7 +22,8 @@ mod scene_gpu;
 
 pub use bind::{
     bind_buffer, dynamic_storage_entry, params_entry, read_storage_entry, sampler_entry,
-    storage_entry, storage_texture_entry, texture_entry, uniform_entry, PARAMS_USAGE,
+    storage_entry, storage_texture_entry, texture_entry, uniform_entry, Bindings, Bound,
+    PARAMS_USAGE,
 };
 pub use compose::Compose;
 pub use direct::{draw_light_faces, needed_cube_faces, DirectLight, CUBE_FACES};
