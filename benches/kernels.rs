@@ -18,8 +18,7 @@ use gibench_harness::run::runner::Harness;
 use gibench_harness::scene::assets::AssetPaths;
 use gibench_harness::scene::Scene;
 
-#[path = "../src/registry.rs"]
-mod registry;
+use gibench_papers::registry;
 
 /// A criterion measurement: the CPU time of every thread of the process, in nanoseconds (where
 /// the platform has no such clock it reads 0 and the bench says so).

@@ -1,12 +1,12 @@
 //! `gibench`: run real-time indirect-illumination techniques side by side on the same scenes,
 //! frames and timing harness, and render their per-stage timing tables.
 //!
-//! This file holds the command line's top level and the dispatch; each subcommand (its
-//! arguments and its work) is a module of [`cli`].
+//! This file holds the command line's top level and the dispatch. The paper work (`run`,
+//! `sweep`, `reference`, `reproduce`, `merge`) is the `gibench-papers` library's; every other
+//! subcommand (its arguments and its work) is a module of [`cli`].
 
 mod cli;
 mod rays;
-mod registry;
 
 use std::process::ExitCode;
 
@@ -16,14 +16,14 @@ use cli::compare::CompareArgs;
 use cli::export::ExportResultsArgs;
 use cli::export_scene::ExportArgs;
 use cli::instructions::InstructionsArgs;
-use cli::merge::MergeArgs;
 use cli::plot_quality::PlotQualityArgs;
 use cli::raycast::RaycastArgs;
-use cli::reference::ReferenceArgs;
 use cli::report::ReportArgs;
-use cli::reproduce::ReproduceArgs;
-use cli::run::RunArgs;
-use cli::sweep::SweepArgs;
+use gibench_papers::merge::MergeArgs;
+use gibench_papers::reference::ReferenceArgs;
+use gibench_papers::reproduce::ReproduceArgs;
+use gibench_papers::run::RunArgs;
+use gibench_papers::sweep::SweepArgs;
 
 #[derive(Parser)]
 #[command(
@@ -81,13 +81,13 @@ fn main() -> ExitCode {
     gibench_harness::cpu::threads::join_global_pool();
     let cli = Cli::parse();
     let outcome = match cli.command {
-        None => cli::run::exec(&RunArgs::parse_default()),
-        Some(Command::Run(args)) => cli::run::exec(&args),
+        None => gibench_papers::run::exec(&RunArgs::parse_default()),
+        Some(Command::Run(args)) => gibench_papers::run::exec(&args),
         Some(Command::List(args)) => cli::list::exec(&args),
         Some(Command::Report(args)) => cli::report::exec(&args),
-        Some(Command::Reference(args)) => cli::reference::exec(&args),
-        Some(Command::Sweep(args)) => cli::sweep::exec(&args),
-        Some(Command::Merge(args)) => cli::merge::exec(&args),
+        Some(Command::Reference(args)) => gibench_papers::reference::exec(&args),
+        Some(Command::Sweep(args)) => gibench_papers::sweep::exec(&args),
+        Some(Command::Merge(args)) => gibench_papers::merge::exec(&args),
         Some(Command::PlotQuality(args)) => cli::plot_quality::exec(&args),
         Some(Command::Compare(args)) => match cli::compare::exec(&args) {
             Ok(status) => return status,
@@ -97,7 +97,7 @@ fn main() -> ExitCode {
         Some(Command::Instructions(args)) => cli::instructions::exec(&args),
         Some(Command::ExportScene(args)) => cli::export_scene::exec(&args),
         Some(Command::Raycast(args)) => cli::raycast::exec(&args),
-        Some(Command::Reproduce(args)) => cli::reproduce::exec(&args),
+        Some(Command::Reproduce(args)) => gibench_papers::reproduce::exec(&args),
         Some(Command::Adapter(args)) => cli::adapter::exec(&args),
     };
     match outcome {

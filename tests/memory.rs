@@ -15,8 +15,7 @@
 //! A test binary of its own, not a module of `tests/it/`: it needs its own process, since it
 //! measures the process's resident set, which every other test running beside it would grow.
 
-#[path = "../src/registry.rs"]
-mod registry;
+use gibench_papers::registry;
 
 use gibench_harness::gpu::profiler::{ProfileMode, Profiler};
 use gibench_harness::run::runner::{process_memory_mb, Harness, TimingMode};

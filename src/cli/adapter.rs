@@ -6,7 +6,7 @@ use clap::Args;
 use gibench_harness::gpu::{GpuContext, GpuOptions};
 use gibench_harness::{Error, Result};
 
-use super::options::GpuArgs;
+use gibench_papers::options::GpuArgs;
 
 #[derive(Args)]
 pub(crate) struct AdapterArgs {

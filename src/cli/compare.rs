@@ -15,8 +15,8 @@ use gibench_harness::report;
 use gibench_harness::report::compare::{Statistic, Verdict};
 use gibench_harness::{Error, Result};
 
-use super::files::check_stem;
 use super::results_io::results_under;
+use gibench_papers::files::check_stem;
 
 #[derive(Args)]
 pub(crate) struct CompareArgs {

@@ -40,8 +40,8 @@ use gibench_harness::report::stage_ms;
 use gibench_harness::{Error, Result};
 use serde_json::{json, Map, Value};
 
-use super::files::writable_file;
 use super::results_io::results_under;
+use gibench_papers::files::writable_file;
 
 /// Formats `gibench export` writes.
 #[derive(Clone, Copy, Debug, ValueEnum)]

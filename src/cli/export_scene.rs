@@ -64,9 +64,9 @@ fn ply(positions: &[[f32; 3]], tris: &[[u32; 3]]) -> Vec<u8> {
 }
 
 pub(crate) fn exec(args: &ExportArgs) -> Result<()> {
-    let resolution = super::params::parse_resolution(&args.resolution)?;
+    let resolution = gibench_papers::params::parse_resolution(&args.resolution)?;
     gibench_harness::run::runner::check_resolution(resolution)?;
-    super::params::check_frame_number("frame", args.frame)?;
+    gibench_papers::params::check_frame_number("frame", args.frame)?;
     if args.rays > crate::rays::MAX_RAYS {
         return Err(Error::param(
             "rays",
@@ -80,7 +80,7 @@ pub(crate) fn exec(args: &ExportArgs) -> Result<()> {
     }
     let desc = SceneDescriptor::resolve(&args.scene)?;
     let scene = Scene::load(&desc, &AssetPaths::standard(args.assets.as_deref()))?;
-    super::files::writable_dir("out", &args.out)?;
+    gibench_papers::files::writable_dir("out", &args.out)?;
     let frame = gibench_harness::scene::anim::FrameClock::new(&desc).frame(args.frame);
     let mesh = gibench_harness::cpu::reference::frame_mesh(&scene, &frame);
     // Triangles per material (a triangle's material is its first vertex's), each with its

@@ -1,20 +1,21 @@
 //! `gibench list`: the built-in scenes and the registered techniques with their parameters
 //! and defaults; `--markdown` prints, from the registry's declarations, the techniques' table
-//! that the README holds and their parameter table that docs/running.md holds (a test checks
-//! that each matches).
+//! that the README holds, their parameter table that docs/running.md holds and their stage
+//! table that docs/techniques.md holds (a test checks that each matches).
 
 use clap::Args;
-use gibench_harness::kit::technique::{ParamKind, ParamSpec};
+use gibench_harness::kit::technique::{ParamKind, ParamSpec, TechniqueInfo};
 use gibench_harness::measure::results::StageKind;
 use gibench_harness::scene::{descriptor, SceneDescriptor};
 use gibench_harness::Result;
 
-use crate::registry;
+use gibench_papers::registry;
 
 #[derive(Args)]
 pub(crate) struct ListArgs {
-    /// Print the techniques (the README's table) and their parameters (docs/running.md's) as
-    /// Markdown tables, a blank line between them.
+    /// Print the techniques (the README's table), their parameters (docs/running.md's) and
+    /// their stages and conformance bounds (docs/techniques.md's) as Markdown tables, a blank
+    /// line between them.
     #[arg(long)]
     markdown: bool,
 }
@@ -22,7 +23,12 @@ pub(crate) struct ListArgs {
 /// `gibench list`: prints the scenes and techniques.
 pub(crate) fn exec(args: &ListArgs) -> Result<()> {
     if args.markdown {
-        print!("{}\n{}", technique_table(), parameter_table());
+        print!(
+            "{}\n{}\n{}",
+            technique_table(),
+            parameter_table(),
+            stage_table()
+        );
         return Ok(());
     }
     println!("Scenes (built-in descriptors; any descriptor JSON path also works):");
@@ -41,6 +47,7 @@ pub(crate) fn exec(args: &ListArgs) -> Result<()> {
     }
     println!("\nTechniques:");
     for t in registry::all() {
+        let stages = stage_list(t);
         println!("  {:<16} {}", t.name, t.description);
         println!(
             "      compared with the {} reference by default; conformance: relative L1 error <= {}, mean ratio {}-{}",
@@ -49,21 +56,7 @@ pub(crate) fn exec(args: &ListArgs) -> Result<()> {
             t.conformance.mean_ratio.0,
             t.conformance.mean_ratio.1
         );
-        let stages: Vec<String> = t
-            .stages()
-            .map(|s| match s.kind {
-                StageKind::Gpu => s.name.to_string(),
-                StageKind::Cpu => format!("{} (CPU)", s.name),
-            })
-            .collect();
-        println!(
-            "      stages: {}",
-            if stages.is_empty() {
-                "none of its own".to_string()
-            } else {
-                stages.join(", ")
-            }
-        );
+        println!("      stages: {stages}");
         if t.param_specs().next().is_none() {
             println!("      (no parameters)");
         }
@@ -120,6 +113,45 @@ fn technique_table() -> String {
         out.push_str(&format!(
             "| [`{0}`](docs/techniques.md#{0}) | {1} | {2} |\n",
             t.name, t.paper, t.summary
+        ));
+    }
+    out
+}
+
+/// A technique's own stages in order, the CPU ones marked (the harness's shared stages, the
+/// G-buffer and the direct light, are every technique's and not listed).
+fn stage_list(t: &TechniqueInfo) -> String {
+    let stages: Vec<String> = t
+        .stages()
+        .map(|s| match s.kind {
+            StageKind::Gpu => s.name.to_string(),
+            StageKind::Cpu => format!("{} (CPU)", s.name),
+        })
+        .collect();
+    if stages.is_empty() {
+        "none of its own".to_string()
+    } else {
+        stages.join(", ")
+    }
+}
+
+/// The registered techniques' stages and conformance bounds as docs/techniques.md's table: what
+/// each records per frame and what the conformance test holds it to against its reference.
+fn stage_table() -> String {
+    let mut out = String::from(
+        "| technique | its stages (CPU ones marked) | compared with | conformance bound |\n\
+         |---|---|---|---|\n",
+    );
+    for t in registry::all() {
+        let c = &t.conformance;
+        out.push_str(&format!(
+            "| `{}` | {} | the {} reference | relative L1 ≤ {}, mean ratio {}–{} |\n",
+            t.name,
+            stage_list(t),
+            t.default_reference().name(),
+            c.max_relative_l1,
+            c.mean_ratio.0,
+            c.mean_ratio.1
         ));
     }
     out

@@ -7,8 +7,8 @@ use clap::Args;
 use gibench_harness::report;
 use gibench_harness::{Error, Result};
 
-use super::files::writable_file;
 use super::results_io::{read_results, shown_list};
+use gibench_papers::files::writable_file;
 
 #[derive(Args)]
 pub(crate) struct PlotQualityArgs {

@@ -107,7 +107,7 @@ pub(crate) fn exec(args: &RaycastArgs) -> Result<()> {
             ));
         }
     }
-    super::files::writable_dir("out", &args.out)?;
+    gibench_papers::files::writable_dir("out", &args.out)?;
     let desc = SceneDescriptor::resolve(&scene_arg).map_err(|e| {
         Error::param(
             "rays",

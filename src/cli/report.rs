@@ -9,9 +9,9 @@ use gibench_harness::output::OutputSet;
 use gibench_harness::report;
 use gibench_harness::Result;
 
-use super::files::check_stem;
-use super::page::{page_line, write_page};
 use super::results_io::read_results_with_folders;
+use gibench_papers::files::check_stem;
+use gibench_papers::page::{page_line, write_page};
 
 #[derive(Args)]
 pub(crate) struct ReportArgs {

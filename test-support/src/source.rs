@@ -32,3 +32,43 @@ pub fn without_comments(code: &str) -> String {
         .collect::<Vec<_>>()
         .join("\n")
 }
+
+/// The first path segment after every `prefix` (`crate::`, `gibench_harness::`) in `code`,
+/// including each item of a `prefix{a::X, b}` group.
+pub fn paths_under(code: &str, prefix: &str) -> Vec<String> {
+    let mut found = Vec::new();
+    let mut rest = code;
+    while let Some(i) = rest.find(prefix) {
+        let preceded = rest[..i].chars().next_back();
+        rest = &rest[i + prefix.len()..];
+        if matches!(preceded, Some(c) if c == '$' || c == ':' || c.is_alphanumeric() || c == '_') {
+            continue;
+        }
+        if let Some(group) = rest.strip_prefix('{') {
+            // Items at the group's top level: split on commas outside nested braces.
+            let (mut depth, mut start) = (0, true);
+            for (k, c) in group.char_indices() {
+                match c {
+                    '{' => depth += 1,
+                    '}' if depth == 0 => break,
+                    '}' => depth -= 1,
+                    ',' if depth == 0 => start = true,
+                    c if start && !c.is_whitespace() => {
+                        start = false;
+                        found.push(ident(&group[k..]));
+                    }
+                    _ => {}
+                }
+            }
+        } else {
+            found.push(ident(rest));
+        }
+    }
+    found
+}
+
+fn ident(s: &str) -> String {
+    s.chars()
+        .take_while(|c| c.is_alphanumeric() || *c == '_')
+        .collect()
+}

@@ -18,8 +18,7 @@
 //!
 //! Runs on the best adapter there is (Vulkan, else GL).
 
-#[path = "../../src/registry.rs"]
-mod registry;
+use gibench_papers::registry;
 
 use gibench_harness::cpu::reference::{render_reference, ReferenceSettings};
 use gibench_harness::glam::Vec3;

@@ -731,10 +731,11 @@ fn no_source_file_passes_900_lines() {
     );
 }
 
-/// Catches: the README's technique table or docs/running.md's parameter table drifting from
-/// the registry's declarations (a technique or parameter added or renamed, a default, doc,
-/// paper or summary changed in the code and not in the docs): each table between its markers
-/// must equal its part of `gibench list --markdown` (techniques, a blank line, parameters).
+/// Catches: the README's technique table, docs/running.md's parameter table or
+/// docs/techniques.md's stage table drifting from the registry's declarations (a technique,
+/// parameter or stage added or renamed, a default, doc, paper, summary or conformance bound
+/// changed in the code and not in the docs): each table between its markers must equal its
+/// part of `gibench list --markdown` (techniques, parameters, stages, a blank line between).
 #[test]
 fn the_generated_tables_in_the_docs_match_gibench_list_markdown() {
     let o = std::process::Command::new(env!("CARGO_BIN_EXE_gibench"))
@@ -743,13 +744,15 @@ fn the_generated_tables_in_the_docs_match_gibench_list_markdown() {
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let generated = String::from_utf8(o.stdout).unwrap();
-    let (techniques, parameters) = generated
-        .split_once("\n\n")
-        .expect("two tables, a blank line between them");
+    let tables: Vec<&str> = generated.split("\n\n").collect();
+    let [techniques, parameters, stages] = tables[..] else {
+        panic!("three tables, a blank line between each two:\n{generated}");
+    };
     assert!(parameters.lines().count() > 20, "{generated}");
     for (file, part, table) in [
         ("README.md", "techniques", format!("{techniques}\n")),
-        ("docs/running.md", "parameters", parameters.to_string()),
+        ("docs/running.md", "parameters", format!("{parameters}\n")),
+        ("docs/techniques.md", "stages", stages.to_string()),
     ] {
         let doc = std::fs::read_to_string(root().join(file)).unwrap();
         let start = format!("<!-- gibench list --markdown: {part} -->\n");

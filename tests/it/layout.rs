@@ -12,7 +12,11 @@ fn root() -> PathBuf {
 /// The `tests/` folders of the workspace's crates: the root's, the harness's, each
 /// technique's.
 fn test_folders() -> Vec<PathBuf> {
-    let mut out = vec![root().join("tests"), root().join("harness/tests")];
+    let mut out = vec![
+        root().join("tests"),
+        root().join("harness/tests"),
+        root().join("papers/tests"),
+    ];
     for e in std::fs::read_dir(root().join("techniques")).unwrap() {
         let tests = e.unwrap().path().join("tests");
         if tests.is_dir() {

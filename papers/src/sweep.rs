@@ -12,26 +12,26 @@ use gibench_harness::report;
 use gibench_harness::run::session::{RunSpec, TechniqueRun};
 use gibench_harness::{Error, Result};
 
-use super::page::{page_line, with_folder, write_page};
-use super::params::assign_params;
-use super::progress::{execute_with_bar, Bars};
-use super::run::{announcement, open_gpu, plan, settings, weigh_equally, Plan, RunArgs};
-use super::shard::{own_units, ShardRecord};
+use crate::page::{page_line, with_folder, write_page};
+use crate::params::assign_params;
+use crate::progress::{execute_with_bar, Bars};
 use crate::registry;
+use crate::run::{announcement, open_gpu, plan, settings, weigh_equally, Plan, RunArgs};
+use crate::shard::{own_units, ShardRecord};
 
 #[derive(Args)]
-pub(crate) struct SweepArgs {
+pub struct SweepArgs {
     /// The swept parameter and its values: name=v1,v2,...
     #[arg(long)]
-    pub(crate) sweep: String,
+    pub sweep: String,
     #[command(flatten)]
-    pub(crate) run: RunArgs,
+    pub run: RunArgs,
 }
 
 /// `gibench sweep`: one technique, one parameter over a list of values. With a shard
 /// (`--shard`, or a job array's environment) only its part of the points runs, and a
 /// [`ShardRecord`] beside the results says which, for `gibench merge`.
-pub(crate) fn exec(args: &SweepArgs) -> Result<()> {
+pub fn exec(args: &SweepArgs) -> Result<()> {
     let mut planned = sweep_plan(args)?;
     let shard = args.run.shard.resolve()?;
     let record = match &shard {
@@ -90,7 +90,7 @@ pub(crate) fn exec(args: &SweepArgs) -> Result<()> {
 }
 
 /// A sweep checked before it runs: the parameter, its values and one plan per value.
-pub(crate) struct SweepPlan {
+pub struct SweepPlan {
     name: String,
     values: Vec<String>,
     plans: Vec<Plan>,
@@ -98,7 +98,7 @@ pub(crate) struct SweepPlan {
 
 impl SweepPlan {
     /// The typed run of every point.
-    pub(crate) fn spec(&self, args: &SweepArgs) -> RunSpec<'_> {
+    pub fn spec(&self, args: &SweepArgs) -> RunSpec<'_> {
         let first = &self.plans[0];
         let info = first.techniques[0];
         let mut spec = first.spec(&args.run);
@@ -151,7 +151,7 @@ impl SweepPlan {
 }
 
 /// Checks a sweep's arguments and plans every point before any runs.
-pub(crate) fn sweep_plan(args: &SweepArgs) -> Result<SweepPlan> {
+pub fn sweep_plan(args: &SweepArgs) -> Result<SweepPlan> {
     let (name, values) = args
         .sweep
         .split_once('=')
@@ -250,7 +250,7 @@ fn check_distinct_values(info: &TechniqueInfo, name: &str, values: &[String]) ->
 
 /// The work of `gibench sweep` once planned and its output set is open. Returns what it
 /// wrote, as a line for the terminal.
-pub(crate) fn sweep_planned(
+pub fn sweep_planned(
     args: &SweepArgs,
     planned: &SweepPlan,
     gpu: &GpuContext,
@@ -306,7 +306,7 @@ pub(crate) fn sweep_planned(
 /// (value, results): `{scene}-{technique}-sweep-{name}.md/.csv/.tex/.svg` and with `quality`
 /// the time-versus-error plot, into `out`. `gibench sweep` and `gibench merge` (pooling
 /// shards) both write them here. Returns the table, the figures and the stem.
-pub(crate) fn write_summary(
+pub fn write_summary(
     points: &[(String, RunResult)],
     technique: &str,
     scene: &str,

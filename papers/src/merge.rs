@@ -1,7 +1,7 @@
 //! `gibench merge DIR… --out DIR`: one output set from the folders of many machines (the
 //! shards of a Slurm array, Kubernetes Indexed Job or Buildkite parallel step). What the
 //! folders hold decides: `reproduce all` folders (a `reproduce-all.json` each) are pooled by
-//! [`crate::cli::reproduce::all::merge`]; the shards of one `gibench run` or `gibench sweep`
+//! [`crate::reproduce::all::merge`]; the shards of one `gibench run` or `gibench sweep`
 //! (a [`ShardRecord`] each) are pooled here: every results file (and its images) copied, and
 //! the run's or sweep's tables and plots drawn again from the pooled results by the code
 //! `run` and `sweep` write them with. A mix is refused, naming the folders.
@@ -14,9 +14,9 @@ use gibench_harness::measure::results::RunResult;
 use gibench_harness::output::{write_atomic, OutputSet};
 use gibench_harness::{Error, Result};
 
-use super::files::writable_dir;
-use super::page::{page_line, with_folder, write_page};
-use super::shard::{ShardRecord, RECORD};
+use crate::files::writable_dir;
+use crate::page::{page_line, with_folder, write_page};
+use crate::shard::{ShardRecord, RECORD};
 
 #[derive(Args)]
 pub struct MergeArgs {
@@ -33,7 +33,7 @@ pub fn exec(args: &MergeArgs) -> Result<()> {
     let manifest = |d: &PathBuf| d.join("reproduce-all.json").is_file();
     let record = |d: &PathBuf| d.join(RECORD).is_file();
     if args.dirs.iter().all(manifest) {
-        return crate::cli::reproduce::all::merge(&args.dirs, &args.out);
+        return crate::reproduce::all::merge(&args.dirs, &args.out);
     }
     if !args.dirs.is_empty() && args.dirs.iter().all(record) {
         return merge_shards(&args.dirs, &args.out);
@@ -242,7 +242,7 @@ fn merge_shards(dirs: &[PathBuf], out: &Path) -> Result<()> {
     let written = if first.command == "sweep" {
         let points: Vec<(String, RunResult)> =
             results.into_iter().map(|(u, r, _)| (u, r)).collect();
-        let (table, figures, stem) = crate::cli::sweep::write_summary(
+        let (table, figures, stem) = crate::sweep::write_summary(
             &points,
             &setting("technique"),
             &scenes[0],
@@ -279,8 +279,7 @@ fn merge_shards(dirs: &[PathBuf], out: &Path) -> Result<()> {
             if runs.is_empty() {
                 continue;
             }
-            let (table, files) =
-                crate::cli::run::write_summary(&runs, &notes, out, scene, quality)?;
+            let (table, files) = crate::run::write_summary(&runs, &notes, out, scene, quality)?;
             println!("{}", table.to_terminal());
             if html {
                 let page = out.join(format!("{scene}-report.html"));

@@ -4,7 +4,7 @@
 
 use gibench_harness::{Error, Result};
 
-use crate::cli::reproduce::{barczak2006, gaitatzes2010, ism2008, laine2007, PaperModule};
+use crate::reproduce::{barczak2006, gaitatzes2010, ism2008, laine2007, PaperModule};
 
 /// How a target is produced.
 pub enum Kind {

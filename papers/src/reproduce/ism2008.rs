@@ -28,7 +28,7 @@ use gibench_ism::{STAGE_POINT_SPLAT, STAGE_PULL_PUSH, STAGE_RSM, STAGE_VPL_SAMPL
 use gibench_keller::STAGE_VPL_GENERATION;
 
 use super::{device_note, load_scene, ms, sum_ms, PaperModule, ReproduceArgs, Reproduction};
-use crate::cli::progress::Bars;
+use crate::progress::Bars;
 use gibench_harness::gpu::GpuContext;
 
 /// The module's entry for `reproduce all`.
@@ -190,7 +190,7 @@ fn spec<'s>(args: &ReproduceArgs, scene: &'s gibench_harness::scene::Scene) -> R
             shadow_size: s.shadow_size,
         },
         quality: None,
-        cache: crate::cli::options::default_reference_cache(),
+        cache: crate::options::default_reference_cache(),
         out: runs_folder(args),
         images: false,
     })
@@ -209,7 +209,7 @@ pub fn reproduce(
     spec.validate()?;
     let mut opened = None;
     let gpu = super::gpu_or_open(gpu, args, &mut opened)?;
-    let runs = crate::cli::progress::execute_with_bar(bars, gpu, &spec)?;
+    let runs = crate::progress::execute_with_bar(bars, gpu, &spec)?;
     let table = breakdown(args, &scene, &runs)?;
     Ok((vec![(table, "ism-breakdown")], runs))
 }

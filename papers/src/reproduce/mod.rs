@@ -18,7 +18,7 @@ pub mod all;
 pub mod barczak2006;
 pub mod gaitatzes2010;
 pub mod ism2008;
-pub(crate) mod job;
+pub mod job;
 pub mod laine2007;
 
 use std::path::PathBuf;
@@ -31,7 +31,7 @@ use gibench_harness::scene::assets::AssetPaths;
 use gibench_harness::scene::{Scene, SceneDescriptor};
 use gibench_harness::{Error, Result};
 
-use super::progress::{execute_with_bar, Bars};
+use crate::progress::{execute_with_bar, Bars};
 
 #[derive(Args, Clone)]
 pub struct ReproduceArgs {
@@ -70,10 +70,10 @@ pub struct ReproduceArgs {
     pub quiet: bool,
     /// With `all`: run the targets in priority order (`--list` prints it) and start none whose
     /// estimate does not fit what is left of this time, e.g. 90s, 2m, 9m (docs/fleet.md).
-    #[arg(long, value_name = "DURATION", value_parser = crate::cli::params::parse_budget)]
+    #[arg(long, value_name = "DURATION", value_parser = crate::params::parse_budget)]
     pub budget: Option<std::time::Duration>,
     #[command(flatten)]
-    pub shard: crate::cli::shard::ShardArgs,
+    pub shard: crate::shard::ShardArgs,
     /// For the test suite only: `tiny` cuts every target to a few frames at tiny sizes. Printed,
     /// and recorded in reproduce-all.json as the mode (e.g. `quick-tiny`): never benchmark results.
     #[arg(long, env = "GIBENCH_TEST_SIZE", value_enum, value_name = "SIZE")]
@@ -99,6 +99,22 @@ pub enum TestSize {
 }
 
 impl ReproduceArgs {
+    /// Parses the words after `gibench reproduce` as the command line does (its checks and
+    /// environment variables included): how a library user or a test states a reproduction.
+    pub fn parse_words(words: &[&str]) -> Result<ReproduceArgs> {
+        #[derive(clap::Parser)]
+        #[command(name = "gibench reproduce")]
+        struct Words {
+            #[command(flatten)]
+            args: ReproduceArgs,
+        }
+        <Words as clap::Parser>::try_parse_from(
+            std::iter::once("reproduce").chain(words.iter().copied()),
+        )
+        .map(|w| w.args)
+        .map_err(|e| Error::Invalid(e.to_string().trim().to_string()))
+    }
+
     /// Whether `--test-size tiny` (or `GIBENCH_TEST_SIZE=tiny`) is on.
     pub fn tiny(&self) -> bool {
         self.test_size == Some(TestSize::Tiny)
@@ -279,7 +295,7 @@ pub fn exec(args: &ReproduceArgs) -> Result<()> {
         ));
     }
     if let Some(frames) = args.frames {
-        super::params::check_frame_number("frames", frames)?;
+        crate::params::check_frame_number("frames", frames)?;
     }
     if args.tiny() {
         eprintln!(

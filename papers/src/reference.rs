@@ -10,38 +10,38 @@ use gibench_harness::scene::assets::AssetPaths;
 use gibench_harness::scene::{Scene, SceneDescriptor};
 use gibench_harness::{Error, Result};
 
-use super::files::writable_dir;
-use super::options::ReferenceOpts;
-use super::params::{check_frame_number, parse_resolution};
-use super::progress::Bars;
+use crate::files::writable_dir;
+use crate::options::ReferenceOpts;
+use crate::params::{check_frame_number, parse_resolution};
+use crate::progress::Bars;
 
 #[derive(Args)]
-pub(crate) struct ReferenceArgs {
+pub struct ReferenceArgs {
     /// Scene: a built-in name or a descriptor JSON.
     #[arg(long, default_value = "cornell")]
-    pub(crate) scene: String,
+    pub scene: String,
     /// Animation frame.
     #[arg(long, default_value_t = 0)]
-    pub(crate) frame: u32,
+    pub frame: u32,
     /// Image size WIDTHxHEIGHT.
     #[arg(long, default_value = "256x192")]
-    pub(crate) resolution: String,
+    pub resolution: String,
     /// Output directory.
     #[arg(long, default_value = "results/local")]
-    pub(crate) out: PathBuf,
+    pub out: PathBuf,
     /// Extra directory searched first for scene assets.
     #[arg(long)]
-    pub(crate) assets: Option<PathBuf>,
+    pub assets: Option<PathBuf>,
     /// Also render with the next seed and report the relative MSE between the two (an
     /// estimate of the reference's own noise).
     #[arg(long)]
-    pub(crate) error_estimate: bool,
+    pub error_estimate: bool,
     #[command(flatten)]
-    pub(crate) reference: ReferenceOpts,
+    pub reference: ReferenceOpts,
 }
 
 /// `gibench reference`: plan, render into an output set, publish.
-pub(crate) fn exec(args: &ReferenceArgs) -> Result<()> {
+pub fn exec(args: &ReferenceArgs) -> Result<()> {
     let planned = reference_plan(args)?;
     let set = OutputSet::begin("out", &args.out)?;
     let done = reference_planned(args, &planned, &Bars::Own(false))?;
@@ -51,15 +51,15 @@ pub(crate) fn exec(args: &ReferenceArgs) -> Result<()> {
 }
 
 /// A reference render checked before it runs.
-pub(crate) struct ReferencePlan {
-    pub(crate) resolution: [u32; 2],
-    pub(crate) settings: ReferenceSettings,
-    pub(crate) desc: SceneDescriptor,
-    pub(crate) scene: Scene,
+pub struct ReferencePlan {
+    pub resolution: [u32; 2],
+    pub settings: ReferenceSettings,
+    pub desc: SceneDescriptor,
+    pub scene: Scene,
 }
 
 /// Checks a reference render's arguments and loads its scene.
-pub(crate) fn reference_plan(args: &ReferenceArgs) -> Result<ReferencePlan> {
+pub fn reference_plan(args: &ReferenceArgs) -> Result<ReferencePlan> {
     let resolution = parse_resolution(&args.resolution)?;
     gibench_harness::run::runner::check_resolution(resolution)?;
     check_frame_number("frame", args.frame)?;
@@ -80,7 +80,7 @@ pub(crate) fn reference_plan(args: &ReferenceArgs) -> Result<ReferencePlan> {
 
 /// The work of `gibench reference` once planned and its output set is open. Returns what it
 /// wrote, as a line for the terminal.
-pub(crate) fn reference_planned(
+pub fn reference_planned(
     args: &ReferenceArgs,
     planned: &ReferencePlan,
     bars: &Bars,

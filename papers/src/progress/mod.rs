@@ -11,17 +11,13 @@ mod overall;
 pub use overall::Overall;
 
 /// Runs `spec` with a progress bar (hidden when `quiet`).
-pub(crate) fn execute_with_bar(
-    bars: &Bars,
-    gpu: &GpuContext,
-    spec: &RunSpec,
-) -> Result<Vec<RunResult>> {
+pub fn execute_with_bar(bars: &Bars, gpu: &GpuContext, spec: &RunSpec) -> Result<Vec<RunResult>> {
     execute_skipping_with_bar(bars, gpu, spec, false).map(|(results, _)| results)
 }
 
 /// [`execute_with_bar`] leaving out, with `skip_unfit`, the techniques that cannot take the
 /// scene or the device ([`session::execute_skipping`]); each is named with its reason.
-pub(crate) fn execute_skipping_with_bar(
+pub fn execute_skipping_with_bar(
     bars: &Bars,
     gpu: &GpuContext,
     spec: &RunSpec,
@@ -60,14 +56,14 @@ pub(crate) fn execute_skipping_with_bar(
 
 /// Where a command reports its progress: a bar of its own (hidden when quiet), or its share of
 /// `gibench reproduce all`'s bar.
-pub(crate) enum Bars<'a> {
+pub enum Bars<'a> {
     Own(bool),
     Shared(&'a Overall),
 }
 
 impl Bars<'_> {
     /// A line for the terminal (above the shared bar, not through it).
-    pub(crate) fn note(&self, line: &str) {
+    pub fn note(&self, line: &str) {
         match self {
             Bars::Own(_) => eprintln!("{line}"),
             Bars::Shared(all) => all.note(line),
@@ -76,7 +72,7 @@ impl Bars<'_> {
 
     /// A result table for the terminal: printed by a command of its own; under `reproduce all`
     /// it is in the files only.
-    pub(crate) fn table(&self, table: &report::Table) {
+    pub fn table(&self, table: &report::Table) {
         if let Bars::Own(_) = self {
             println!("{}", table.to_terminal());
         }
@@ -84,7 +80,7 @@ impl Bars<'_> {
 }
 
 /// A bar of `total` frames with the technique running as its message (hidden when `quiet`).
-pub(crate) fn progress_bar(quiet: bool, total: u64) -> indicatif::ProgressBar {
+pub fn progress_bar(quiet: bool, total: u64) -> indicatif::ProgressBar {
     let bar = if quiet {
         indicatif::ProgressBar::hidden()
     } else {

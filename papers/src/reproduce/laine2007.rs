@@ -32,7 +32,7 @@ use gibench_harness::{Error, Result};
 use super::{
     device_note, load_scene, ms, paper_cells, sum_ms, PaperModule, ReproduceArgs, Reproduction,
 };
-use crate::cli::progress::Bars;
+use crate::progress::Bars;
 use gibench_harness::gpu::GpuContext;
 
 /// The module's entry for `reproduce all`.
@@ -281,7 +281,7 @@ fn run_pairs(args: &ReproduceArgs, gpu: Option<&GpuContext>, bars: &Bars) -> Res
                         shadow_size,
                     },
                     quality: None,
-                    cache: crate::cli::options::default_reference_cache(),
+                    cache: crate::options::default_reference_cache(),
                     out: out(args).join("runs"),
                     images: false,
                 },
@@ -295,7 +295,7 @@ fn run_pairs(args: &ReproduceArgs, gpu: Option<&GpuContext>, bars: &Bars) -> Res
     let gpu = super::gpu_or_open(gpu, args, &mut opened)?;
     let mut out = Vec::new();
     for (name, res, spec) in &specs {
-        let mut results = crate::cli::progress::execute_with_bar(bars, gpu, spec)?;
+        let mut results = crate::progress::execute_with_bar(bars, gpu, spec)?;
         let keller = results.pop().expect("two runs");
         let laine = results.pop().expect("two runs");
         out.push((name.clone(), *res, laine, keller));

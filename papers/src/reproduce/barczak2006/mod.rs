@@ -41,7 +41,7 @@ use gibench_harness::scene::{Scene, SceneDescriptor};
 use gibench_harness::{Error, Result};
 
 use super::{PaperModule, ReproduceArgs, Reproduced};
-use crate::cli::progress::Bars;
+use crate::progress::Bars;
 use figures::{fig5_2, fig5_3, fig5_4, fig5_5, fig5_6, quality_table};
 
 /// The module's entry for `reproduce all`.
@@ -299,7 +299,7 @@ fn spec<'s>(args: &ReproduceArgs, scene: &'s Scene, set: Set) -> Result<RunSpec<
         config: super::paper_config(args, s.resolution, frames, s.warmup, quality.is_some()),
         // The quality runs at the size the reference affords (as every quality target).
         quality,
-        cache: crate::cli::options::default_reference_cache(),
+        cache: crate::options::default_reference_cache(),
         out: runs_folder(args),
         images: false,
     })

@@ -8,9 +8,9 @@ use gibench_harness::report;
 use gibench_harness::{Error, Result};
 
 use super::targets::{Kind, Target};
-use crate::cli::progress::Bars;
-use crate::cli::reproduce::job::Job;
-use crate::cli::reproduce::ReproduceArgs;
+use crate::progress::Bars;
+use crate::reproduce::job::Job;
+use crate::reproduce::ReproduceArgs;
 
 /// A target checked and ready to run into `out`.
 pub(super) struct Planned {
@@ -164,14 +164,14 @@ impl Planned {
                 if self.args.html {
                     let page = self.out.join(format!("{}.html", self.target.name));
                     let figures = (m.figures)(&self.out, self.target.name);
-                    crate::cli::page::write_page(
+                    crate::page::write_page(
                         &page,
                         self.target.description(),
                         tables.into_iter().map(|(t, _)| t).collect(),
                         figures,
-                        crate::cli::page::with_folder(&(m.runs_folder)(&self.args), runs),
+                        crate::page::with_folder(&(m.runs_folder)(&self.args), runs),
                     )?;
-                    done.push_str(&crate::cli::page::page_line(&page));
+                    done.push_str(&crate::page::page_line(&page));
                 }
                 Ok(done)
             }

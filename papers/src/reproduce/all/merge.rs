@@ -16,7 +16,7 @@ use gibench_harness::{Error, Result};
 
 use super::manifest::{Manifest, Record};
 use super::targets::{find, TARGETS};
-use crate::cli::files::writable_dir;
+use crate::files::writable_dir;
 
 /// Pools `dirs` (each with a `reproduce-all.json`) into `out`.
 pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<()> {

@@ -19,7 +19,7 @@ struct Span {
 }
 
 impl Overall {
-    pub(crate) fn new(quiet: bool, total: u64) -> Overall {
+    pub fn new(quiet: bool, total: u64) -> Overall {
         let bar = if quiet {
             indicatif::ProgressBar::hidden()
         } else {
@@ -38,7 +38,7 @@ impl Overall {
     }
 
     /// The next target: `len` of the bar, `frames` frames.
-    pub(crate) fn start(&self, label: &str, len: u64, frames: u64) {
+    pub fn start(&self, label: &str, len: u64, frames: u64) {
         if let Ok(mut s) = self.state.lock() {
             let start = s.start + s.len;
             *s = Span {
@@ -80,7 +80,7 @@ impl Overall {
         }
     }
 
-    pub(crate) fn finish(&self) {
+    pub fn finish(&self) {
         self.bar.finish_and_clear();
     }
 }

@@ -326,7 +326,7 @@ impl Manifest {
                 "gibench reproduce all ({} sizes) on {}",
                 self.mode, self.adapter
             ),
-            &crate::cli::page::command_line(),
+            &crate::page::command_line(),
             &entries,
         )
     }

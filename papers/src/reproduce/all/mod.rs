@@ -33,8 +33,8 @@ use gibench_harness::output::OutputSet;
 use gibench_harness::{Error, Result};
 
 use super::{out_dir, ReproduceArgs};
-use crate::cli::files::writable_dir;
-use crate::cli::progress::{Bars, Overall};
+use crate::files::writable_dir;
+use crate::progress::{Bars, Overall};
 use manifest::{duration, Manifest, Record, MANIFEST};
 pub use merge::merge;
 use planned::Planned;
@@ -168,10 +168,10 @@ pub fn reproduce(args: &ReproduceArgs) -> Result<()> {
 /// How a target that failed within a budget is recorded as left out.
 const FAILED: &str = "failed: ";
 
-/// The targets of shard `s`: the selection split by [`crate::cli::shard::assign`] on the
+/// The targets of shard `s`: the selection split by [`crate::shard::assign`] on the
 /// estimates of the committed manifest (the same file on every machine of a checkout), a
 /// target never timed there weighing the mean of those timed (1 s where none is).
-fn own_part(planned: Vec<Planned>, s: &crate::cli::shard::Shard) -> Vec<Planned> {
+fn own_part(planned: Vec<Planned>, s: &crate::shard::Shard) -> Vec<Planned> {
     let committed = Manifest::committed();
     let timed: Vec<Option<f64>> = planned
         .iter()
@@ -205,7 +205,7 @@ fn own_part(planned: Vec<Planned>, s: &crate::cli::shard::Shard) -> Vec<Planned>
             ""
         }
     );
-    let mine = crate::cli::shard::own_units(&units, s, &|e| duration(e), &basis);
+    let mine = crate::shard::own_units(&units, s, &|e| duration(e), &basis);
     planned
         .into_iter()
         .zip(mine)

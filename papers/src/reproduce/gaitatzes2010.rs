@@ -31,7 +31,7 @@ use gibench_harness::scene::Scene;
 use gibench_harness::{Error, Result};
 
 use super::{device_note, load_scene, ms, PaperModule, ReproduceArgs, Reproduced};
-use crate::cli::progress::Bars;
+use crate::progress::Bars;
 
 /// The module's entry for `reproduce all`.
 pub const MODULE: PaperModule = PaperModule {
@@ -290,7 +290,7 @@ fn spec<'s>(
         runs,
         config: super::paper_config(args, res, frames, warmup, compared),
         quality,
-        cache: crate::cli::options::default_reference_cache(),
+        cache: crate::options::default_reference_cache(),
         out: runs_folder(args),
         images: compared,
     })
@@ -345,7 +345,7 @@ fn cornell_spec<'s>(
             reference: ReferenceSettings::default(),
             component: Some(IndirectComponent::MultiBounce),
         }),
-        cache: crate::cli::options::default_reference_cache(),
+        cache: crate::options::default_reference_cache(),
         out: runs_folder(args),
         images: true,
     })

@@ -5,7 +5,7 @@ use gibench_harness::kit::technique::{Params, TechniqueInfo};
 use gibench_harness::{Error, Result};
 
 /// `--resolution WIDTHxHEIGHT` as `[width, height]`.
-pub(crate) fn parse_resolution(s: &str) -> Result<[u32; 2]> {
+pub fn parse_resolution(s: &str) -> Result<[u32; 2]> {
     let bad = || {
         Error::param(
             "resolution",
@@ -23,7 +23,7 @@ pub(crate) fn parse_resolution(s: &str) -> Result<[u32; 2]> {
 /// technique that declares `name`; it is an error if none does, and an error if a technique
 /// would get the same parameter twice (`vpls=8` and `laine.vpls=16`: which one holds would
 /// depend on their order).
-pub(crate) fn assign_params(techniques: &[&TechniqueInfo], raw: &[String]) -> Result<Vec<Params>> {
+pub fn assign_params(techniques: &[&TechniqueInfo], raw: &[String]) -> Result<Vec<Params>> {
     // Per technique: (parameter, value, the `--param` it came from).
     let mut given: Vec<Vec<(String, String, &str)>> = vec![Vec::new(); techniques.len()];
     for p in raw {
@@ -96,7 +96,7 @@ pub(crate) fn assign_params(techniques: &[&TechniqueInfo], raw: &[String]) -> Re
 
 /// Checks a frame number or count given as option `option` against the limit every command
 /// shares ([`gibench_harness::run::runner::MAX_FRAMES`]).
-pub(crate) fn check_frame_number(option: &str, frame: u32) -> Result<()> {
+pub fn check_frame_number(option: &str, frame: u32) -> Result<()> {
     let max = gibench_harness::run::runner::MAX_FRAMES;
     if frame > max {
         return Err(Error::param(
@@ -109,7 +109,7 @@ pub(crate) fn check_frame_number(option: &str, frame: u32) -> Result<()> {
 
 /// A time budget such as `90s`, `2m`, `9m`, `1m30s` or `1h`: numbers each followed by `h`, `m`
 /// or `s`, more than zero in all (the `--budget` value parser: clap's error names the option).
-pub(crate) fn parse_budget(s: &str) -> std::result::Result<std::time::Duration, String> {
+pub fn parse_budget(s: &str) -> std::result::Result<std::time::Duration, String> {
     let expected = "expected a duration such as 90s, 2m, 9m or 1m30s (numbers with h, m or s)";
     let mut total = 0.0f64;
     let mut number = String::new();

@@ -7,10 +7,10 @@ use gibench_harness::gpu::GpuContext;
 use gibench_harness::run::session::RunSpec;
 use gibench_harness::{Error, Result};
 
-use crate::cli::progress::Bars;
-use crate::cli::reference::{reference_plan, reference_planned, ReferenceArgs, ReferencePlan};
-use crate::cli::run::{plan, run_planned, Plan, RunArgs};
-use crate::cli::sweep::{sweep_plan, sweep_planned, SweepArgs, SweepPlan};
+use crate::progress::Bars;
+use crate::reference::{reference_plan, reference_planned, ReferenceArgs, ReferencePlan};
+use crate::run::{plan, run_planned, Plan, RunArgs};
+use crate::sweep::{sweep_plan, sweep_planned, SweepArgs, SweepPlan};
 
 /// The commands a target may be, parsed as `gibench run|sweep|reference ...` is.
 #[derive(Parser)]
@@ -22,7 +22,7 @@ enum TargetCommand {
 }
 
 /// A gibench command run as a target of `gibench reproduce`, checked before anything runs.
-pub(crate) enum Job {
+pub enum Job {
     Run(Box<RunArgs>, Box<Plan>),
     Sweep(Box<SweepArgs>, Box<SweepPlan>),
     Reference(Box<ReferenceArgs>, Box<ReferencePlan>),
@@ -30,7 +30,7 @@ pub(crate) enum Job {
 
 impl Job {
     /// Parses and checks `gibench ARGV...` (run, sweep or reference).
-    pub(crate) fn plan(argv: &[String]) -> Result<Job> {
+    pub fn plan(argv: &[String]) -> Result<Job> {
         if !matches!(
             argv.first().map(String::as_str),
             Some("run" | "sweep" | "reference")
@@ -61,12 +61,12 @@ impl Job {
         }
     }
 
-    pub(crate) fn needs_gpu(&self) -> bool {
+    pub fn needs_gpu(&self) -> bool {
         !matches!(self, Job::Reference(..))
     }
 
     /// (frames rendered, frames × pixels; reference: samples × pixels).
-    pub(crate) fn work(&self) -> (u64, u64) {
+    pub fn work(&self) -> (u64, u64) {
         let of = |spec: &RunSpec| {
             let frames = spec.total_frames();
             let [w, h] = spec.config.resolution;
@@ -84,7 +84,7 @@ impl Job {
     }
 
     /// Runs it into its `--out` (inside an open output set) on `gpu`; returns what it wrote.
-    pub(crate) fn execute(&self, gpu: Option<&GpuContext>, bars: &Bars) -> Result<String> {
+    pub fn execute(&self, gpu: Option<&GpuContext>, bars: &Bars) -> Result<String> {
         let gpu =
             || gpu.ok_or_else(|| Error::Invalid("no adapter was opened for a GPU run".into()));
         match self {

@@ -17,91 +17,91 @@ use gibench_harness::scene::assets::AssetPaths;
 use gibench_harness::scene::{Scene, SceneDescriptor};
 use gibench_harness::{Error, Result};
 
-use super::files::{file_name, writable_dir};
-use super::options::{GpuArgs, ReferenceOpts};
-use super::page::{page_line, with_folder, write_page};
-use super::params::{assign_params, parse_resolution};
-use super::progress::{execute_skipping_with_bar, Bars};
-use super::shard::{own_units, ShardArgs, ShardRecord};
+use crate::files::{file_name, writable_dir};
+use crate::options::{GpuArgs, ReferenceOpts};
+use crate::page::{page_line, with_folder, write_page};
+use crate::params::{assign_params, parse_resolution};
+use crate::progress::{execute_skipping_with_bar, Bars};
 use crate::registry;
+use crate::shard::{own_units, ShardArgs, ShardRecord};
 
 #[derive(Args, Clone)]
-pub(crate) struct RunArgs {
+pub struct RunArgs {
     /// Scene: a built-in name (see `gibench list`) or a path to a descriptor JSON; `run` takes
     /// several, comma-separated (one summary table each).
     #[arg(long, default_value = "cornell")]
-    pub(crate) scene: String,
+    pub scene: String,
     /// Techniques, comma-separated (default: every registered technique).
     #[arg(long, value_delimiter = ',')]
-    pub(crate) technique: Vec<String>,
+    pub technique: Vec<String>,
     /// Technique parameter `name=value` (applies to every selected technique that declares it)
     /// or `technique.name=value`. Repeatable.
     #[arg(long = "param", short = 'p')]
-    pub(crate) params: Vec<String>,
+    pub params: Vec<String>,
     /// Measured frames.
     #[arg(long, default_value_t = 60)]
-    pub(crate) frames: u32,
+    pub frames: u32,
     /// Warm-up frames run first and dropped from the statistics.
     #[arg(long, default_value_t = 5)]
-    pub(crate) warmup: u32,
+    pub warmup: u32,
     /// Animation frame to start at.
     #[arg(long, default_value_t = 0)]
-    pub(crate) first_frame: u32,
+    pub first_frame: u32,
     /// Image size WIDTHxHEIGHT (the papers used 1024x768 and 1600x1200).
     #[arg(long, default_value = "256x192")]
-    pub(crate) resolution: String,
+    pub resolution: String,
     /// Edge length of each face of the primary light's cube shadow map (Laine: 1024).
     #[arg(long, default_value_t = 256)]
-    pub(crate) shadow_size: u32,
+    pub shadow_size: u32,
     /// `stages` (per-stage, flushed), `frame` (whole frames, no added sync) or `both`.
     #[arg(long, default_value = "both")]
-    pub(crate) timing: String,
+    pub timing: String,
     /// Seed for every random choice a technique makes.
     #[arg(long, default_value_t = 1)]
-    pub(crate) seed: u64,
+    pub seed: u64,
     /// Directory for results JSON, images and tables.
     #[arg(long, default_value = "results/local")]
-    pub(crate) out: PathBuf,
+    pub out: PathBuf,
     /// Extra directory searched first for scene assets (glTF files).
     #[arg(long)]
-    pub(crate) assets: Option<PathBuf>,
+    pub assets: Option<PathBuf>,
     /// Do not write images.
     #[arg(long)]
-    pub(crate) no_images: bool,
+    pub no_images: bool,
     /// Do not show a progress bar.
     #[arg(long)]
-    pub(crate) quiet: bool,
+    pub quiet: bool,
     /// Also measure image error against the CPU reference (RMSE, relative MSE, MAE, FLIP,
     /// flicker) on consecutive frame pairs spread over the measured frames.
     #[arg(long)]
-    pub(crate) quality: bool,
+    pub quality: bool,
     /// Frame pairs compared with the reference when --quality is given [default: 2].
     #[arg(long)]
-    pub(crate) quality_pairs: Option<u32>,
+    pub quality_pairs: Option<u32>,
     /// With --quality, compare every measured frame (per-frame error and lag plots).
     #[arg(long)]
-    pub(crate) quality_all: bool,
+    pub quality_all: bool,
     /// The reference component the indirect irradiance is compared with: one-bounce,
     /// multi-bounce, or direct (for a technique's direct light samples: `barczak set=direct`)
     /// (default: each technique's declared component, see `gibench list`).
     #[arg(long)]
-    pub(crate) quality_reference: Option<String>,
+    pub quality_reference: Option<String>,
     /// Also write an HTML page of the run (`{scene}-report.html`, or `{stem}.html` for a
     /// sweep): tables, images beside the reference, error maps, time versus error.
     #[arg(long)]
-    pub(crate) html: bool,
+    pub html: bool,
     #[command(flatten)]
-    pub(crate) reference: ReferenceOpts,
+    pub reference: ReferenceOpts,
     #[command(flatten)]
-    pub(crate) gpu: GpuArgs,
+    pub gpu: GpuArgs,
     #[command(flatten)]
-    pub(crate) shard: ShardArgs,
+    pub shard: ShardArgs,
 }
 
 impl RunArgs {
     /// `gibench` with no arguments: `gibench run`'s defaults, compared with the CPU reference
     /// (cached after the first run) and written up as an HTML page.
-    pub(crate) fn parse_default() -> RunArgs {
+    pub fn parse_default() -> RunArgs {
         RunArgs::parse_args(["gibench", "--quality", "--html"])
     }
 
@@ -119,18 +119,18 @@ impl RunArgs {
 }
 
 /// Everything a run needs, checked before anything runs or is written.
-pub(crate) struct Plan {
-    pub(crate) config: RunConfig,
-    pub(crate) quality: Option<QualityConfig>,
-    pub(crate) techniques: Vec<&'static TechniqueInfo>,
-    pub(crate) params: Vec<Params>,
-    pub(crate) desc: SceneDescriptor,
-    pub(crate) scene: Scene,
+pub struct Plan {
+    pub config: RunConfig,
+    pub quality: Option<QualityConfig>,
+    pub techniques: Vec<&'static TechniqueInfo>,
+    pub params: Vec<Params>,
+    pub desc: SceneDescriptor,
+    pub scene: Scene,
 }
 
 /// Checks `args` (with `extra_params` after its `--param`s) and loads the scene: everything a
 /// run needs, before any GPU work or file.
-pub(crate) fn plan(args: &RunArgs, extra_params: &[String]) -> Result<Plan> {
+pub fn plan(args: &RunArgs, extra_params: &[String]) -> Result<Plan> {
     let config = RunConfig {
         resolution: parse_resolution(&args.resolution)?,
         frames: args.frames,
@@ -257,7 +257,7 @@ fn other_components(
 
 impl Plan {
     /// The typed run of these techniques, files named `{scene}-{technique}`.
-    pub(crate) fn spec(&self, args: &RunArgs) -> RunSpec<'_> {
+    pub fn spec(&self, args: &RunArgs) -> RunSpec<'_> {
         let runs = self
             .techniques
             .iter()
@@ -281,7 +281,7 @@ impl Plan {
 }
 
 /// The line a run starts with: scene, size, adapter, frames and timing mode.
-pub(crate) fn announcement(plan: &Plan, gpu: &GpuContext) -> String {
+pub fn announcement(plan: &Plan, gpu: &GpuContext) -> String {
     let c = &plan.config;
     format!(
         "gibench: scene '{}' ({} triangles) at {}x{} on {} ({}), {} measured + {} warm-up frames, timing '{}'",
@@ -308,7 +308,7 @@ fn gpu_options(args: &RunArgs) -> GpuOptions {
 }
 
 /// The adapter `args` ask for, opened.
-pub(crate) fn open_gpu(args: &RunArgs) -> Result<GpuContext> {
+pub fn open_gpu(args: &RunArgs) -> Result<GpuContext> {
     GpuContext::new(&gpu_options(args))
 }
 
@@ -316,7 +316,7 @@ pub(crate) fn open_gpu(args: &RunArgs) -> Result<GpuContext> {
 /// run, publish. With a shard (`--shard`, or a job array's environment) only its part of the
 /// (scene, technique) units runs, and a [`ShardRecord`] beside the results says which, for
 /// `gibench merge`.
-pub(crate) fn exec(args: &RunArgs) -> Result<()> {
+pub fn exec(args: &RunArgs) -> Result<()> {
     // Everything that can be checked without running is checked before anything is written.
     let names: Vec<&str> = args.scene.split(',').map(str::trim).collect();
     for (i, n) in names.iter().enumerate() {
@@ -412,12 +412,12 @@ pub(crate) fn exec(args: &RunArgs) -> Result<()> {
 }
 
 /// Units of equal weight (a run's or a sweep's units share one size and frame count).
-pub(crate) fn weigh_equally(units: &[String]) -> Vec<(&str, f64)> {
+pub fn weigh_equally(units: &[String]) -> Vec<(&str, f64)> {
     units.iter().map(|u| (u.as_str(), 1.0)).collect()
 }
 
 /// The settings every shard of one run must share, by name (`gibench merge` compares them).
-pub(crate) fn settings(args: &RunArgs, plan: &Plan) -> BTreeMap<String, String> {
+pub fn settings(args: &RunArgs, plan: &Plan) -> BTreeMap<String, String> {
     let c = &plan.config;
     let q = plan.quality.as_ref();
     [
@@ -459,12 +459,7 @@ fn skipped_file(scene: &str) -> String {
 
 /// The work of `gibench run` once planned and its output set is open: runs, tables, plots.
 /// Returns what it wrote, as a line for the terminal.
-pub(crate) fn run_planned(
-    args: &RunArgs,
-    plan: &Plan,
-    gpu: &GpuContext,
-    bars: &Bars,
-) -> Result<String> {
+pub fn run_planned(args: &RunArgs, plan: &Plan, gpu: &GpuContext, bars: &Bars) -> Result<String> {
     run_planned_skipping(args, plan, gpu, bars).map(|(done, _)| done)
 }
 
@@ -541,7 +536,7 @@ fn run_planned_skipping(
 /// `skipped`, with why): `{name}-summary.md/.csv/.tex/.svg` and with `quality` the error
 /// plots, into `out`. `gibench run` and `gibench merge` (pooling shards) both write them here.
 /// Returns the table and the files written.
-pub(crate) fn write_summary(
+pub fn write_summary(
     results: &[RunResult],
     skipped: &[(String, String)],
     out: &Path,

@@ -8,7 +8,7 @@ use gibench_harness::report;
 use gibench_harness::Result;
 
 /// The runs paired with the folder they were written to.
-pub(crate) fn with_folder(dir: &Path, results: Vec<RunResult>) -> Vec<(PathBuf, RunResult)> {
+pub fn with_folder(dir: &Path, results: Vec<RunResult>) -> Vec<(PathBuf, RunResult)> {
     results
         .into_iter()
         .map(|r| (dir.to_path_buf(), r))
@@ -17,7 +17,7 @@ pub(crate) fn with_folder(dir: &Path, results: Vec<RunResult>) -> Vec<(PathBuf, 
 
 /// This command as a user would type it: `gibench` and its arguments (not the executable's
 /// path on this machine, which names a user's folders and means nothing elsewhere).
-pub(crate) fn command_line() -> String {
+pub fn command_line() -> String {
     std::iter::once("gibench".to_string())
         .chain(std::env::args().skip(1))
         .collect::<Vec<_>>()
@@ -25,7 +25,7 @@ pub(crate) fn command_line() -> String {
 }
 
 /// Writes an HTML page ([`gibench_harness::report::html`]) with this process's command line.
-pub(crate) fn write_page(
+pub fn write_page(
     path: &Path,
     title: String,
     tables: Vec<report::Table>,
@@ -43,7 +43,7 @@ pub(crate) fn write_page(
 }
 
 /// "\nreport: PATH (open it in a browser)", the page's path made absolute.
-pub(crate) fn page_line(page: &Path) -> String {
+pub fn page_line(page: &Path) -> String {
     let shown = std::env::current_dir()
         .map(|d| d.join(page))
         .unwrap_or_else(|_| page.to_path_buf());

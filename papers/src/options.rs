@@ -9,22 +9,22 @@ use gibench_harness::run::quality::ReferenceCache;
 use gibench_harness::{Error, Result};
 
 #[derive(Args, Clone)]
-pub(crate) struct ReferenceOpts {
+pub struct ReferenceOpts {
     /// Reference samples per pixel (cosine-weighted hemisphere paths at each visible point).
     #[arg(long = "spp", default_value_t = ReferenceSettings::default().spp)]
-    pub(crate) spp: u32,
+    pub spp: u32,
     /// Reference bounce limit for the multi-bounce image.
     #[arg(long = "bounces", default_value_t = ReferenceSettings::default().bounces)]
-    pub(crate) bounces: u32,
+    pub bounces: u32,
     /// Reference seed.
     #[arg(long = "reference-seed", default_value_t = ReferenceSettings::default().seed)]
-    pub(crate) reference_seed: u64,
+    pub reference_seed: u64,
     /// Directory of the reference cache.
     #[arg(long, default_value = DEFAULT_CACHE_DIR)]
-    pub(crate) cache: PathBuf,
+    pub cache: PathBuf,
     /// Do not read or write the reference cache.
     #[arg(long)]
-    pub(crate) no_cache: bool,
+    pub no_cache: bool,
 }
 
 /// Where references are cached unless `--cache` or `--no-cache` says otherwise.
@@ -33,7 +33,7 @@ const DEFAULT_CACHE_DIR: &str = "results/cache";
 /// The reference cache of a command without cache options (the paper targets of
 /// `gibench reproduce`): the folder `gibench run --quality` uses by default, so that their
 /// references are rendered once and reused by every run, target and later invocation.
-pub(crate) fn default_reference_cache() -> ReferenceCache {
+pub fn default_reference_cache() -> ReferenceCache {
     ReferenceCache {
         dir: Some(PathBuf::from(DEFAULT_CACHE_DIR)),
     }
@@ -46,7 +46,7 @@ const MAX_SPP: u32 = 1 << 16;
 const MAX_BOUNCES: u32 = 64;
 
 impl ReferenceOpts {
-    pub(crate) fn settings(&self) -> Result<ReferenceSettings> {
+    pub fn settings(&self) -> Result<ReferenceSettings> {
         if !(1..=MAX_SPP).contains(&self.spp) {
             return Err(Error::param(
                 "spp",
@@ -68,7 +68,7 @@ impl ReferenceOpts {
             seed: self.reference_seed,
         })
     }
-    pub(crate) fn cache(&self) -> ReferenceCache {
+    pub fn cache(&self) -> ReferenceCache {
         ReferenceCache {
             dir: (!self.no_cache).then(|| self.cache.clone()),
         }
@@ -76,15 +76,15 @@ impl ReferenceOpts {
 }
 
 #[derive(Args, Clone)]
-pub(crate) struct GpuArgs {
+pub struct GpuArgs {
     /// Restrict the adapter to one backend: vulkan, gl, metal or dx12.
     #[arg(long, env = "GIBENCH_BACKEND")]
-    pub(crate) backend: Option<String>,
+    pub backend: Option<String>,
     /// Use the adapter whose name contains this (case-insensitive).
     #[arg(long, env = "GIBENCH_ADAPTER")]
-    pub(crate) adapter: Option<String>,
+    pub adapter: Option<String>,
     /// Fail when the GPU takes longer than this many seconds over one submission (default:
     /// wait as long as the work takes; a note is printed after 30 s).
     #[arg(long, env = "GIBENCH_GPU_TIMEOUT", value_name = "SECONDS")]
-    pub(crate) gpu_timeout: Option<f64>,
+    pub gpu_timeout: Option<f64>,
 }

@@ -6,7 +6,7 @@ use std::path::Path;
 use gibench_harness::{Error, Result};
 
 /// Creates `dir` if needed and checks a file can be written there; the error names `option`.
-pub(crate) fn writable_dir(option: &str, dir: &Path) -> Result<()> {
+pub fn writable_dir(option: &str, dir: &Path) -> Result<()> {
     let fail = |e: std::io::Error| {
         Error::param(
             option,
@@ -36,7 +36,7 @@ pub(crate) fn writable_dir(option: &str, dir: &Path) -> Result<()> {
 
 /// Checks `path` can be written as a file: not a folder, in a folder that can be created and
 /// written ([`writable_dir`]); the error names `option` and suggests `example` inside a folder.
-pub(crate) fn writable_file(option: &str, path: &Path, example: &str) -> Result<()> {
+pub fn writable_file(option: &str, path: &Path, example: &str) -> Result<()> {
     if path.is_dir() {
         return Err(Error::param(
             option,
@@ -64,14 +64,14 @@ pub(crate) fn writable_file(option: &str, path: &Path, example: &str) -> Result<
 }
 
 /// The file name of `p`, for messages and listings (empty if it has none).
-pub(crate) fn file_name(p: &Path) -> String {
+pub fn file_name(p: &Path) -> String {
     p.file_name()
         .map(|f| f.to_string_lossy().into_owned())
         .unwrap_or_default()
 }
 
 /// A `--stem` must be a plain file name (checked before any work).
-pub(crate) fn check_stem(stem: &str) -> Result<()> {
+pub fn check_stem(stem: &str) -> Result<()> {
     if stem.is_empty() || stem.contains(['/', '\\']) || stem.starts_with('.') {
         return Err(Error::param(
             "stem",
