@@ -10,7 +10,10 @@
 //!    pool (the surfaces sampled uniformly by area once, in `prepare`; movers' points moved
 //!    by their transforms every frame) splatted into its paraboloid map, one dispatch.
 //! 4. **Pull-push** ([`PullPush`]): holes filled in every map at once, `pull-push-levels`
-//!    levels.
+//!    levels; the plain average by default, or depth-aware (`pull-push=depth-aware`: Marroquim
+//!    et al. 2007, the front-most surface's depth interval in the pull, only empty or occluded
+//!    texels filled in the push), which closes the sun box's leak and darkens the other boxes
+//!    (`results/ism/pull-push-*`).
 //! 5. **Gathering**: the kit's interleaved accumulation and geometry-aware filter over the
 //!    float atlas ([`VplGather`] without a rasteriser). Direct light comes from the harness.
 //!
@@ -39,7 +42,7 @@ pub use params::IsmParams;
 use gibench_harness::glam::Mat4;
 use gibench_harness::kit::ir::gather::VplGather;
 use gibench_harness::kit::ir::points::{self, PoolPoint};
-use gibench_harness::kit::ir::pullpush::PullPush;
+use gibench_harness::kit::ir::pullpush::{PullPush, PullPushSettings};
 use gibench_harness::kit::ir::raster::StoreViews;
 use gibench_harness::kit::ir::rsm::ReflectiveShadowMap;
 use gibench_harness::kit::ir::splat::PointSplat;
@@ -127,9 +130,10 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     create,
 };
 
-/// The point pool, sampled once per scene.
+/// The point pool, sampled once per scene, and the area of the surfaces it was sampled on.
 struct IsmPrepared {
     pool: Vec<PoolPoint>,
+    area: f64,
 }
 
 fn prepare(params: &Params, ctx: &PrepareContext) -> Result<Prepared> {
@@ -137,6 +141,7 @@ fn prepare(params: &Params, ctx: &PrepareContext) -> Result<Prepared> {
     p.check_device(ctx.gpu)?;
     Ok(Box::new(IsmPrepared {
         pool: points::sample_scene(ctx.scene, p.pool, ctx.seed)?,
+        area: points::scene_area(ctx.scene),
     }))
 }
 
@@ -217,10 +222,10 @@ fn create(
     prepared: &Prepared,
 ) -> Result<Box<dyn Technique>> {
     let p = IsmParams::from_params(params)?;
-    let pool = &prepared
+    let prepared = prepared
         .downcast_ref::<IsmPrepared>()
-        .ok_or_else(|| Error::Invalid("ism: built without its preparation".into()))?
-        .pool;
+        .ok_or_else(|| Error::Invalid("ism: built without its preparation".into()))?;
+    let pool = &prepared.pool;
     let gpu = ctx.gpu;
     let device = &gpu.device;
     let ism = Ism::new(&p, ctx, None, |gather| {
@@ -256,7 +261,12 @@ fn create(
             pool.len() as u32,
             p.points_per_vpl,
         )?;
-        let pullpush = PullPush::new(gpu, &splat, &gather.atlas, p.levels)?;
+        let settings = PullPushSettings {
+            levels: p.levels,
+            mode: p.fill,
+            interval: PullPushSettings::interval(prepared.area, p.points_per_vpl, &gather.atlas),
+        };
+        let pullpush = PullPush::new(gpu, &splat, &gather.atlas, settings)?;
         Ok(Maps::Imperfect(Box::new(ImperfectMaps {
             splat,
             pullpush,

@@ -4,6 +4,7 @@
 
 use gibench_harness::kit::ir::atlas::{AtlasFormat, MapKind};
 use gibench_harness::kit::ir::gather::{GatherParams, GATHER_PARAMS};
+use gibench_harness::kit::ir::pullpush::PullPushMode;
 use gibench_harness::kit::ir::vpl_sample::VplWarp;
 use gibench_harness::kit::technique::{ParamKind, ParamSpec, Params};
 use gibench_harness::{Error, Result};
@@ -46,6 +47,12 @@ pub(crate) const OWN_PARAMS: &[ParamSpec] = &[
         default: "row-column",
         doc: "how each VPL's fixed point picks its texel of the reflective shadow map: 'flat', the luminance CDF over the flattened map; 'row-column', a row by luminance, then a texel of it",
     },
+    ParamSpec {
+        name: "pull-push",
+        kind: ParamKind::Choice(PullPushMode::NAMES),
+        default: "average",
+        doc: "how the pull-push fills holes: 'average' (every valid depth averaged); 'depth-aware' (Marroquim et al. 2007: the front-most surface's depth interval in the pull, only empty or occluded texels filled in the push: closes the sun box's leak, darkens the other boxes; results/ism/README.md)",
+    },
 ];
 
 /// The kit's gather parameters that apply to imperfect maps: tiles, map size, clamp (the maps
@@ -63,6 +70,8 @@ pub struct IsmParams {
     pub pool: u32,
     pub rsm_size: u32,
     pub levels: u32,
+    /// How the pull-push fills holes (`ism-classic`: unused, the average).
+    pub fill: PullPushMode,
     pub warp: VplWarp,
     pub gather: GatherParams,
 }
@@ -76,6 +85,7 @@ impl IsmParams {
             pool: params.int("point-pool") as u32,
             rsm_size: params.int("rsm-size") as u32,
             levels: params.int("pull-push-levels") as u32,
+            fill: PullPushMode::from_name(params.choice("pull-push"))?,
             warp: VplWarp::from_name(params.choice("vpl-warp"))?,
             gather: Self::gather(params, AtlasFormat::Float32),
         };
@@ -137,6 +147,7 @@ impl IsmParams {
             pool: 0,
             rsm_size: params.int("rsm-size") as u32,
             levels: 0,
+            fill: PullPushMode::Average,
             warp: VplWarp::from_name(params.choice("vpl-warp"))?,
             gather: Self::gather(params, AtlasFormat::Depth32),
         })

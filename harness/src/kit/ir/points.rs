@@ -83,6 +83,17 @@ pub fn sample_scene(scene: &Scene, count: u32, seed: u64) -> Result<Vec<PoolPoin
     sample_meshes(&meshes, count, seed)
 }
 
+/// The area of the scene's surfaces (the static mesh and the movers), what
+/// [`sample_scene`] spreads its points over.
+pub fn scene_area(scene: &Scene) -> f64 {
+    let meshes = std::iter::once(&scene.mesh).chain(scene.movers.iter().map(|m| &m.mesh));
+    meshes
+        .flat_map(|mesh| (0..mesh.triangle_count()).map(move |t| mesh.triangle(t)))
+        .map(|[a, b, c]| 0.5 * (b - a).cross(c - a).length() as f64)
+        .filter(|a| a.is_finite())
+        .sum()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

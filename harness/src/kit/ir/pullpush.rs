@@ -1,21 +1,42 @@
 //! **Pull-push**: fills the holes of every imperfect shadow map at once, in texture space
-//! (Ritschel et al. 2008; the pull-push of Grossman and Dally 1998), and writes the maps into
-//! the atlas.
+//! (Ritschel et al. 2008), and writes the maps into the atlas. Two modes ([`PullPushMode`]):
+//! depth-aware (Marroquim et al. 2007, the default of `ism`) and the plain average (the pull-push
+//! of Grossman and Dally 1998, what `ism` did before).
 //!
 //! Reads: [`PointSplat`]'s imperfect depth buffer (level 0).
 //! Writes (owns): a pyramid of `levels` coarser levels of every map, (mean reversed depth,
 //! weight) per texel; the float ([`AtlasFormat::Float32`]) [`ShadowAtlas`] — every slot's
 //! paraboloid block.
 //!
-//! Pull: each texel of level k + 1 is the mean of the valid depths among its 2×2 children,
-//! with weight min(1, Σ child weights) (0 when none is valid). Push, from level `levels` − 1
-//! down to 1: a texel of weight w < 1 becomes w · itself + (1 − w) · its parent. The last push
-//! writes level 0 into the atlas: a texel a point landed on keeps its depth exactly; a hole
-//! takes its parent's depth, or stays empty (0) where no point landed within 2^`levels` texels
-//! — so large empty regions (no geometry behind a VPL's horizon) are not closed up. `levels` 0
-//! copies the splats unfilled (the paper's "depth map without pull-push", with its leaks).
+//! **Depth-aware** (Marroquim, Kraus, Cavalcanti 2007, "Efficient point-based rendering using
+//! image reconstruction"). Pull: of each 2×2 block's valid children, those within the level's
+//! depth interval of the front-most one are kept (the front-most surface's); the texel of level
+//! k + 1 stores their mean depth with weight min(1, Σ kept weights) (0 when none is valid). (The
+//! front-most depth alone, which Marroquim et al. store, fills a slanted surface's holes nearer
+//! the light than the surface and shadows it; the mean of its own texels does not.) Push, from level `levels` − 1
+//! down to 1, and the last push into the atlas at level 0: a texel that is empty, or occluded
+//! (behind its parent by more than the interval: a farther surface seen through a hole in a
+//! nearer one) where the parent's points cover it (a texel of its level is no wider, at the
+//! parent's distance, than a point's diameter: the points are discs of their radius, as the
+//! paper's splats), takes its parent's depth; any other texel keeps its own. A plain average would
+//! invent an occluder between the two surfaces at a hole or a silhouette, and keep the farther
+//! surface where it shows through a hole — where light leaks. The interval at level 0 is the
+//! points' diameter 2r (r from the points' density, [`PullPushSettings::interval`]) in depth
+//! units, doubled per level (a texel of level k spans 2^k texels, so a slanted surface's depth
+//! spreads twice as far between siblings at each level up).
 //!
-//! Deviation: the push takes the parent texel (nearest), not a bilinear mix of four parents.
+//! **Average.** Pull: each texel of level k + 1 is the mean of the valid depths among its 2×2
+//! children, with weight min(1, Σ child weights). Push: a texel of weight w < 1 becomes
+//! w · itself + (1 − w) · its parent; at level 0 a texel a point landed on keeps its depth
+//! exactly and a hole takes its parent's depth.
+//!
+//! In both a hole stays empty (0) where no point landed within 2^`levels` texels — so large
+//! empty regions (no geometry behind a VPL's horizon) are not closed up — and no read crosses a
+//! map's tile border (each map is its own slot). `levels` 0 copies the splats unfilled (the
+//! paper's "depth map without pull-push", with its leaks).
+//!
+//! Deviation: the push takes the parent texel (nearest), not a bilinear mix of four parents
+//! (public implementations weigh them 9/3/3/1).
 
 use bytemuck::{Pod, Zeroable};
 
@@ -32,6 +53,62 @@ use crate::{Error, Result};
 struct ParamsData {
     counts: [u32; 4],
     offsets: [u32; 4],
+    fill: [f32; 4],
+}
+
+/// How the pull-push fills holes (see the module docs).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PullPushMode {
+    /// Marroquim et al. 2007: front-most depth interval in the pull, only empty or occluded
+    /// texels filled in the push.
+    DepthAware,
+    /// Grossman and Dally 1998: every valid child averaged, partial texels blended.
+    Average,
+}
+
+impl PullPushMode {
+    /// The parameter values, in the order of the variants.
+    pub const NAMES: &'static [&'static str] = &["depth-aware", "average"];
+
+    /// The mode named `name` (one of [`PullPushMode::NAMES`]).
+    pub fn from_name(name: &str) -> Result<PullPushMode> {
+        match name {
+            "depth-aware" => Ok(PullPushMode::DepthAware),
+            "average" => Ok(PullPushMode::Average),
+            other => Err(Error::param(
+                "pull-push",
+                format!("expected one of {:?}, got '{other}'", Self::NAMES),
+            )),
+        }
+    }
+
+    fn code(self) -> u32 {
+        match self {
+            PullPushMode::DepthAware => 0,
+            PullPushMode::Average => 1,
+        }
+    }
+}
+
+/// What the pull-push does: its levels, its mode and (depth-aware) the depth interval.
+#[derive(Clone, Copy, Debug)]
+pub struct PullPushSettings {
+    /// Levels pulled (at most log2 of the map size).
+    pub levels: u32,
+    pub mode: PullPushMode,
+    /// The depth interval at level 0, in the atlas's depth units (reversed, 1 − distance /
+    /// far): two surfaces closer than this are one. Unused by [`PullPushMode::Average`].
+    pub interval: f32,
+}
+
+impl PullPushSettings {
+    /// The interval of points sampled uniformly by area, `points` of them over `area`, in
+    /// `atlas`'s depth units: their diameter 2r, with r the radius of the disc each point
+    /// stands for (π r² = area / points), over the atlas's far distance.
+    pub fn interval(area: f64, points: u32, atlas: &ShadowAtlas) -> f32 {
+        let r = (area / (std::f64::consts::PI * points.max(1) as f64)).sqrt();
+        (2.0 * r / atlas.far as f64) as f32
+    }
 }
 
 /// One dispatch: its pipeline, bind group and the texels of a map at its level.
@@ -56,15 +133,29 @@ pub struct PullPush {
 
 const NO_SOURCE: u32 = u32::MAX;
 
+/// The steepest slant (75°: tan ≈ 3.73) at which a surface still counts as one across a texel
+/// in the depth-aware mode: a texel of a paraboloid map of `size`² spans at most 4 / `size`
+/// radians (at the centre), over which a surface at distance D tilted θ from the view ray
+/// changes distance by about D · (4 / size) · tan θ.
+const SLANT_TAN: f32 = 3.73;
+
 impl PullPush {
     /// The passes over `splat`'s depth buffer into `atlas` (a float atlas of the same slots
-    /// and map size), pulling `levels` levels (at most log2 of the map size).
+    /// and map size), as `settings` say.
     pub fn new(
         gpu: &GpuContext,
         splat: &PointSplat,
         atlas: &ShadowAtlas,
-        levels: u32,
+        settings: PullPushSettings,
     ) -> Result<PullPush> {
+        if settings.mode == PullPushMode::DepthAware
+            && !(settings.interval.is_finite() && settings.interval >= 0.0)
+        {
+            return Err(Error::Invalid(format!(
+                "the pull-push's depth interval must be finite and at least 0 (got {})",
+                settings.interval
+            )));
+        }
         let device = &gpu.device;
         let (slots, size) = splat.layout();
         if atlas.settings.format != AtlasFormat::Float32 || atlas.settings.size != size {
@@ -72,7 +163,7 @@ impl PullPush {
                 "pull-push writes a float atlas of the splat's map size".into(),
             ));
         }
-        let levels = levels.min(size.trailing_zeros());
+        let levels = settings.levels.min(size.trailing_zeros());
         // Offsets of levels 1..=levels in the pyramid (items).
         let mut offsets = vec![0u32; levels as usize + 2];
         let mut items = 0u64;
@@ -113,12 +204,23 @@ impl PullPush {
         let columns = atlas.columns();
         let pass = |kind: usize, level: u32, source: u32| -> Pass {
             let s = size >> level;
+            // The interval of the level compared: the children's (level − 1) in the pull, the
+            // texels' own in the push and the store.
+            let compared = if kind == 0 { level - 1 } else { level };
+            let scale = (1u32 << compared) as f32;
+            let texel = 4.0 / size as f32;
             let params = params_buffer(
                 gpu,
                 "pull-push params",
                 &ParamsData {
                     counts: [level, s, slots, columns],
-                    offsets: [offsets[level as usize], source, 0, 0],
+                    offsets: [offsets[level as usize], source, settings.mode.code(), 0],
+                    fill: [
+                        settings.interval * scale,
+                        SLANT_TAN * texel * scale,
+                        texel * scale,
+                        settings.interval,
+                    ],
                 },
             );
             let layout = if kind == 2 { &store_layout } else { &layout };

@@ -241,6 +241,24 @@ pub const TARGETS: &[Target] = &[
         },
     },
     Target {
+        name: "ism-pull-push-sun",
+        dir: "ism/pull-push-sun",
+        what: "ism's pull-push, the plain average against the depth-aware one (Marroquim et al. 2007), in the sun box where light leaks through the imperfect maps' holes: error and bias against the one-bounce reference",
+        kind: Kind::Command {
+            quick: "sweep --scene cornell-sun --technique ism --sweep pull-push=average,depth-aware --quality --frames 3 --warmup 3 --timing stages",
+            paper: "sweep --scene cornell-sun --technique ism --sweep pull-push=average,depth-aware --quality --frames 3 --warmup 3 --timing stages",
+        },
+    },
+    Target {
+        name: "ism-pull-push-spot",
+        dir: "ism/pull-push-spot",
+        what: "the same in the spot-lit Cornell box, where the depth-aware pull-push darkens",
+        kind: Kind::Command {
+            quick: "sweep --scene cornell --technique ism --sweep pull-push=average,depth-aware --quality --frames 3 --warmup 3 --timing stages",
+            paper: "sweep --scene cornell --technique ism --sweep pull-push=average,depth-aware --quality --frames 3 --warmup 3 --timing stages",
+        },
+    },
+    Target {
         name: "ism-breakdown",
         dir: "ism/breakdown",
         what: "",
@@ -322,6 +340,8 @@ pub const PRIORITY: &[&str] = &[
     "ism-map-size",
     "ism-vpls",
     "ism-tiles",
+    "ism-pull-push-sun",
+    "ism-pull-push-spot",
     "gaitatzes-grid",
     "gaitatzes-iterations",
     "gaitatzes-transport",

@@ -1,6 +1,8 @@
-// The last push: level 0 into the atlas. A texel where a point landed keeps its depth exactly;
-// a hole takes its filled parent's depth (level 1), or stays empty (0) where nothing was
-// within the levels pulled. Adds a binding to pullpush.wgsl's.
+// The last push: level 0 into the atlas. Average mode: a texel where a point landed keeps its
+// depth exactly; a hole takes its filled parent's depth (level 1), or stays empty (0) where
+// nothing was within the levels pulled. Depth-aware mode: the same, and a texel occluded by
+// its parent (behind it by more than the interval) takes the parent's depth too. Adds a
+// binding to pullpush.wgsl's.
 #import gibench::pullpush
 
 @group(0) @binding(3) var atlas_out: texture_storage_2d<r32float, write>;
@@ -15,9 +17,10 @@ fn store(@builtin(global_invocation_id) id: vec3<u32>) {
     let x = id.x % size;
     let y = id.x / size;
     var v = level0(slot, x, y, size);
-    if (v.y <= 0.0 && pp.offsets.y != 0xffffffffu) {
+    if (pp.offsets.y != 0xffffffffu) {
         let parent = texel(pp.offsets.y, slot, x / 2u, y / 2u, size / 2u);
-        if (parent.y > 0.0) {
+        let aware = pp.offsets.z == 0u;
+        if ((v.y <= 0.0 && parent.y > 0.0) || (aware && filled_from(v, parent))) {
             v = vec2<f32>(parent.x, 1.0);
         }
     }
