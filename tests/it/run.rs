@@ -134,7 +134,7 @@ fn quality_columns_and_results() {
         ],
         tmp.path(),
     );
-    for col in ["RMSE", "relMSE", "FLIP", "flicker"] {
+    for col in ["RMSE", "relMSE", "FLIP", "flicker", "flicker floor"] {
         assert!(stdout.contains(col), "table lacks '{col}':\n{stdout}");
     }
     let r = RunResult::read(&tmp.path().join("cornell-direct.json")).unwrap();
@@ -145,6 +145,13 @@ fn quality_columns_and_results() {
         vec![4, 5]
     );
     assert!(q.frames[1].temporal.is_some());
+    // The reference's own flicker floor, from the pair rendered again with the next seed: above
+    // 0 at 16 spp (0: the pair compared with itself, the same seed).
+    assert!(
+        q.flicker_floor.is_some_and(|f| f > 0.0 && f.is_finite()),
+        "{:?}",
+        q.flicker_floor
+    );
     // `direct` has no indirect light: its relative MSE against one bounce is close to 1.
     assert!(
         q.rel_mse.mean > 0.5 && q.rel_mse.mean <= 1.0,
@@ -158,8 +165,8 @@ fn quality_columns_and_results() {
     );
     assert!(tmp.path().join("cornell-direct-flip.png").is_file());
     // The references were cached: frames 4 and 5, one-bounce (the VPL techniques) and
-    // multi-bounce (`gaitatzes`).
-    assert_eq!(std::fs::read_dir(&cache).unwrap().count(), 4);
+    // multi-bounce (`gaitatzes`), each with the run's seed and the next (the floor).
+    assert_eq!(std::fs::read_dir(&cache).unwrap().count(), 8);
 }
 
 /// README: two seeds of the reference at the default spp agree to a relative MSE below 0.02.
@@ -397,7 +404,9 @@ fn a_run_that_skips_nothing_leaves_no_list_of_skipped_techniques() {
 
 /// A multi-frame quality run on the Cornell box with its walking bunny builds the static
 /// mesh's tree once for the whole run (the techniques' CPU rays and every reference frame share
-/// it) and the bunny's tree once per rendered reference frame, and says so in the results
+/// it) and the bunny's tree once per rendered reference frame (frames 1 to 3, then both pairs,
+/// 1–2 and 2–3, again with the next seed for the flicker floor: three more rendered, frame 2's
+/// second request read from the cache), and says so in the results
 /// (`quality.reference_work`); run again over the same cache, it renders no reference and
 /// builds no mover tree, and its reference images are the first run's. Catches the reference
 /// building its own trees per frame again (its mover builds then go uncounted), a static tree
@@ -428,10 +437,10 @@ fn quality_run_builds_the_static_tree_once_and_movers_per_frame() {
     assert_eq!(
         first,
         ReferenceWork {
-            rendered: 3,
-            cached: 0,
+            rendered: 6,
+            cached: 1,
             static_tree_builds: 1,
-            mover_tree_builds: 3
+            mover_tree_builds: 6
         }
     );
     let (again, png_again) = run("again");
@@ -439,7 +448,7 @@ fn quality_run_builds_the_static_tree_once_and_movers_per_frame() {
         again,
         ReferenceWork {
             rendered: 0,
-            cached: 3,
+            cached: 7,
             static_tree_builds: 1,
             mover_tree_builds: 0
         }

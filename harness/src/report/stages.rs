@@ -176,7 +176,9 @@ pub fn stage_table(results: &[RunResult]) -> Table {
     );
     let quality = results.iter().any(|r| r.quality.is_some());
     if quality {
-        columns.extend(["RMSE", "relMSE", "bias", "FLIP", "flicker"].map(String::from));
+        columns.extend(
+            ["RMSE", "relMSE", "bias", "FLIP", "flicker", "flicker floor"].map(String::from),
+        );
     }
 
     let rows = results
@@ -217,6 +219,7 @@ pub fn stage_table(results: &[RunResult]) -> Table {
                 row.push(Cell::Num(q.map(|q| q.bias.mean), 4));
                 row.push(Cell::Num(q.map(|q| q.flip_mean.mean), 4));
                 row.push(Cell::Num(q.and_then(|q| q.temporal.map(|t| t.mean)), 4));
+                row.push(Cell::Num(q.and_then(|q| q.flicker_floor), 4));
             }
             row
         })
@@ -234,7 +237,9 @@ pub fn stage_table(results: &[RunResult]) -> Table {
              (relative MSE, Rousselle et al. 2011) and bias (signed relative error of the mean) of indirect \
              irradiance; FLIP (LDR-FLIP, mean) of the \
              tonemapped composed images; flicker: RMS of the frame-to-frame change of indirect irradiance \
-             beyond the reference's change.",
+             beyond the reference's change; flicker floor: the reference's own frame-to-frame noise \
+             (up to three compared pairs rendered again with the next seed), which every flicker \
+             includes: a flicker at or below it is at the floor.",
             refs.join("; ")
         ));
     }

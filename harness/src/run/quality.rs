@@ -532,6 +532,43 @@ pub fn indirect_exposure(reference_indirect: &[Vec3], hit: &[bool]) -> f32 {
     }
 }
 
+/// The reference's flicker floor ([`metrics::flicker_floor`]) of a quality pass: over up to
+/// three of its compared pairs (spread over them, the last included), each rendered again by
+/// `again` (a frame's reference with the next seed), the mean; `None` when no pair was compared.
+pub fn flicker_floor(
+    captured: &[CapturedFrame],
+    references: &[ReferenceImages],
+    component: IndirectComponent,
+    again: &mut dyn FnMut(u32) -> Result<ReferenceImages>,
+) -> Result<Option<f64>> {
+    let pairs: Vec<usize> = (1..captured.len())
+        .filter(|&i| captured[i].pair_end && captured[i - 1].frame + 1 == captured[i].frame)
+        .collect();
+    let chosen = match pairs.len() {
+        0..=3 => pairs,
+        n => vec![pairs[0], pairs[n / 2], pairs[n - 1]],
+    };
+    let mut floors = Vec::new();
+    for &i in &chosen {
+        let (r1p, r1c) = (again(captured[i - 1].frame)?, again(captured[i].frame)?);
+        let (r0p, r0c) = (&references[i - 1], &references[i]);
+        let mask: Vec<bool> = r0p
+            .hit
+            .iter()
+            .zip(&r0c.hit)
+            .map(|(a, b)| *a && *b)
+            .collect();
+        floors.push(metrics::flicker_floor(
+            component.of(&r1p),
+            component.of(&r1c),
+            component.of(r0p),
+            component.of(r0c),
+            &mask,
+        ));
+    }
+    Ok((!floors.is_empty()).then(|| floors.iter().sum::<f64>() / floors.len() as f64))
+}
+
 /// Compares captured frames with their references.
 pub fn compare(
     captured: &[CapturedFrame],

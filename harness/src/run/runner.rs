@@ -637,6 +637,27 @@ impl<'a> Harness<'a> {
                 Ok(r)
             })
             .collect::<Result<Vec<_>>>()?;
+        // The reference's flicker floor, from pairs rendered again with the next seed.
+        let reseeded = crate::cpu::reference::ReferenceSettings {
+            seed: settings.seed.wrapping_add(1),
+            ..settings
+        };
+        let floor = crate::run::quality::flicker_floor(
+            &captured,
+            &references,
+            quality.component(),
+            &mut |f| {
+                let frame = self.clock.frame(f);
+                let (r, setup) =
+                    cache.get_with(&self.trees, &frame, config.resolution, &reseeded)?;
+                *(if setup.is_some() {
+                    &mut work.rendered
+                } else {
+                    &mut work.cached
+                }) += 1;
+                Ok(r)
+            },
+        )?;
         let builds = self.trees.builds();
         work.static_tree_builds = builds.static_tree;
         work.mover_tree_builds = builds.mover_trees;
@@ -647,6 +668,7 @@ impl<'a> Harness<'a> {
             self.scene.descriptor.settings.exposure,
         )?;
         summary.reference_work = Some(work);
+        summary.flicker_floor = floor;
         Ok((summary, images))
     }
 

@@ -41,7 +41,7 @@ pub fn per_frame_lines(results: &[RunResult], metric: &str) -> Result<Vec<Line>>
             _ => None,
         }
     };
-    Ok(results
+    let mut lines: Vec<Line> = results
         .iter()
         .filter_map(|r| {
             let q = r.quality.as_ref()?;
@@ -56,7 +56,34 @@ pub fn per_frame_lines(results: &[RunResult], metric: &str) -> Result<Vec<Line>>
                 .collect();
             (!pts.is_empty()).then(|| (run_label(r), pts))
         })
-        .collect())
+        .collect();
+    if metric == "flicker" {
+        lines.extend(floor_lines(results));
+    }
+    Ok(lines)
+}
+
+/// The reference's flicker floor of each scene, as a flat line over the frames its runs
+/// compared (one per scene and floor): a flicker line at it is at the floor.
+fn floor_lines(results: &[RunResult]) -> Vec<Line> {
+    let mut out: Vec<Line> = Vec::new();
+    for r in results {
+        let Some(q) = r.quality.as_ref() else {
+            continue;
+        };
+        let Some(floor) = q.flicker_floor.filter(|f| f.is_finite()) else {
+            continue;
+        };
+        let frames = q.frames.iter().filter(|f| f.temporal.is_some());
+        let (lo, hi) = frames.fold((f64::MAX, f64::MIN), |(lo, hi), f| {
+            (lo.min(f.frame as f64), hi.max(f.frame as f64))
+        });
+        let label = format!("reference's flicker floor @ {}", r.scene);
+        if lo <= hi && !out.iter().any(|(l, p)| *l == label && p[0].1 == floor) {
+            out.push((label, vec![(lo, floor), (hi, floor)]));
+        }
+    }
+    out
 }
 
 /// Per-frame image error against the reference for each result that has quality data: one

@@ -25,6 +25,9 @@ use serde::{Deserialize, Serialize};
 use crate::measure::stats::Stats;
 use crate::{Error, Result};
 
+mod temporal;
+pub use temporal::{flicker_floor, relative_temporal_instability, temporal_instability};
+
 /// Visits every masked-in pixel (see the module conventions) with its test and reference value.
 fn for_each_masked(
     test: &[Vec3],
@@ -270,123 +273,6 @@ pub fn flip_error_png(result: &FlipResult, size: [u32; 2]) -> Vec<u8> {
     out
 }
 
-/// Temporal instability (flicker) of a technique between two consecutive frames, relative to
-/// the reference's own change:
-///
-/// ```text
-/// sqrt(mean over masked pixels p and channels c of
-///      ((t_cur − t_prev) − (r_cur − r_prev))²)
-/// ```
-///
-/// i.e. the RMSE of the technique's frame-to-frame change against the reference's
-/// frame-to-frame change. Genuine changes (moving light or objects) appear in both and cancel;
-/// what remains is change the technique makes that it should not (flicker, popping, VPLs jumping
-/// around), plus change it fails to make (lag). Same units as the images.
-///
-/// This is the measure that checks Laine et al. 2007's claim that incremental instant radiosity
-/// flickers less than recomputing all VPLs every frame, and the imperfect-shadow-maps paper's
-/// claim of temporally coherent ("no flicker") indirect light: a technique that is temporally
-/// stable scores close to the reference's own value.
-///
-/// `mask` must select the pixels that are valid in *both* frames (the caller ANDs the two hit
-/// masks; a pixel that is background in either frame is not comparable). Conventions on lengths
-/// and empty masks are the module's. Note that Monte Carlo noise in the reference that differs
-/// between the frames adds to the value (variances add); render the reference with a per-frame
-/// fixed seed, or with enough samples that this floor is negligible.
-pub fn temporal_instability(
-    test_prev: &[Vec3],
-    test_cur: &[Vec3],
-    ref_prev: &[Vec3],
-    ref_cur: &[Vec3],
-    mask: &[bool],
-) -> f64 {
-    let (sum, n) = temporal_sums(
-        test_prev,
-        test_cur,
-        ref_prev,
-        ref_cur,
-        mask,
-        |tp, tc, rp, rc| {
-            let d = (tc - tp) - (rc - rp);
-            d * d
-        },
-    );
-    if n == 0 {
-        0.0
-    } else {
-        (sum / n as f64).sqrt()
-    }
-}
-
-/// [`temporal_instability`] divided by the RMS of the reference's values in the two frames,
-/// `sqrt(mean over masked p, c of (r_prev² + r_cur²) / 2)`, so that it is dimensionless and
-/// comparable across scenes, light powers and exposures (scaling all four images by `k > 0`
-/// leaves it unchanged). A value of 0.05 means the unexplained frame-to-frame change is 5 % of
-/// the typical reference value.
-///
-/// If the reference is black over the whole mask, the RMS of the test's values in the two frames
-/// is used instead (so the value stays finite); 0 when that is 0 too or no pixel is masked in.
-pub fn relative_temporal_instability(
-    test_prev: &[Vec3],
-    test_cur: &[Vec3],
-    ref_prev: &[Vec3],
-    ref_cur: &[Vec3],
-    mask: &[bool],
-) -> f64 {
-    let abs = temporal_instability(test_prev, test_cur, ref_prev, ref_cur, mask);
-    if abs == 0.0 {
-        return 0.0;
-    }
-    let rms = |prev: &[Vec3], cur: &[Vec3]| {
-        let (sum, n) = temporal_sums(test_prev, test_cur, prev, cur, mask, |_, _, p, c| {
-            (p * p + c * c) / 2.0
-        });
-        if n == 0 {
-            0.0
-        } else {
-            (sum / n as f64).sqrt()
-        }
-    };
-    let mut norm = rms(ref_prev, ref_cur);
-    if norm == 0.0 {
-        norm = rms(test_prev, test_cur);
-    }
-    if norm == 0.0 {
-        0.0
-    } else {
-        abs / norm
-    }
-}
-
-/// Sum over the masked pixels (pixels present in all four images and the mask) and channels of
-/// `g(t_prev, t_cur, r_prev, r_cur)`, and the number of terms.
-fn temporal_sums(
-    test_prev: &[Vec3],
-    test_cur: &[Vec3],
-    ref_prev: &[Vec3],
-    ref_cur: &[Vec3],
-    mask: &[bool],
-    g: impl Fn(f64, f64, f64, f64) -> f64,
-) -> (f64, usize) {
-    let mut sum = 0.0f64;
-    let mut n = 0usize;
-    let it = test_prev
-        .iter()
-        .zip(test_cur)
-        .zip(ref_prev.iter().zip(ref_cur))
-        .zip(mask);
-    for (((tp, tc), (rp, rc)), m) in it {
-        if !*m {
-            continue;
-        }
-        for c in 0..3 {
-            sum += g(tp[c] as f64, tc[c] as f64, rp[c] as f64, rc[c] as f64);
-        }
-        n += 3;
-    }
-    (sum, n)
-}
-
 /// Quality of one frame of a technique against the reference.
 #[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
 pub struct FrameQuality {
@@ -435,6 +321,12 @@ pub struct QualitySummary {
     /// frame has it.
     #[serde(skip_serializing_if = "Option::is_none", default)]
     pub temporal: Option<Stats>,
+    /// The reference's own flicker floor ([`flicker_floor`]), the mean over up to three of the
+    /// compared pairs (spread over them, the last included), in [`FrameQuality::temporal`]'s
+    /// units; `None` when no pair was compared (and in files
+    /// written before it was recorded).
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub flicker_floor: Option<f64>,
     /// How the reference images were come by; absent in files written before it was recorded.
     #[serde(skip_serializing_if = "Option::is_none", default)]
     pub reference_work: Option<ReferenceWork>,
@@ -486,17 +378,18 @@ pub fn summarize(reference: String, frames: Vec<FrameQuality>) -> QualitySummary
         flip_mean: of(|f| f.flip_mean),
         bias: of(|f| f.bias),
         temporal: (!temporal.is_empty()).then(|| Stats::of(&temporal)),
+        flicker_floor: None,
         frames,
         reference_work: None,
     }
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     /// A deterministic, varied test image of `n` pixels.
-    fn image(n: usize) -> Vec<Vec3> {
+    pub(crate) fn image(n: usize) -> Vec<Vec3> {
         (0..n)
             .map(|i| {
                 let x = i as f32;
@@ -509,7 +402,7 @@ mod tests {
             .collect()
     }
 
-    fn all(n: usize) -> Vec<bool> {
+    pub(crate) fn all(n: usize) -> Vec<bool> {
         vec![true; n]
     }
 
@@ -747,71 +640,6 @@ mod tests {
             error_map: vec![f32::NAN, 2.0, -1.0],
         };
         assert_eq!(flip_error_png(&odd, [3, 3]).len(), 36);
-    }
-
-    #[test]
-    fn metrics_temporal_instability() {
-        let n = 30;
-        let m = all(n);
-        let t = image(n);
-        let r_prev = image(n);
-        let d = 0.125f32;
-        let r_cur: Vec<Vec3> = r_prev.iter().map(|v| *v + Vec3::splat(d)).collect();
-        // Static technique, reference changes by d → d.
-        let v = temporal_instability(&t, &t, &r_prev, &r_cur, &m);
-        assert!((v - d as f64).abs() < 1e-6, "{v}");
-        // Identical changes → 0.
-        assert_eq!(
-            temporal_instability(&r_prev, &r_cur, &r_prev, &r_cur, &m),
-            0.0
-        );
-        // Same change on a biased image → 0 up to f32 rounding of the inputs.
-        let t_prev: Vec<Vec3> = r_prev.iter().map(|v| *v * 0.5).collect();
-        let t_cur: Vec<Vec3> = t_prev.iter().map(|v| *v + Vec3::splat(d)).collect();
-        assert!(temporal_instability(&t_prev, &t_cur, &r_prev, &r_cur, &m) < 1e-6);
-        let (t_prev, t_cur) = (r_prev.clone(), r_cur.clone());
-        assert_eq!(
-            temporal_instability(&t_prev, &t_cur, &r_prev, &r_cur, &m),
-            0.0
-        );
-        assert_eq!(
-            relative_temporal_instability(&t_prev, &t_cur, &r_prev, &r_cur, &m),
-            0.0
-        );
-        // Masked-out pixels don't count.
-        let mut t_flicker = t_cur.clone();
-        t_flicker[0] = Vec3::splat(99.0);
-        let mut m0 = m.clone();
-        m0[0] = false;
-        assert_eq!(
-            temporal_instability(&t_prev, &t_flicker, &r_prev, &r_cur, &m0),
-            0.0
-        );
-        assert!(temporal_instability(&t_prev, &t_flicker, &r_prev, &r_cur, &m) > 1.0);
-    }
-
-    #[test]
-    fn metrics_relative_temporal_instability_normalised() {
-        let n = 20;
-        let m = all(n);
-        let r = vec![Vec3::splat(2.0); n];
-        let t_prev = r.clone();
-        let t_cur: Vec<Vec3> = r.iter().map(|v| *v + Vec3::splat(0.5)).collect();
-        // Static reference of RMS 2, technique jumps by 0.5 → 0.25.
-        let v = relative_temporal_instability(&t_prev, &t_cur, &r, &r, &m);
-        assert!((v - 0.25).abs() < 1e-12, "{v}");
-        // Scale-invariant.
-        let s = |x: &[Vec3]| x.iter().map(|v| *v * 7.0).collect::<Vec<_>>();
-        let v7 = relative_temporal_instability(&s(&t_prev), &s(&t_cur), &s(&r), &s(&r), &m);
-        assert!((v7 - v).abs() < 1e-9);
-        // Black reference: finite.
-        let black = vec![Vec3::ZERO; n];
-        let vb = relative_temporal_instability(&t_prev, &t_cur, &black, &black, &m);
-        assert!(vb.is_finite() && vb > 0.0);
-        assert_eq!(
-            relative_temporal_instability(&t_prev, &t_cur, &r, &r, &[]),
-            0.0
-        );
     }
 
     fn fq(frame: u32, temporal: Option<f64>) -> FrameQuality {
