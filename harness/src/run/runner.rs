@@ -623,19 +623,19 @@ impl<'a> Harness<'a> {
         profiler.finish(self.gpu)?;
         let settings = quality.reference_settings();
         let mut work = ReferenceWork::default();
-        let references = captured
-            .iter()
-            .map(|c| {
-                let frame = self.clock.frame(c.frame);
-                let (r, setup) =
-                    cache.get_with(&self.trees, &frame, config.resolution, &settings)?;
-                *(if setup.is_some() {
-                    &mut work.rendered
-                } else {
-                    &mut work.cached
-                }) += 1;
-                Ok(r)
-            })
+        // A frame's reference with `settings`, from the cache or rendered, counted in `work`.
+        let mut fetch = |f: u32, settings: &crate::cpu::reference::ReferenceSettings| {
+            let frame = self.clock.frame(f);
+            let (r, setup) = cache.get_with(&self.trees, &frame, config.resolution, settings)?;
+            *(if setup.is_some() {
+                &mut work.rendered
+            } else {
+                &mut work.cached
+            }) += 1;
+            Ok(r)
+        };
+        let references = (captured.iter())
+            .map(|c| fetch(c.frame, &settings))
             .collect::<Result<Vec<_>>>()?;
         // The reference's flicker floor, from pairs rendered again with the next seed.
         let reseeded = crate::cpu::reference::ReferenceSettings {
@@ -646,17 +646,7 @@ impl<'a> Harness<'a> {
             &captured,
             &references,
             quality.component(),
-            &mut |f| {
-                let frame = self.clock.frame(f);
-                let (r, setup) =
-                    cache.get_with(&self.trees, &frame, config.resolution, &reseeded)?;
-                *(if setup.is_some() {
-                    &mut work.rendered
-                } else {
-                    &mut work.cached
-                }) += 1;
-                Ok(r)
-            },
+            &mut |f| fetch(f, &reseeded),
         )?;
         let builds = self.trees.builds();
         work.static_tree_builds = builds.static_tree;

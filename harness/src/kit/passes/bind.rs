@@ -178,7 +178,7 @@ pub struct Bound {
 }
 
 impl<'a> Bindings<'a> {
-    /// No bindings yet; those added are visible to `visibility` until [`Bindings::visible`].
+    /// No bindings yet; those added are visible to `visibility`.
     pub fn new(label: &'a str, visibility: wgpu::ShaderStages) -> Bindings<'a> {
         Bindings {
             label,
@@ -194,12 +194,6 @@ impl<'a> Bindings<'a> {
     pub fn first_binding(mut self, first: u32) -> Bindings<'a> {
         assert!(self.entries.is_empty(), "first_binding after a binding");
         self.first = first;
-        self
-    }
-
-    /// The bindings added from here on are visible to `visibility`.
-    pub fn visible(mut self, visibility: wgpu::ShaderStages) -> Bindings<'a> {
-        self.visibility = visibility;
         self
     }
 
@@ -253,7 +247,7 @@ impl<'a> Bindings<'a> {
     }
 
     /// A texture of `sample_type` and `dim`.
-    pub fn texture_of(
+    fn texture_of(
         self,
         view: &'a wgpu::TextureView,
         sample_type: wgpu::TextureSampleType,
@@ -271,16 +265,6 @@ impl<'a> Bindings<'a> {
     ) -> Bindings<'a> {
         let entry = |b, _| storage_texture_entry(b, format);
         self.with(entry, wgpu::BindingResource::TextureView(view))
-    }
-
-    /// A sampler of `kind`.
-    pub fn sampler(
-        self,
-        sampler: &'a wgpu::Sampler,
-        kind: wgpu::SamplerBindingType,
-    ) -> Bindings<'a> {
-        let entry = |b, v| sampler_entry(b, v, kind);
-        self.with(entry, wgpu::BindingResource::Sampler(sampler))
     }
 
     /// The layout entries declared so far, in binding order.
