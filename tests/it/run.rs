@@ -426,6 +426,12 @@ fn quality_run_builds_the_static_tree_once_and_movers_per_frame() {
             &out,
         );
         let r = RunResult::read(&out.join("cornell-bunny-direct.json")).unwrap();
+        // The per-frame flicker plot draws the reference's floor beside the run's line.
+        let svg = std::fs::read_to_string(out.join("cornell-bunny-flicker-per-frame.svg")).unwrap();
+        assert!(
+            svg.contains("flicker floor @ cornell-bunny"),
+            "no floor line"
+        );
         let json = out.join("cornell-bunny-direct.json");
         let png = std::fs::read(support::reference_image(&json, "-reference-frames.png")).unwrap();
         (

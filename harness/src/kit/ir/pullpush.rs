@@ -1,7 +1,7 @@
 //! **Pull-push**: fills the holes of every imperfect shadow map at once, in texture space
 //! (Ritschel et al. 2008), and writes the maps into the atlas. Two modes ([`PullPushMode`]):
-//! depth-aware (Marroquim et al. 2007, the default of `ism`) and the plain average (the pull-push
-//! of Grossman and Dally 1998, what `ism` did before).
+//! the plain average (the pull-push of Grossman and Dally 1998, `ism`'s default) and
+//! depth-aware (after Marroquim et al. 2007, `pull-push=depth-aware`).
 //!
 //! Reads: [`PointSplat`]'s imperfect depth buffer (level 0).
 //! Writes (owns): a pyramid of `levels` coarser levels of every map, (mean reversed depth,
@@ -10,20 +10,26 @@
 //!
 //! **Depth-aware** (Marroquim, Kraus, Cavalcanti 2007, "Efficient point-based rendering using
 //! image reconstruction"). Pull: of each 2×2 block's valid children, those within the level's
-//! depth interval of the front-most one are kept (the front-most surface's); the texel of level
-//! k + 1 stores their mean depth with weight min(1, Σ kept weights) (0 when none is valid). (The
-//! front-most depth alone, which Marroquim et al. store, fills a slanted surface's holes nearer
-//! the light than the surface and shadows it; the mean of its own texels does not.) Push, from level `levels` − 1
-//! down to 1, and the last push into the atlas at level 0: a texel that is empty, or occluded
-//! (behind its parent by more than the interval: a farther surface seen through a hole in a
-//! nearer one) where the parent's points cover it (a texel of its level is no wider, at the
-//! parent's distance, than a point's diameter: the points are discs of their radius, as the
-//! paper's splats), takes its parent's depth; any other texel keeps its own. A plain average would
-//! invent an occluder between the two surfaces at a hole or a silhouette, and keep the farther
-//! surface where it shows through a hole — where light leaks. The interval at level 0 is the
-//! points' diameter 2r (r from the points' density, [`PullPushSettings::interval`]) in depth
-//! units, doubled per level (a texel of level k spans 2^k texels, so a slanted surface's depth
-//! spreads twice as far between siblings at each level up).
+//! depth interval of the front-most one are kept (the front-most surface's); the texel of
+//! level k + 1 stores their mean depth with weight min(1, Σ kept weights) (0 when none is
+//! valid). Push, from level `levels` − 1 down to 1, and the last push into the atlas at level
+//! 0: a texel that is empty, or occluded (behind its parent by more than the interval: a
+//! farther surface seen through a hole in a nearer one) where the parent's points cover it,
+//! takes its parent's depth; any other texel keeps its own. A plain average would invent an
+//! occluder between the two surfaces at a hole or a silhouette, and keep the farther surface
+//! where it shows through a hole — where light leaks.
+//!
+//! The interval at level 0 is the larger of the points' diameter 2r (r from the points'
+//! density, [`PullPushSettings::interval`]) and a slanted surface's depth change across one
+//! texel (up to 75° from the view ray, at the front-most surface's distance), in depth units;
+//! both double per level (a texel of level k spans 2^k texels). Three changes from the paper,
+//! each measured (docs/deviations.md): the slant term (our points are splatted as single
+//! texels, not discs, so a slanted surface changes depth between neighbouring texels by more
+//! than a point's diameter, and the diameter alone splits it in two); the mean of the kept
+//! children rather than the front-most depth (which fills a slanted surface's holes nearer the
+//! light than the surface, so it shadows itself); and the occluded fill only where a texel of
+//! its level is no wider, at the parent's distance, than a point's diameter (a coarser parent
+//! would spread an occluder past its silhouette).
 //!
 //! **Average.** Pull: each texel of level k + 1 is the mean of the valid depths among its 2×2
 //! children, with weight min(1, Σ child weights). Push: a texel of weight w < 1 becomes
@@ -186,6 +192,8 @@ impl PullPush {
         });
         let atlas_view = atlas.texture().create_view(&Default::default());
         let (depth, store) = (splat.depth(), Some(&atlas_view));
+        // The two layouts, from the passes' declaration (a layout reads only the bindings'
+        // kinds, so any buffer stands in for the per-pass parameters made below).
         let layout = declare(&pyramid, depth, &pyramid, None).layout(device);
         let store_layout = declare(&pyramid, depth, &pyramid, store).layout(device);
         let common = include_str!("shaders/pullpush.wgsl");
