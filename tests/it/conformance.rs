@@ -94,7 +94,7 @@ fn every_registered_technique_conforms() {
 
 /// Barczak's receivers on scenes that record no patches are generated charts (issue 37): its
 /// entry also covers the papers' large scenes, with one build each (the Cornell entries check
-/// determinism; a build here takes most of a minute on two cores).
+/// determinism; each build is most of this test's time).
 #[test]
 fn barczak_conforms_on_the_papers_scenes() {
     let gpu = GpuContext::new(&GpuOptions::default()).expect("a GPU adapter (Vulkan or GL)");

@@ -5,10 +5,14 @@
 //!
 //! Reads: the blockers' shapes (their axis-aligned boxes).
 //! Writes: for a query (a test "is this box certainly outside?"), the blockers whose boxes it
-//! does not rule out (each blocker's own box, not only its leaf's), ascending. A box outside
-//! one of a pyramid's bounding planes is outside the pyramid, so the exact test would have
-//! rejected every blocker left out: the database is the same with the index as without
-//! (tested).
+//! does not rule out (each blocker's own box, not only its leaf's), ascending: exactly those
+//! testing every box would keep (tested). A box outside one of a pyramid's bounding planes is
+//! outside the pyramid, so the exact test would have rejected every blocker left out: the
+//! database is the same with the index as without (tested). A plane a box lies wholly inside
+//! is not tested again below it.
+//!
+//! [`clusters`] groups receivers that are near one another, so that they share one search
+//! (see `database`).
 //!
 //! Built once (median splits on the longest axis, up to [`LEAF_SIZE`] blockers a leaf); when
 //! an object moves, its blockers' leaves are refitted and then their ancestors, in place
@@ -62,6 +66,35 @@ pub fn bounds(shape: &Shape) -> (Vec3, Vec3) {
 
 const NONE: u32 = u32::MAX;
 
+/// Groups of at most `size` of the points `centres` (indices), near one another: the points
+/// split at the median of their longest axis until a part holds `size` or fewer.
+pub fn clusters(centres: &[Vec3], size: usize) -> Vec<Vec<u32>> {
+    fn split(centres: &[Vec3], part: &mut [u32], size: usize, out: &mut Vec<Vec<u32>>) {
+        if part.len() <= size.max(1) {
+            out.push(part.to_vec());
+            return;
+        }
+        let (lo, hi) = part.iter().fold(
+            (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+            |(lo, hi), &i| (lo.min(centres[i as usize]), hi.max(centres[i as usize])),
+        );
+        let axis = (hi - lo).max_position();
+        let mid = part.len() / 2;
+        part.select_nth_unstable_by(mid, |a, b| {
+            centres[*a as usize][axis].total_cmp(&centres[*b as usize][axis])
+        });
+        let (left, right) = part.split_at_mut(mid);
+        split(centres, left, size, out);
+        split(centres, right, size, out);
+    }
+    let mut all: Vec<u32> = (0..centres.len() as u32).collect();
+    let mut out = Vec::new();
+    if !all.is_empty() {
+        split(centres, &mut all, size, &mut out);
+    }
+    out
+}
+
 impl BlockerIndex {
     /// The index of `blockers`.
     pub fn new(blockers: &[Blocker]) -> BlockerIndex {
@@ -114,30 +147,34 @@ impl BlockerIndex {
         me
     }
 
-    /// Appends to `out` (cleared first) the blockers whose boxes `outside` does not rule out,
-    /// ascending.
-    pub fn query(&self, outside: impl Fn(Vec3, Vec3) -> bool, out: &mut Vec<u32>) {
+    /// Appends to `out` (cleared first) the blockers whose boxes `cull` does not rule out,
+    /// ascending. `cull(lo, hi, mask)` is asked about a box with the tests still needed
+    /// (`mask`, all ones at the root) and says `None` when the box is certainly outside, else
+    /// the tests its contents still need: a test a box passes wholly (a box inside one of a
+    /// pyramid's half-spaces) is passed by every box inside it, so it is dropped below.
+    pub fn query(&self, cull: impl Fn(Vec3, Vec3, u32) -> Option<u32>, out: &mut Vec<u32>) {
         out.clear();
         if self.nodes.is_empty() {
             return;
         }
-        let mut stack = [0u32; 64];
+        let mut stack = [(0u32, u32::MAX); 64];
         let mut top = 1;
         while top > 0 {
             top -= 1;
-            let node = &self.nodes[stack[top] as usize];
-            if outside(node.lo, node.hi) {
+            let (n, mask) = stack[top];
+            let node = &self.nodes[n as usize];
+            let Some(mask) = cull(node.lo, node.hi, mask) else {
                 continue;
-            }
+            };
             if node.left == NONE {
                 let (f, c) = (node.first as usize, node.count as usize);
                 out.extend(self.order[f..f + c].iter().filter(|&&b| {
                     let (lo, hi) = self.boxes[b as usize];
-                    !outside(lo, hi)
+                    cull(lo, hi, mask).is_some()
                 }));
             } else {
-                stack[top] = node.left;
-                stack[top + 1] = node.right;
+                stack[top] = (node.left, mask);
+                stack[top + 1] = (node.right, mask);
                 top += 2;
             }
         }

@@ -30,7 +30,7 @@
 use glam::Vec3;
 use rayon::prelude::*;
 
-use crate::blocker_index::BlockerIndex;
+use crate::blocker_index::{clusters, BlockerIndex};
 use crate::visibility::{Blocker, LightState, Occlusion, PatchTree, PointLight, Reach};
 
 /// A receiver's geometry.
@@ -60,6 +60,18 @@ impl Receiver {
         match &self.shape {
             ReceiverShape::Patch(t) => t.nodes[node].children,
             ReceiverShape::Object { .. } => None,
+        }
+    }
+    /// A sphere holding the receiver (centre, radius).
+    fn bounds(&self) -> (Vec3, f32) {
+        match &self.shape {
+            ReceiverShape::Patch(t) => {
+                let corners = t.nodes[0].corners;
+                let centre = corners.iter().copied().sum::<Vec3>() / 4.0;
+                let radius = corners.iter().map(|c| (*c - centre).length());
+                (centre, radius.fold(0f32, f32::max))
+            }
+            ReceiverShape::Object { center, radius } => (*center, *radius),
         }
     }
     fn reach(&self, node: usize, light: &PointLight) -> Reach {
@@ -164,10 +176,16 @@ pub struct VisibilityDatabase {
     movable: Option<Vec<u32>>,
 }
 
+/// Receivers whose searches of the blocker index are shared (see [`Shared::recompute`]).
+const GROUP: usize = 8;
+
 /// Whether a light lights a node in this state (it belongs in the light map).
 fn lit(state: Option<LightState>) -> bool {
     matches!(state, Some(LightState::Unblocked | LightState::Partial))
 }
+
+/// A receiver being computed and its entries (`[node][light]`).
+type Member<'a> = (&'a Receiver, &'a mut Vec<Vec<NodeEntry>>);
 
 /// What every receiver's computation reads: the lights, the blockers and their index.
 struct Shared<'a> {
@@ -177,20 +195,55 @@ struct Shared<'a> {
 }
 
 impl Shared<'_> {
-    /// Recomputes every node of `receiver` (its `entries`, `[node][light]`) for every light
-    /// against every blocker (those the index rules out for the root's reach are left out:
-    /// the exact test would reject them).
-    fn recompute(&self, receiver: &Receiver, entries: &mut [Vec<NodeEntry>]) -> usize {
-        let mut candidates = Vec::new();
+    /// Recomputes every node of the receivers of `group` (near one another; each with its
+    /// `entries`, `[node][light]`) for every light against every blocker, those the index
+    /// rules out for a root's reach left out (the exact test would reject them).
+    ///
+    /// Per light, one search of the index with a pyramid from the light around the whole
+    /// group finds the blockers that may reach into any member's pyramid (each lies inside
+    /// it); each member keeps those its own root's reach does not rule out: the blockers a
+    /// search with its own reach would find, for one search per group instead of one per
+    /// member. A light inside the group's sphere searches per member.
+    fn recompute(&self, group: &mut [Member]) -> usize {
+        let spheres: Vec<(Vec3, f32)> = group.iter().map(|(r, _)| r.bounds()).collect();
+        let (lo, hi) = spheres.iter().fold(
+            (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+            |(lo, hi), (c, r)| (lo.min(*c - *r), hi.max(*c + *r)),
+        );
+        let centre = (lo + hi) * 0.5;
+        let radius = spheres
+            .iter()
+            .map(|(c, r)| (*c - centre).length() + r)
+            .fold(0f32, f32::max);
+        // Widened a little, so that rounding never leaves a member's point outside.
+        let radius = radius * (1.0 + 1e-4);
+        let (mut near, mut candidates) = (Vec::new(), Vec::new());
         let mut tests = 0;
-        for l in 0..self.lights.len() {
-            let reach = receiver.reach(0, &self.lights[l]);
-            self.index
-                .query(|lo, hi| reach.rules_out(lo, hi), &mut candidates);
-            for node in entries.iter_mut() {
-                node[l] = NodeEntry::default();
+        for (l, light) in self.lights.iter().enumerate() {
+            let around = match group {
+                [(only, _)] => only.reach(0, light),
+                _ => Reach::around(light, centre, radius),
+            };
+            let shared = !matches!(around, Reach::Everything);
+            if shared {
+                (self.index).query(|lo, hi, mask| around.cull(lo, hi, mask), &mut near);
             }
-            tests += self.visit(receiver, entries, l, 0, None, &candidates, true);
+            for (receiver, entries) in group.iter_mut() {
+                let reach = receiver.reach(0, light);
+                if shared {
+                    candidates.clear();
+                    candidates.extend(near.iter().copied().filter(|&b| {
+                        let (lo, hi) = self.index.bounds_of(b);
+                        !reach.rules_out(lo, hi)
+                    }));
+                } else {
+                    (self.index).query(|lo, hi, mask| reach.cull(lo, hi, mask), &mut candidates);
+                }
+                for node in entries.iter_mut() {
+                    node[l] = NodeEntry::default();
+                }
+                tests += self.visit(receiver, entries, l, 0, None, &candidates, true);
+            }
         }
         tests
     }
@@ -221,12 +274,12 @@ impl Shared<'_> {
         let fresh: Vec<(u32, Occlusion)> = match (&reach, parent) {
             (Reach::Behind, _) => Vec::new(),
             // At a root, a blocker whose box lies outside the reach cannot reach in (the exact
-            // test would say so; the index already left such blockers out of a recomputation).
+            // test would say so; in a recomputation the index already left such blockers out).
             (_, None) => (only.iter().copied())
                 .filter(|&b| self.blockers[b as usize].object != receiver.object)
                 .filter(|&b| {
                     let (lo, hi) = self.index.bounds_of(b);
-                    !reach.rules_out(lo, hi)
+                    full || !reach.rules_out(lo, hi)
                 })
                 .filter_map(&mut test)
                 .collect(),
@@ -313,19 +366,34 @@ impl VisibilityDatabase {
             blockers,
             movable,
         };
-        // Receivers are independent: computed in parallel, the same as one after another.
+        // Receivers are independent: computed in parallel, the same as one after another, in
+        // groups of neighbours that share their searches of the index.
         let scene = Shared {
             lights: &db.lights,
             blockers: &db.blockers,
             index: &db.index,
         };
         let movable = db.movable.as_deref();
-        let tests = (db.receivers.par_iter())
-            .zip(db.entries.par_iter_mut())
-            .map(|(receiver, entries)| {
-                let tests = scene.recompute(receiver, entries);
+        let centres: Vec<Vec3> = db.receivers.iter().map(|r| r.bounds().0).collect();
+        let mut slots: Vec<Option<&mut Vec<Vec<NodeEntry>>>> =
+            db.entries.iter_mut().map(Some).collect();
+        let mut groups: Vec<Vec<Member>> = (clusters(&centres, GROUP).into_iter())
+            .map(|g| {
+                g.into_iter()
+                    .map(|r| {
+                        let entries = slots[r as usize].take().expect("in one group");
+                        (&db.receivers[r as usize], entries)
+                    })
+                    .collect()
+            })
+            .collect();
+        let tests = (groups.par_iter_mut())
+            .map(|group| {
+                let tests = scene.recompute(group);
                 if let Some(movable) = movable {
-                    keep_only(entries, scene.blockers, movable);
+                    for (_, entries) in group.iter_mut() {
+                        keep_only(entries, scene.blockers, movable);
+                    }
                 }
                 tests
             })
@@ -421,7 +489,7 @@ impl VisibilityDatabase {
         for (receiver, entries) in self.receivers.iter().zip(&mut self.entries) {
             if receiver.object == object {
                 // Moved: every node against every blocker (its reach moved).
-                tests += scene.recompute(receiver, entries);
+                tests += scene.recompute(&mut [(receiver, entries)]);
                 if let Some(movable) = &self.movable {
                     keep_only(entries, &self.blockers, movable);
                 }

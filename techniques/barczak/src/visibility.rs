@@ -110,12 +110,18 @@ pub struct Blocker {
 struct Plane {
     n: Vec3,
     d: f32,
+    /// `|n|` per axis: how far a box's corners reach from its centre along `n`, per half-extent.
+    abs_n: Vec3,
 }
 
 impl Plane {
     /// Through `p` with `n` pointing inside.
     fn through(p: Vec3, n: Vec3) -> Plane {
-        Plane { n, d: -n.dot(p) }
+        Plane {
+            n,
+            d: -n.dot(p),
+            abs_n: n.abs(),
+        }
     }
     fn distance(&self, x: Vec3) -> f32 {
         self.n.dot(x) + self.d
@@ -270,34 +276,57 @@ impl Pyramid {
     /// moved `eps` towards the light) covers a share of the pyramid's solid angle.
     fn clips_to_something(&self, vertices: &[Vec3]) -> bool {
         let shift = |k: usize| if k == 4 { self.tolerance.eps } else { 0.0 };
-        // Wholly outside one plane: nothing is left (the common case, decided without clipping).
-        let outside = |(k, plane): (usize, &Plane)| {
-            vertices.iter().all(|v| plane.distance(*v) - shift(k) < 0.0)
-        };
-        if self.planes.iter().enumerate().any(outside) {
-            return false;
-        }
-        let mut poly: Vec<Vec3> = vertices.to_vec();
-        let mut next = Vec::with_capacity(poly.len() + 5);
+        // Wholly outside one plane: nothing is left (the common case, decided without
+        // clipping); wholly inside a plane: that plane clips nothing.
+        let mut cutting = 0u32;
         for (k, plane) in self.planes.iter().enumerate() {
-            let shift = shift(k);
-            next.clear();
-            for i in 0..poly.len() {
-                let (p, q) = (poly[i], poly[(i + 1) % poly.len()]);
-                let (dp, dq) = (plane.distance(p) - shift, plane.distance(q) - shift);
-                if dp >= 0.0 {
-                    next.push(p);
-                }
-                if (dp >= 0.0) != (dq >= 0.0) {
-                    next.push(p + (q - p) * (dp / (dp - dq)));
-                }
+            let (mut any_in, mut all_in) = (false, true);
+            for v in vertices {
+                let d = plane.distance(*v) - shift(k);
+                any_in |= d >= 0.0;
+                all_in &= d >= 0.0;
             }
-            std::mem::swap(&mut poly, &mut next);
-            if poly.len() < 3 {
+            if !any_in {
                 return false;
             }
+            cutting |= (!all_in as u32) << k;
         }
-        solid_angle(self.apex, &poly) > self.tolerance.min_solid_angle
+        if cutting == 0 {
+            return solid_angle(self.apex, vertices) > self.tolerance.min_solid_angle;
+        }
+        thread_local! {
+            /// The clipped polygon and the next one (kept: a database build clips millions).
+            static SCRATCH: std::cell::RefCell<(Vec<Vec3>, Vec<Vec3>)> = Default::default();
+        }
+        SCRATCH.with_borrow_mut(|(poly, next)| {
+            poly.clear();
+            poly.extend_from_slice(vertices);
+            for (k, plane) in self.planes.iter().enumerate() {
+                if cutting & (1 << k) == 0 {
+                    continue;
+                }
+                let shift = shift(k);
+                next.clear();
+                // Each edge p → q in turn, starting with the closing one.
+                let mut p = poly[poly.len() - 1];
+                let mut dp = plane.distance(p) - shift;
+                for &q in poly.iter() {
+                    let dq = plane.distance(q) - shift;
+                    if (dp >= 0.0) != (dq >= 0.0) {
+                        next.push(p + (q - p) * (dp / (dp - dq)));
+                    }
+                    if dq >= 0.0 {
+                        next.push(q);
+                    }
+                    (p, dp) = (q, dq);
+                }
+                std::mem::swap(poly, next);
+                if poly.len() < 3 {
+                    return false;
+                }
+            }
+            solid_angle(self.apex, poly) > self.tolerance.min_solid_angle
+        })
     }
 
     /// Whether all four edges of the pyramid pass through the polygon's interior strictly
@@ -319,17 +348,22 @@ impl Pyramid {
 /// The solid angle the convex polygon `vertices` subtends at `eye` (a fan of spherical
 /// triangles, Van Oosterom and Strackee's formula); points at the eye add nothing.
 fn solid_angle(eye: Vec3, vertices: &[Vec3]) -> f32 {
-    let dirs: Vec<Vec3> = vertices
+    let mut dirs = vertices
         .iter()
         .map(|v| (*v - eye).normalize_or_zero())
-        .filter(|d| *d != Vec3::ZERO)
-        .collect();
+        .filter(|d| *d != Vec3::ZERO);
+    let Some(a) = dirs.next() else {
+        return 0.0;
+    };
+    let Some(mut b) = dirs.next() else {
+        return 0.0;
+    };
     let mut total = 0.0;
-    for i in 1..dirs.len().saturating_sub(1) {
-        let (a, b, c) = (dirs[0], dirs[i], dirs[i + 1]);
+    for c in dirs {
         let num = a.dot(b.cross(c)).abs();
         let den = 1.0 + a.dot(b) + b.dot(c) + c.dot(a);
         total += 2.0 * num.atan2(den);
+        b = c;
     }
     total
 }
@@ -522,6 +556,9 @@ pub struct NodeVisibility {
 /// Where a light's rays to a receiver node run: nowhere (the light is behind it or faces away),
 /// everywhere (a light inside a complex object's bounds: every blocker may shadow it), or
 /// through an occlusion pyramid.
+// Built on the stack for every node and light of a database (millions): boxing the pyramid
+// would allocate each time.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Debug)]
 pub enum Reach {
     Behind,
@@ -561,17 +598,44 @@ impl Reach {
         }
     }
 
+    /// From `light` to anywhere in the sphere (`center`, `radius`), the light's hemisphere
+    /// left out: a pyramid holding every segment from the light to the sphere's points.
+    pub fn around(light: &PointLight, center: Vec3, radius: f32) -> Reach {
+        match Pyramid::to_sphere(light.position, center, radius) {
+            Some(p) => Reach::Pyramid(p),
+            None => Reach::Everything,
+        }
+    }
+
     /// Whether nothing inside the axis-aligned box `lo`..`hi` can reach in: the box lies
     /// outside one of the pyramid's planes (or the light is behind).
     pub fn rules_out(&self, lo: Vec3, hi: Vec3) -> bool {
+        self.cull(lo, hi, u32::MAX).is_none()
+    }
+
+    /// [`Reach::rules_out`] for a search down a hierarchy of boxes: only the planes in `mask`
+    /// (bit k: plane k) are tested; `None` when the box lies outside one of them, else `mask`
+    /// without the planes the box lies wholly inside (every box inside it does too).
+    pub fn cull(&self, lo: Vec3, hi: Vec3, mask: u32) -> Option<u32> {
         match self {
-            Reach::Behind => true,
-            Reach::Everything => false,
+            Reach::Behind => None,
+            Reach::Everything => Some(0),
             Reach::Pyramid(p) => {
                 let (c, e) = ((lo + hi) * 0.5, (hi - lo) * 0.5);
-                p.planes
-                    .iter()
-                    .any(|pl| pl.distance(c) + pl.n.abs().dot(e) < 0.0)
+                let mut left = mask;
+                for (k, pl) in p.planes.iter().enumerate() {
+                    if mask & (1 << k) == 0 {
+                        continue;
+                    }
+                    let (centre, reach) = (pl.distance(c), pl.abs_n.dot(e));
+                    if centre + reach < 0.0 {
+                        return None;
+                    }
+                    if centre - reach >= 0.0 {
+                        left &= !(1 << k);
+                    }
+                }
+                Some(left & 0b11111)
             }
         }
     }
