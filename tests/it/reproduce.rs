@@ -229,6 +229,8 @@ fn barczak2006_writes_five_figures_and_their_tables() {
             "reproduce",
             "barczak2006",
             "--quick",
+            "--test-size",
+            "tiny",
             "--frames",
             "1",
             "--quiet",

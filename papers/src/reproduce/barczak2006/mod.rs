@@ -116,6 +116,8 @@ fn sizes(args: &ReproduceArgs) -> Sizes {
         }
     };
     Sizes {
+        // The test size: every run (and its reference) at 64x48.
+        resolution: if args.tiny() { [64, 48] } else { s.resolution },
         frames: args.frames.unwrap_or(s.frames),
         update_frames: args.frames.unwrap_or(s.update_frames),
         ..s
