@@ -18,7 +18,7 @@ fn a_paper_targets_second_quality_run_renders_no_reference() {
         let out = tmp.path().join(name);
         #[rustfmt::skip]
         let args = ["reproduce", "gaitatzes-quality", "--quick", "--scenes", "cornell",
-                    "--frames", "2", "--quiet"];
+                    "--frames", "2", "--test-size", "tiny", "--quiet"];
         let o = gibench_in(tmp.path(), &args, &out);
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
         let mut runs: Vec<_> = std::fs::read_dir(out.join("runs"))

@@ -187,6 +187,7 @@ fn sizes(target: &str, args: &ReproduceArgs) -> ([u32; 2], u32, u32) {
         (_, true) => ([256, 192], 4, 3),
         (_, false) => ([512, 512], 100, 10),
     };
+    let res = if args.tiny() { [64, 48] } else { res };
     (res, args.frames.unwrap_or(frames), warmup)
 }
 

@@ -100,6 +100,9 @@ fn sizes(args: &ReproduceArgs) -> Sizes {
     if let Some(f) = args.frames {
         s.frames = f;
     }
+    if args.tiny() {
+        s.resolution = [64, 48];
+    }
     if let Some(scene) = args.scenes.first() {
         s.scene = scene.clone();
     }

@@ -93,8 +93,7 @@ pub struct ReproduceArgs {
 /// `--test-size` / `GIBENCH_TEST_SIZE`: sizes for the test suite, not for results.
 #[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum TestSize {
-    /// Two frames, 64x48 for the command targets and Barczak's rooms; Laine's tables on the
-    /// Cornell box only, at 64x48 and 96x72.
+    /// Two frames at 64x48; Laine's tables on the Cornell box only, at 64x48 and 96x72.
     Tiny,
 }
 
