@@ -268,9 +268,14 @@ fn identical_runs_agree_bit_for_bit_and_the_warp_reaches_the_sampler() {
 }
 
 /// The VPLs together carry the flux the first bounce reflects, so each variant's mean
-/// irradiance over the image is the CPU reference's one-bounce mean within the registered
-/// conformance bounds (0.88–1.2), with 64 VPLs, on the spot box and the sun box (measured on
-/// llvmpipe: `ism` 0.92 and 0.99, `ism-classic` 0.93 and 0.90).
+/// irradiance over the image is the CPU reference's one-bounce mean within [`ENERGY`], with 64
+/// VPLs, on the spot box and the sun box (measured on llvmpipe: `ism` 0.92 and 0.99,
+/// `ism-classic` 0.93 and 0.90).
+/// The mean ratio a variant's VPLs keep to the first bounce: 12 % short (64 VPLs miss some of
+/// the light's paths) to 20 % over (light leaking through the imperfect maps' holes on the sun
+/// box); half the flux or double falls far outside.
+const ENERGY: (f64, f64) = (0.88, 1.2);
+
 #[test]
 fn the_vpls_carry_the_first_bounce() {
     for name in ["cornell", "cornell-sun"] {
@@ -290,7 +295,7 @@ fn the_vpls_carry_the_first_bounce() {
             ] {
                 let out = render(harness, info, &pairs);
                 let ratio = mean(&out.indirect, &reference.hit) / want;
-                let (lo, hi) = info.conformance.mean_ratio;
+                let (lo, hi) = ENERGY;
                 eprintln!("{name} {backend} {}: mean ratio {ratio:.4}", info.name);
                 assert!(
                     (lo..=hi).contains(&ratio),

@@ -39,7 +39,8 @@ use gibench_harness::kit::ir::raster::AtlasClear;
 use gibench_harness::kit::passes::DrawSet;
 use gibench_harness::kit::technique::IndirectComponent;
 use gibench_harness::kit::technique::{
-    Conformance, FrameContext, Params, PrepareContext, Prepared, Technique, TechniqueInfo,
+    cornell_boxes, Conformance, FrameContext, Params, PrepareContext, Prepared, Technique,
+    TechniqueInfo,
 };
 use gibench_harness::{wgpu, Error, Result};
 
@@ -53,12 +54,28 @@ const OWN_STAGES: &[gibench_harness::kit::technique::Stage] =
         STAGE_VPL_GENERATION,
     )];
 
-/// Conformance on the Cornell boxes against the one-bounce reference (64 VPLs, 4x4 tiles):
-/// measured relative L1 0.30–0.72 and mean ratio 0.96–1.05 over the spot, area, omni and sun
-/// boxes (the omni and sun boxes are the hard ones: hot spots near the light, few VPLs inside).
-const CONFORMANCE: Conformance = Conformance {
-    max_relative_l1: 0.8,
-    mean_ratio: (0.88, 1.1),
+/// `keller-full`'s known bias on the Cornell boxes against the one-bounce reference (64 VPLs,
+/// 4x4 tiles; measured on lavapipe, 96x72, after three frames): the mean within 5 % of the
+/// reference's; the omni and sun boxes' larger L1 is their hot spots near the light and few
+/// VPLs inside.
+const CONFORMANCE_FULL: Conformance = Conformance {
+    defaults: &cornell_boxes([
+        (0.959, 0.304),
+        (0.965, 0.349),
+        (0.967, 0.720),
+        (1.052, 0.566),
+    ]),
+};
+
+/// `keller-incremental`'s, measured the same way: the same VPL count, some of it kept from
+/// earlier frames.
+const CONFORMANCE_INCREMENTAL: Conformance = Conformance {
+    defaults: &cornell_boxes([
+        (0.973, 0.388),
+        (0.994, 0.420),
+        (0.973, 0.700),
+        (0.956, 0.632),
+    ]),
 };
 
 /// What Keller's VPLs light with `params`: one bounce from single-vertex paths, several with
@@ -86,7 +103,7 @@ pub const FULL: TechniqueInfo = TechniqueInfo {
     required_features: wgpu::Features::empty(),
     required_limits: wgpu::Limits::downlevel_defaults,
     reference: computed_component,
-    conformance: CONFORMANCE,
+    conformance: CONFORMANCE_FULL,
     prepare,
     create: create_full,
 };
@@ -102,7 +119,7 @@ pub const INCREMENTAL: TechniqueInfo = TechniqueInfo {
     required_features: wgpu::Features::empty(),
     required_limits: wgpu::Limits::downlevel_defaults,
     reference: computed_component,
-    conformance: CONFORMANCE,
+    conformance: CONFORMANCE_INCREMENTAL,
     prepare,
     create: create_incremental,
 };
