@@ -374,11 +374,24 @@ impl VisibilityDatabase {
             index: &db.index,
         };
         let movable = db.movable.as_deref();
-        let centres: Vec<Vec3> = db.receivers.iter().map(|r| r.bounds().0).collect();
+        // Patches only: a patch's pyramid is the hull of the light and the patch, inside the
+        // group's. A complex object's is squared around its sphere's cone, and its corners may
+        // stick out of the group's: each object is a group of its own.
+        let patches: Vec<u32> = (0..db.receivers.len() as u32)
+            .filter(|&r| matches!(db.receivers[r as usize].shape, ReceiverShape::Patch(_)))
+            .collect();
+        let centres: Vec<Vec3> = (patches.iter())
+            .map(|&r| db.receivers[r as usize].bounds().0)
+            .collect();
+        let objects = (0..db.receivers.len() as u32)
+            .filter(|r| patches.binary_search(r).is_err())
+            .map(|r| vec![r]);
         let mut slots: Vec<Option<&mut Vec<Vec<NodeEntry>>>> =
             db.entries.iter_mut().map(Some).collect();
         let mut groups: Vec<Vec<Member>> = (clusters(&centres, GROUP).into_iter())
-            .map(|g| {
+            .map(|g| g.into_iter().map(|i| patches[i as usize]).collect())
+            .chain(objects)
+            .map(|g: Vec<u32>| {
                 g.into_iter()
                     .map(|r| {
                         let entries = slots[r as usize].take().expect("in one group");
