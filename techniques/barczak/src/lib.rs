@@ -178,6 +178,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
 fn prepare(params: &Params, ctx: &PrepareContext) -> Result<Prepared> {
     let p = BarczakParams::from_params(params, ctx.resolution)?;
     Ok(Box::new(renderer::Prepared::new(
+        ctx.gpu,
         ctx.scene,
         ctx.bvh,
         &ctx.first_frame,

@@ -223,6 +223,23 @@ pub struct LightMapPass {
     pipeline: wgpu::RenderPipeline,
 }
 
+/// The bytes of the light-map buffer for `leaves` leaves of `res`² texels; an error naming
+/// `light-map-res` when that is more than `limit` (what the device binds).
+pub fn buffer_size(leaves: usize, res: u32, limit: u64) -> Result<u64> {
+    let size = (leaves as u64 * (res * res) as u64 * 16).max(16);
+    if size > limit {
+        return Err(Error::param(
+            "light-map-res",
+            format!(
+                "{res}² texels on each of {leaves} leaves need a {} MB light-map buffer, more than this device binds ({} MB); use a lower light-map-res",
+                size >> 20,
+                limit >> 20
+            ),
+        ));
+    }
+    Ok(size)
+}
+
 impl LightMapPass {
     /// The pass for `leaves` (of `db`), with maps of `maps.res`² texels.
     pub fn new(
@@ -234,19 +251,7 @@ impl LightMapPass {
     ) -> Result<LightMapPass> {
         let device = &gpu.device;
         let res = maps.res;
-        let size = (leaves.tiles.len() as u64 * (res * res) as u64 * 16).max(16);
-        let limit = gpu.max_storage_buffer();
-        if size > limit {
-            return Err(Error::param(
-                "light-map-res",
-                format!(
-                    "{res}² texels on each of {} leaves need a {} MB light-map buffer, more than this device binds ({} MB); use a lower light-map-res",
-                    leaves.tiles.len(),
-                    size >> 20,
-                    limit >> 20
-                ),
-            ));
-        }
+        let size = buffer_size(leaves.tiles.len(), res, gpu.max_storage_buffer())?;
         let texels = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("barczak light maps"),
             size,

@@ -42,7 +42,7 @@ use crate::prt::{self, COEFFS};
 use crate::prt_pass::PrtPass;
 use crate::samples::SampleSettings;
 use crate::schedule::ShadowMapSchedule;
-use crate::setup::{prepare, BarczakScene};
+use crate::setup::{prepare, BarczakScene, LightMapSize};
 
 /// The renderer's settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -83,18 +83,23 @@ pub struct Prepared {
 impl Prepared {
     /// Prepares `scene` at `frame` (light and mover poses).
     pub fn new(
+        gpu: &GpuContext,
         scene: &Scene,
         bvh: &SceneBvh,
         frame: &FrameState,
         settings: &RendererSettings,
     ) -> Result<Prepared> {
+        let light_maps = LightMapSize {
+            res: settings.light_map_res,
+            max_bytes: gpu.max_storage_buffer(),
+        };
         let bz = prepare(
             scene,
             bvh,
             frame,
             &frame.light,
             settings.samples,
-            settings.light_map_res,
+            light_maps,
             settings.max_charts,
         )?;
         let lift = 1e-4 * scene.extent.diagonal;
@@ -236,7 +241,7 @@ impl Renderer {
         frame: &FrameState,
         settings: RendererSettings,
     ) -> Result<Renderer> {
-        let prepared = Prepared::new(scene, bvh, frame, &settings)?;
+        let prepared = Prepared::new(gpu, scene, bvh, frame, &settings)?;
         Renderer::with(gpu, scene, uniforms, gbuffer, frame, settings, prepared)
     }
 

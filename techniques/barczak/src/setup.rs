@@ -75,19 +75,29 @@ pub const CHART_LEVELS: u32 = 2;
 /// memory is no longer the limit: static blockers are folded, see [`crate::database`]).
 pub const MAX_CHARTS: usize = 60_000;
 
+/// The light maps' size: `res`² texels a leaf, in a buffer of at most `max_bytes`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightMapSize {
+    pub res: u32,
+    pub max_bytes: u64,
+}
+
 /// Prepares `scene` at `frame` (the movers' poses) with light `light` (see the module docs).
 /// Errors name the scene when it records no patches and makes more than `max_charts` charts,
-/// before any work per chart.
+/// before any work per chart, and `light-map-res` when the light maps would not fit in
+/// `light_maps.max_bytes`, before the visibility database is built.
 pub fn prepare(
     scene: &Scene,
     bvh: &SceneBvh,
     frame: &FrameState,
     light: &LightPose,
     settings: SampleSettings,
-    light_map_res: u32,
+    light_maps: LightMapSize,
     max_charts: usize,
 ) -> Result<BarczakScene> {
     let patches = scene.receiver_patches(CHART_LEVELS, max_charts)?;
+    let leaves: usize = patches.iter().map(|p| 4usize.pow(p.levels)).sum();
+    crate::lightmap_pass::buffer_size(leaves, light_maps.res, light_maps.max_bytes)?;
     let samples = samples::generate(scene, bvh, light, settings)?;
     let lights: Vec<PointLight> = samples
         .all()
@@ -160,7 +170,7 @@ pub fn prepare(
         .map(|k| first_mover_object + k)
         .collect();
     let (db, _) = VisibilityDatabase::build_keeping_movers(lights, receivers, blockers, &movable);
-    let light_maps = LightMaps::bake(&db, &flux, light_map_res);
+    let light_maps = LightMaps::bake(&db, &flux, light_maps.res);
     Ok(BarczakScene {
         samples,
         flux,

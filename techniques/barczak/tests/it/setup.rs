@@ -5,7 +5,7 @@
 use gibench_barczak::database::ReceiverShape;
 use gibench_barczak::lightmap::{contribution, texel_position};
 use gibench_barczak::samples::SampleSettings;
-use gibench_barczak::setup::{prepare, CHART_LEVELS, MAX_CHARTS};
+use gibench_barczak::setup::{prepare, LightMapSize, CHART_LEVELS, MAX_CHARTS};
 use gibench_barczak::visibility::LightState;
 use gibench_harness::cpu::bvh::SceneBvh;
 use gibench_harness::glam::Vec3;
@@ -39,7 +39,10 @@ fn light_maps_agree_with_ray_casts(name: &str, direct: u32) {
         &frame,
         &frame.light,
         settings,
-        RES,
+        LightMapSize {
+            res: RES,
+            max_bytes: u64::MAX,
+        },
         MAX_CHARTS,
     )
     .unwrap();

@@ -243,6 +243,19 @@ pub fn prepared(
     settings: gibench_barczak::samples::SampleSettings,
     res: u32,
 ) -> gibench_barczak::setup::BarczakScene {
-    use gibench_barczak::setup::{prepare, MAX_CHARTS};
-    prepare(scene, bvh, frame, &frame.light, settings, res, MAX_CHARTS).unwrap()
+    use gibench_barczak::setup::{prepare, LightMapSize, MAX_CHARTS};
+    let light_maps = LightMapSize {
+        res,
+        max_bytes: u64::MAX,
+    };
+    prepare(
+        scene,
+        bvh,
+        frame,
+        &frame.light,
+        settings,
+        light_maps,
+        MAX_CHARTS,
+    )
+    .unwrap()
 }

@@ -79,6 +79,11 @@ fn bad_parameters_are_refused_by_name() {
     // An edge step below the factor leaves pixels the interpolation reads unmasked.
     let e = err("cornell-area", SIZE, &[("edge-step", "1")]);
     assert!(e.contains("edge-step") && e.contains("factor 2"), "{e}");
+    // Light maps bigger than the device binds: refused while preparing (before the visibility
+    // database, which takes most of a minute on a scene of this size), not when the pass is
+    // made.
+    let e = err("sibenik", SIZE, &[("light-map-res", "64")]);
+    assert!(e.contains("light-map-res") && e.contains("MB"), "{e}");
     // VD has no low-resolution pass: any resolution.
     let scene = gibench_test_support::load("cornell-area");
     let config = gibench_test_support::one_frame([97, 72]).build();
