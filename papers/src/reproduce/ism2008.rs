@@ -21,7 +21,6 @@ use gibench_harness::kit::ir::gather::{COMMON_STAGES, STAGE_FILTER, STAGE_VPL_SH
 use gibench_harness::kit::technique::TechniqueInfo;
 use gibench_harness::measure::results::RunResult;
 use gibench_harness::report::{self, Cell, Table};
-use gibench_harness::run::runner::{RunConfig, TimingMode};
 use gibench_harness::run::session::{RunSpec, TechniqueRun};
 use gibench_harness::{Error, Result};
 use gibench_ism::{STAGE_POINT_SPLAT, STAGE_PULL_PUSH, STAGE_RSM, STAGE_VPL_SAMPLING};
@@ -64,7 +63,6 @@ struct Sizes {
     pool: u32,
     frames: u32,
     warmup: u32,
-    shadow_size: u32,
 }
 
 /// The paper's sizes, or `--quick`'s; `--frames` and `--scenes` (its first) override.
@@ -80,7 +78,6 @@ fn sizes(args: &ReproduceArgs) -> Sizes {
             pool: 1 << 18,
             frames: 4,
             warmup: 3,
-            shadow_size: 256,
         }
     } else {
         Sizes {
@@ -94,7 +91,6 @@ fn sizes(args: &ReproduceArgs) -> Sizes {
             pool: 1 << 20,
             frames: 100,
             warmup: 10,
-            shadow_size: 1024,
         }
     };
     if let Some(f) = args.frames {
@@ -183,15 +179,7 @@ fn spec<'s>(args: &ReproduceArgs, scene: &'s gibench_harness::scene::Scene) -> R
     Ok(RunSpec {
         scene,
         runs,
-        config: RunConfig {
-            resolution: s.resolution,
-            frames: s.frames,
-            warmup: s.warmup,
-            first_frame: 0,
-            timing: TimingMode::Both,
-            seed: 1,
-            shadow_size: s.shadow_size,
-        },
+        config: super::paper_config(args, s.resolution, s.frames, s.warmup, false),
         quality: None,
         cache: crate::options::default_reference_cache(),
         out: runs_folder(args),

@@ -23,9 +23,7 @@ use gibench_harness::kit::ir::gather::{COMMON_STAGES, STAGE_VPL_SHADOW_MAPS};
 use gibench_harness::kit::technique::TechniqueInfo;
 use gibench_harness::measure::results::RunResult;
 use gibench_harness::report::{self, Cell, Table};
-use gibench_harness::run::runner::{
-    RunConfig, TimingMode, STAGE_DIRECT_LIGHT, STAGE_DIRECT_SHADOW_MAP, STAGE_GBUFFER,
-};
+use gibench_harness::run::runner::{STAGE_DIRECT_LIGHT, STAGE_DIRECT_SHADOW_MAP, STAGE_GBUFFER};
 use gibench_harness::run::session::{RunSpec, TechniqueRun};
 use gibench_harness::{Error, Result};
 
@@ -240,7 +238,6 @@ type Pair = (String, [u32; 2], RunResult, RunResult);
 fn run_pairs(args: &ReproduceArgs, gpu: Option<&GpuContext>, bars: &Bars) -> Result<Vec<Pair>> {
     let s = sizes(args);
     let scenes = scenes_of("laine-tables", args);
-    let shadow_size = if args.quick { 256 } else { 1024 };
     let laine = TechniqueInfo::find(crate::registry::all(), "laine")?;
     let keller = TechniqueInfo::find(crate::registry::all(), "keller-full")?;
     // Everything that can be checked is checked before the first frame.
@@ -271,15 +268,7 @@ fn run_pairs(args: &ReproduceArgs, gpu: Option<&GpuContext>, bars: &Bars) -> Res
                         TechniqueRun::new(laine, &params, stem(laine.name))?,
                         TechniqueRun::new(keller, &params, stem(keller.name))?,
                     ],
-                    config: RunConfig {
-                        resolution: *res,
-                        frames: s.frames,
-                        warmup: s.warmup,
-                        first_frame: 0,
-                        timing: TimingMode::Both,
-                        seed: 1,
-                        shadow_size,
-                    },
+                    config: super::paper_config(args, *res, s.frames, s.warmup, false),
                     quality: None,
                     cache: crate::options::default_reference_cache(),
                     out: out(args).join("runs"),
