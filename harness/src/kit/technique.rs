@@ -284,6 +284,15 @@ pub struct KnownBias {
 }
 
 impl KnownBias {
+    /// The entry for `scene`.
+    pub const fn new(scene: &'static str, mean_ratio: f64, relative_l1: f64) -> KnownBias {
+        KnownBias {
+            scene,
+            mean_ratio,
+            relative_l1,
+        }
+    }
+
     /// How far the mean ratio may move either way, as a factor. A technique's output is
     /// deterministic for its seed and the reference's mean at 256 samples per pixel moves by
     /// well under 1 % between seeds, so this admits backends' last bits and a reordered sum, and
@@ -332,18 +341,11 @@ impl KnownBias {
 /// [`KnownBias`] entries for the four Cornell boxes, `(mean ratio, relative L1)` in the order
 /// spot (`cornell`), area, omni, sun.
 pub const fn cornell_boxes(m: [(f64, f64); 4]) -> [KnownBias; 4] {
-    const fn at(scene: &'static str, (mean_ratio, relative_l1): (f64, f64)) -> KnownBias {
-        KnownBias {
-            scene,
-            mean_ratio,
-            relative_l1,
-        }
-    }
     [
-        at("cornell", m[0]),
-        at("cornell-area", m[1]),
-        at("cornell-omni", m[2]),
-        at("cornell-sun", m[3]),
+        KnownBias::new("cornell", m[0].0, m[0].1),
+        KnownBias::new("cornell-area", m[1].0, m[1].1),
+        KnownBias::new("cornell-omni", m[2].0, m[2].1),
+        KnownBias::new("cornell-sun", m[3].0, m[3].1),
     ]
 }
 

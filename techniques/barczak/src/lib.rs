@@ -140,22 +140,15 @@ const CONFORMANCE: [KnownBias; 7] = {
         (1.045, 0.673),
         (1.059, 0.431),
     ]);
-    let large = [
-        ("sibenik", 0.784, 0.323),
-        ("sponza", 1.119, 0.321),
-        ("maze", 1.205, 0.468),
-    ];
-    let mut all = [c[0], c[1], c[2], c[3], c[0], c[0], c[0]];
-    let mut i = 0;
-    while i < large.len() {
-        all[4 + i] = KnownBias {
-            scene: large[i].0,
-            mean_ratio: large[i].1,
-            relative_l1: large[i].2,
-        };
-        i += 1;
-    }
-    all
+    [
+        c[0],
+        c[1],
+        c[2],
+        c[3],
+        KnownBias::new("sibenik", 0.784, 0.323),
+        KnownBias::new("sponza", 1.119, 0.321),
+        KnownBias::new("maze", 1.205, 0.468),
+    ]
 };
 
 pub const INFO: TechniqueInfo = TechniqueInfo {
