@@ -4,7 +4,7 @@
 //! table that docs/techniques.md holds (a test checks that each matches).
 
 use clap::Args;
-use gibench_harness::kit::technique::{KnownBias, ParamKind, ParamSpec, TechniqueInfo};
+use gibench_harness::kit::technique::{Converged, KnownBias, ParamKind, ParamSpec, TechniqueInfo};
 use gibench_harness::measure::results::StageKind;
 use gibench_harness::scene::{descriptor, SceneDescriptor};
 use gibench_harness::Result;
@@ -54,7 +54,14 @@ pub(crate) fn exec(args: &ListArgs) -> Result<()> {
             t.default_reference().name(),
             KnownBias::FACTOR,
             KnownBias::L1_SLACK,
-            known_bias(t)
+            known_bias(t.conformance.defaults)
+        );
+        println!(
+            "      converged at {} (held within x{} / +{}): {}",
+            converged_setting(t),
+            Converged::FACTOR,
+            Converged::L1_SLACK,
+            known_bias(t.conformance.converged.boxes)
         );
         println!("      stages: {stages}");
         if t.param_specs().next().is_none() {
@@ -139,24 +146,37 @@ fn stage_list(t: &TechniqueInfo) -> String {
 /// each records per frame and what the conformance test holds it to against its reference.
 fn stage_table() -> String {
     let mut out = String::from(
-        "| technique | its stages (CPU ones marked) | compared with | known bias at the defaults (mean ratio / relative L1) |\n\
-         |---|---|---|---|\n",
+        "| technique | its stages (CPU ones marked) | compared with | known bias at the defaults (mean ratio / relative L1) | converged setting: its residual |\n\
+         |---|---|---|---|---|\n",
     );
     for t in registry::all() {
         out.push_str(&format!(
-            "| `{}` | {} | the {} reference | {} |\n",
+            "| `{}` | {} | the {} reference | {} | {}: {} |\n",
             t.name,
             stage_list(t),
             t.default_reference().name(),
-            known_bias(t)
+            known_bias(t.conformance.defaults),
+            converged_setting(t),
+            known_bias(t.conformance.converged.boxes)
         ));
     }
     out
 }
 
-/// The technique's known bias per scene (`KnownBias`): `scene mean/L1`, comma-separated.
-fn known_bias(t: &TechniqueInfo) -> String {
-    (t.conformance.defaults.iter())
+/// The technique's converged setting (`Converged::params`) and why, or "its defaults".
+fn converged_setting(t: &TechniqueInfo) -> String {
+    let c = &t.conformance.converged;
+    if c.params.is_empty() {
+        format!("its defaults ({})", c.why)
+    } else {
+        format!("`{}` ({})", c.params.join(" "), c.why)
+    }
+}
+
+/// Known biases per scene (`KnownBias`): `scene mean/L1`, comma-separated.
+fn known_bias(entries: &[KnownBias]) -> String {
+    entries
+        .iter()
         .map(|k| format!("{} {}/{}", k.scene, k.mean_ratio, k.relative_l1))
         .collect::<Vec<_>>()
         .join(", ")

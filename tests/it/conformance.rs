@@ -12,7 +12,10 @@
 //!    bias it declares for the scene (`TechniqueInfo::conformance`, `KnownBias`), and the
 //!    output scaled by 1.15 or by 0.87 fails that band (a band that admits them cannot tell a
 //!    technique that lost or gained that much light). The mean ratio is the energy check:
-//!    halving a technique's VPL intensities moves it to about half its known bias.
+//!    halving a technique's VPL intensities moves it to about half its known bias. On the
+//!    Cornell boxes, the same at the technique's converged setting (`Conformance::converged`):
+//!    within ×1.05 of its stated residual, which lies within ±10 % of the reference, and the
+//!    output ×1.1 or ×0.9 fails;
 //!
 //! 5. every stage it times is declared in `TechniqueInfo::stages` (name and GPU or CPU), and
 //!    every GPU stage declares its minimum cost (`Profiler::stage_cost`, the roofline's input,
@@ -22,14 +25,15 @@
 
 use gibench_papers::registry;
 
-use gibench_harness::cpu::reference::{render_reference, ReferenceSettings};
+use gibench_harness::cpu::reference::{render_reference, ReferenceImages, ReferenceSettings};
 use gibench_harness::glam::Vec3;
 use gibench_harness::gpu::profiler::ProfileMode;
 use gibench_harness::gpu::{GpuContext, GpuOptions};
-use gibench_harness::kit::technique::TechniqueInfo;
+use gibench_harness::kit::technique::{Converged, KnownBias, Params, TechniqueInfo};
 use gibench_harness::measure::results::StageKind;
 use gibench_harness::run::quality::IndirectComponent;
 use gibench_harness::run::runner::{Harness, RunConfig};
+use gibench_harness::scene::anim::FrameState;
 use gibench_harness::scene::assets::AssetPaths;
 use gibench_harness::scene::Scene;
 
@@ -43,12 +47,12 @@ fn render(
     gpu: &GpuContext,
     h: &Harness,
     info: &TechniqueInfo,
+    params: &Params,
     config: &RunConfig,
 ) -> (Vec<Vec3>, Vec<String>) {
-    let params = info.parse_params(&[]).expect("defaults parse");
-    let prepared = h.prepare(info, &params, config).expect("prepare");
+    let prepared = h.prepare(info, params, config).expect("prepare");
     let (mut t, compose) = h
-        .build(info, &params, config, &prepared)
+        .build(info, params, config, &prepared)
         .expect("technique builds");
     let mut profiler = h.profiler(info, ProfileMode::Frame);
     for f in 0..FRAMES {
@@ -132,33 +136,14 @@ fn conform_on<'a>(
     let config = gibench_test_support::one_frame(SIZE).frames(FRAMES).build();
     let h = Harness::new(gpu, &scene, &config).unwrap();
     let frame = h.clock.frame(FRAMES - 1);
-    let mut references = Vec::new();
+    let mut references = References::default();
     for info in techniques {
+        let defaults = info.parse_params(&[]).expect("defaults parse");
         let component = info.default_reference();
-        let reference = match references.iter().position(|(c, _)| *c == component) {
-            Some(i) => &references[i].1,
-            None => {
-                let bounces = match component {
-                    IndirectComponent::OneBounce => 1,
-                    IndirectComponent::MultiBounce | IndirectComponent::Direct => 8,
-                };
-                let r = render_reference(
-                    &scene,
-                    &frame,
-                    SIZE,
-                    &ReferenceSettings {
-                        spp: 256,
-                        bounces,
-                        seed: 0,
-                    },
-                );
-                references.push((component, r));
-                &references.last().unwrap().1
-            }
-        };
-        let (a, undeclared) = render(gpu, &h, info, &config);
+        let reference = references.get(&scene, &frame, component);
+        let (a, undeclared) = render(gpu, &h, info, &defaults, &config);
         let b = if twice {
-            render(gpu, &h, info, &config).0
+            render(gpu, &h, info, &defaults, &config).0
         } else {
             a.clone()
         };
@@ -194,27 +179,108 @@ fn conform_on<'a>(
         }
         // 4. Against the declared reference component, within the band around its known bias
         // on this scene; and the band tells a ×1.15 or ×0.87 of the output from it.
-        let want = component.of(reference);
         let Some(known) = info.conformance.on(scene_name) else {
             failures.push(format!("{name}: no known bias declared for this scene"));
             continue;
         };
-        let (ratio, rel_l1) = against(&a, want, &reference.hit);
-        let (lo, hi) = known.mean_ratio_bounds();
+        let held = Held {
+            name: &name,
+            known,
+            factor: KnownBias::FACTOR,
+            slack: KnownBias::L1_SLACK,
+            scales: SCALES,
+        };
+        held.check(&a, component.of(reference), &reference.hit, failures);
+        // 4b. At the converged setting (on the Cornell boxes), once; `direct` has none but its
+        // defaults.
+        let converged = &info.conformance.converged;
+        if let Some(known) = (twice && !converged.params.is_empty())
+            .then(|| converged.on(scene_name))
+            .flatten()
+        {
+            let params = info
+                .parse_params(&converged.given())
+                .expect("the converged setting parses");
+            let component = (info.reference)(&params);
+            let reference = references.get(&scene, &frame, component);
+            let name = format!("{name} at {}", converged.params.join(" "));
+            let (c, _) = render(gpu, &h, info, &params, &config);
+            let held = Held {
+                name: &name,
+                known,
+                factor: Converged::FACTOR,
+                slack: Converged::L1_SLACK,
+                scales: CONVERGED_SCALES,
+            };
+            held.check(&c, component.of(reference), &reference.hit, failures);
+        }
+    }
+}
+
+/// The references of one scene's last frame, one per component, rendered when first asked.
+#[derive(Default)]
+struct References(Vec<(IndirectComponent, ReferenceImages)>);
+
+impl References {
+    fn get(
+        &mut self,
+        scene: &Scene,
+        frame: &FrameState,
+        component: IndirectComponent,
+    ) -> &ReferenceImages {
+        let i = match self.0.iter().position(|(c, _)| *c == component) {
+            Some(i) => i,
+            None => {
+                let bounces = match component {
+                    IndirectComponent::OneBounce => 1,
+                    IndirectComponent::MultiBounce | IndirectComponent::Direct => 8,
+                };
+                let settings = ReferenceSettings {
+                    spp: 256,
+                    bounces,
+                    seed: 0,
+                };
+                let r = render_reference(scene, frame, SIZE, &settings);
+                self.0.push((component, r));
+                self.0.len() - 1
+            }
+        };
+        &self.0[i].1
+    }
+}
+
+/// One entry and the band it is held within.
+struct Held<'a> {
+    name: &'a str,
+    known: &'a KnownBias,
+    factor: f64,
+    slack: f64,
+    /// Uniform scales of the output the band must not admit.
+    scales: [f32; 2],
+}
+
+impl Held<'_> {
+    /// Checks `output` against `want` over the pixels that `hit` geometry, and that each of the
+    /// scales of it fails.
+    fn check(&self, output: &[Vec3], want: &[Vec3], hit: &[bool], failures: &mut Vec<String>) {
+        let name = self.name;
+        let known = self.known;
+        let (ratio, rel_l1) = against(output, want, hit);
+        let (lo, hi) = known.bounds_within(self.factor);
         eprintln!(
-            "{name}: relative L1 error {rel_l1:.4} (at most {:.4}), mean ratio {ratio:.4} ({lo:.4}-{hi:.4}) against the {} reference",
-            known.max_relative_l1(),
-            component.name()
+            "{name}: relative L1 error {rel_l1:.4} (at most {:.4}), mean ratio {ratio:.4} ({lo:.4}-{hi:.4})",
+            known.relative_l1 + self.slack,
         );
-        if let Some(why) = known.check(ratio, rel_l1) {
+        let check = |ratio, rel_l1| known.check_within(self.factor, self.slack, ratio, rel_l1);
+        if let Some(why) = check(ratio, rel_l1) {
             failures.push(format!("{name}: {why}"));
         }
         // A band around zero cannot tell a scale (`direct`: no indirect light at all).
         if known.mean_ratio > 0.0 {
-            for scale in SCALES {
-                let scaled: Vec<Vec3> = a.iter().map(|v| *v * scale).collect();
-                let (ratio, rel_l1) = against(&scaled, want, &reference.hit);
-                if known.check(ratio, rel_l1).is_none() {
+            for scale in self.scales {
+                let scaled: Vec<Vec3> = output.iter().map(|v| *v * scale).collect();
+                let (ratio, rel_l1) = against(&scaled, want, hit);
+                if check(ratio, rel_l1).is_none() {
                     failures.push(format!(
                         "{name}: the output ×{scale} passes its entry too (mean ratio {ratio:.4})"
                     ));
@@ -224,9 +290,40 @@ fn conform_on<'a>(
     }
 }
 
-/// Uniform changes of the output every entry must fail: a band that admits them cannot tell a
-/// technique that lost or gained that much light from its known bias.
+/// Uniform changes of the output every defaults entry must fail: a band that admits them cannot
+/// tell a technique that lost or gained that much light from its known bias.
 const SCALES: [f32; 2] = [1.15, 0.87];
+/// The same for every converged entry.
+const CONVERGED_SCALES: [f32; 2] = [1.1, 0.9];
+
+/// Catches: a converged entry whose setting is not converged (a residual beyond ±10 % of the
+/// reference stated as the method's), or one that names a parameter the technique does not
+/// take, or a box missing. Cheap: reads the declarations only.
+#[test]
+fn every_converged_entry_is_within_ten_percent_and_parses() {
+    let mut failures = Vec::new();
+    for info in registry::all() {
+        let converged = &info.conformance.converged;
+        if let Err(e) = info.parse_params(&converged.given()) {
+            failures.push(format!("{}: {e}", info.name));
+        }
+        for scene in CORNELL_BOXES {
+            match converged.on(scene) {
+                None => failures.push(format!("{}: no converged entry on {scene}", info.name)),
+                // `direct` computes no indirect light: nothing to converge.
+                Some(k) if k.mean_ratio == 0.0 && converged.params.is_empty() => {}
+                Some(k) if (k.mean_ratio - 1.0).abs() > Converged::MAX_RESIDUAL => {
+                    failures.push(format!(
+                        "{}: converged mean ratio {} on {scene}",
+                        info.name, k.mean_ratio
+                    ))
+                }
+                Some(_) => {}
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
 
 /// The mean ratio (Σt / Σr) and relative L1 error (Σ|t − r| / Σr) of `output` against `want`
 /// over the pixels that `hit` geometry, RGB summed.

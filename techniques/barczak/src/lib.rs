@@ -79,8 +79,8 @@ pub use params::BarczakParams;
 
 use gibench_harness::kit::technique::IndirectComponent;
 use gibench_harness::kit::technique::{
-    cornell_boxes, Conformance, FrameContext, KnownBias, Params, PrepareContext, Prepared,
-    Technique, TechniqueInfo,
+    cornell_boxes, Conformance, Converged, FrameContext, KnownBias, Params, PrepareContext,
+    Prepared, Technique, TechniqueInfo,
 };
 use gibench_harness::{wgpu, Error, Result};
 
@@ -163,6 +163,11 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     reference: computed_component,
     conformance: Conformance {
         defaults: &CONFORMANCE,
+        converged: Converged {
+            params: &["vpls=1024"],
+            why: "1024 light samples (16x the defaults): the samples' noise and hot spots shrink; left: the light maps' resolution (8 texels a patch edge) and the random walks' five hits",
+            boxes: &cornell_boxes([(0.952, 0.125), (0.985, 0.125), (0.962, 0.515), (0.973, 0.159)]),
+        },
     },
     prepare,
     create,

@@ -7,8 +7,8 @@
 mod params;
 
 use gibench_harness::kit::technique::{
-    cornell_boxes, prepare_nothing, Conformance, FrameContext, Params, PrepareContext, Prepared,
-    Technique, TechniqueInfo,
+    cornell_boxes, prepare_nothing, Conformance, Converged, FrameContext, Params, PrepareContext,
+    Prepared, Technique, TechniqueInfo,
 };
 use gibench_harness::wgpu;
 use gibench_harness::Result;
@@ -30,6 +30,11 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     // No indirect light at all: a mean ratio of exactly 0 and the all-zero image's relative L1.
     conformance: Conformance {
         defaults: &cornell_boxes([(0.0, 1.0); 4]),
+        converged: Converged {
+            params: &[],
+            why: "nothing to converge: the baseline computes no indirect light at any setting",
+            boxes: &cornell_boxes([(0.0, 1.0); 4]),
+        },
     },
     prepare: prepare_nothing,
     create,

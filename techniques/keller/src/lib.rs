@@ -39,8 +39,8 @@ use gibench_harness::kit::ir::raster::AtlasClear;
 use gibench_harness::kit::passes::DrawSet;
 use gibench_harness::kit::technique::IndirectComponent;
 use gibench_harness::kit::technique::{
-    cornell_boxes, Conformance, FrameContext, Params, PrepareContext, Prepared, Technique,
-    TechniqueInfo,
+    cornell_boxes, Conformance, Converged, FrameContext, Params, PrepareContext, Prepared,
+    Technique, TechniqueInfo,
 };
 use gibench_harness::{wgpu, Error, Result};
 
@@ -65,6 +65,11 @@ const CONFORMANCE_FULL: Conformance = Conformance {
         (0.967, 0.720),
         (1.052, 0.566),
     ]),
+    converged: Converged {
+        params: &["vpls=1024"],
+        why: "1024 VPLs (16x the defaults; 64 per pixel under the 4x4 tiles): the VPLs' noise and hot spots shrink; left: the clamp (k = 10) and the shadow maps' depth bias",
+        boxes: &cornell_boxes([(0.974, 0.100), (0.985, 0.107), (0.991, 0.666), (1.006, 0.210)]),
+    },
 };
 
 /// `keller-incremental`'s, measured the same way: the same VPL count, some of it kept from
@@ -76,6 +81,11 @@ const CONFORMANCE_INCREMENTAL: Conformance = Conformance {
         (0.973, 0.700),
         (0.956, 0.632),
     ]),
+    converged: Converged {
+        params: &["vpls=1024"],
+        why: "1024 VPLs (16x the defaults; 64 per pixel under the 4x4 tiles): the VPLs' noise and hot spots shrink; left: the clamp (k = 10) and the shadow maps' depth bias; the ring still holds paths from earlier frames' light and bunny",
+        boxes: &cornell_boxes([(0.957, 0.326), (0.981, 0.311), (0.983, 0.660), (0.962, 0.429)]),
+    },
 };
 
 /// What Keller's VPLs light with `params`: one bounce from single-vertex paths, several with
