@@ -34,9 +34,9 @@
 //! a side face still leans forward: 84 / 68 / 53 / 37 / 25 % reach the facing wall at the
 //! distances above, and light still spreads.
 //!
-//! `mode=lpv` is plain light propagation volumes (Kaplanyan 2009) for the paper's Figure 6(d):
-//! the same injection, propagation through every cell without occlusion or reflection, the
-//! radiance accumulated everywhere and interpolated from all eight cells.
+//! `mode=lpv` is Kaplanyan's light propagation volumes (2009) for the paper's Figure 6(d)
+//! ([`lpv`]): reflective-shadow-map texels injected as VPLs, his face weights, no occlusion or
+//! reflection, every step accumulated, interpolated from all eight cells.
 //!
 //! Second-order SH per colour channel, in the convention of [`sh`]. Deviations (README): what a
 //! cell sends through a face is normalised so that it passes on exactly its radiance integral
@@ -51,6 +51,7 @@
 //! storage buffers per shader stage, five with `transport=carry` or `pyramid` (checked when the
 //! technique is created).
 
+pub mod lpv;
 mod params;
 pub mod sh;
 pub mod slab;
@@ -64,12 +65,18 @@ use gibench_harness::kit::technique::{
 };
 use gibench_harness::{wgpu, Result};
 
+use gibench_harness::kit::ir::rsm::ReflectiveShadowMap;
+use gibench_harness::kit::passes::needed_cube_faces;
 use gibench_harness::measure::roofline::StageCost;
 use params::PARAMS;
 use volume::{Grid, Mode, Propagation, Reconstruction, Volumes, Voxelizer, CELL_BYTES};
 
 /// Stage: voxelization, combine and injection.
 pub const STAGE_VOXELIZATION: &str = "voxelization";
+/// Stage (`mode=lpv`): the reflective shadow map.
+pub const STAGE_RSM: &str = "rsm";
+/// Stage (`mode=lpv`): its texels injected into the grid.
+pub const STAGE_INJECTION: &str = "injection";
 /// Stage: the propagation iterations.
 pub const STAGE_PROPAGATION: &str = "propagation";
 /// Stage: the per-pixel reconstruction.
@@ -77,6 +84,8 @@ pub const STAGE_RECONSTRUCTION: &str = "reconstruction";
 /// Every stage, declared, in frame order.
 const STAGES: &[gibench_harness::kit::technique::Stage] = &[
     gibench_harness::kit::technique::Stage::gpu(STAGE_VOXELIZATION),
+    gibench_harness::kit::technique::Stage::gpu(STAGE_RSM),
+    gibench_harness::kit::technique::Stage::gpu(STAGE_INJECTION),
     gibench_harness::kit::technique::Stage::gpu(STAGE_PROPAGATION),
     gibench_harness::kit::technique::Stage::gpu(STAGE_RECONSTRUCTION),
 ];
@@ -86,7 +95,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
     name: "gaitatzes",
     paper: "Gaitatzes et al. 2010",
     summary: "voxel SH propagation of indirect light",
-    description: "Gaitatzes et al. 2010 voxel SH light propagation with occlusion and multiple bounces (mode=lpv: plain LPV)",
+    description: "Gaitatzes et al. 2010 voxel SH light propagation with occlusion and multiple bounces (mode=lpv: Kaplanyan's light propagation volumes)",
     stages: &[STAGES],
     params: &[PARAMS],
     required_features: wgpu::Features::empty(),
@@ -116,14 +125,27 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
 /// `gaitatzes`.
 pub struct Gaitatzes {
     _volumes: Volumes,
-    voxelizer: Voxelizer,
-    propagation: Propagation,
+    light: Light,
     reconstruction: Reconstruction,
     iterations: u32,
     grid: u32,
     _output: wgpu::Texture,
     view: wgpu::TextureView,
     costs: Costs,
+}
+
+/// How the grid gets its light and moves it: the paper's voxelization and occluded
+/// propagation, or light propagation volumes' injection and propagation (`mode=lpv`).
+enum Light {
+    Occluded {
+        voxelizer: Box<Voxelizer>,
+        propagation: Propagation,
+    },
+    Lpv {
+        rsm: Box<ReflectiveShadowMap>,
+        injection: lpv::Injection,
+        propagation: lpv::LpvPropagation,
+    },
 }
 
 /// The stages' declared minimum costs ([`gibench_harness::measure::roofline`]), computed once. Cells:
@@ -149,20 +171,16 @@ impl Costs {
                 .plus(StageCost::per_element(cells, 0, 3 * CELL_BYTES, 0));
         // `propagation`, per iteration and cell: its voxel's normal and occupancy read (a
         // vec4, 16 bytes), its SH read once (48: every neighbour reads it, but once is the
-        // minimum) and the next SH written (48); plain LPV also adds into every cell's
-        // accumulation (48 read, 48 written), the occluded mode only in occupied cells (not
-        // counted). Operations: each cell's six face integrals once (6 faces × 3 channels × a
-        // 4-term dot product, 144) and the six incoming lobes added (6 × 3 × 4 FMAs, 144).
-        let accumulate = match grid.mode {
-            Mode::Lpv => CELL_BYTES,
-            Mode::Occluded => 0,
+        // minimum) and the next SH written (48); the accumulation is added to only in
+        // occupied cells (not counted). Operations: each cell's six face integrals once (6
+        // faces × 3 channels × a 4-term dot product, 144) and the six incoming lobes added
+        // (6 × 3 × 4 FMAs, 144). `mode=lpv`: `LpvPropagation::cost`.
+        let propagation = match grid.mode {
+            Mode::Occluded => {
+                StageCost::per_element(cells * iterations as u64, 16 + CELL_BYTES, CELL_BYTES, 288)
+            }
+            Mode::Lpv => lpv::LpvPropagation::cost(cells, iterations),
         };
-        let propagation = StageCost::per_element(
-            cells * iterations as u64,
-            16 + CELL_BYTES + accumulate,
-            CELL_BYTES + accumulate,
-            288,
-        );
         // `reconstruction`: per pixel the G-buffer's depth and normal read (12 bytes) and the
         // irradiance written (Rgba16Float, 8); the accumulation and the voxels' occupancy read
         // once (48 + 16 bytes per cell). Per pixel the position rebuilt from depth (32
@@ -189,22 +207,39 @@ fn create(params: &Params, ctx: &PrepareContext, _: &Prepared) -> Result<Box<dyn
         p.transport,
     );
     let volumes = Volumes::new(gpu, &grid)?;
-    let voxelizer = Voxelizer::new(
-        gpu,
-        &grid,
-        ctx.gpu_scene,
-        ctx.uniforms,
-        ctx.direct,
-        &volumes,
-    )?;
-    let propagation = Propagation::new(gpu, &grid, &volumes)?;
+    let light = match p.mode {
+        Mode::Occluded => Light::Occluded {
+            voxelizer: Box::new(Voxelizer::new(
+                gpu,
+                &grid,
+                ctx.gpu_scene,
+                ctx.uniforms,
+                ctx.direct,
+                &volumes,
+            )?),
+            propagation: Propagation::new(gpu, &grid, &volumes)?,
+        },
+        Mode::Lpv => {
+            let rsm = Box::new(ReflectiveShadowMap::new(
+                gpu,
+                ctx.gpu_scene,
+                ctx.uniforms,
+                lpv::RSM_SIZE,
+            )?);
+            let injection = lpv::Injection::new(gpu, &grid, rsm.buffers(), rsm.texels(), &volumes)?;
+            Light::Lpv {
+                rsm,
+                injection,
+                propagation: lpv::LpvPropagation::new(gpu, &grid, &volumes)?,
+            }
+        }
+    };
     let output = gibench_harness::kit::passes::indirect_target(&gpu.device, ctx.resolution, true);
     let view = output.create_view(&Default::default());
     let reconstruction = Reconstruction::new(gpu, &grid, ctx.gbuffer, &volumes, &view)?;
     Ok(Box::new(Gaitatzes {
         _volumes: volumes,
-        voxelizer,
-        propagation,
+        light,
         reconstruction,
         iterations: p.iterations,
         grid: p.grid,
@@ -219,14 +254,42 @@ impl Technique for Gaitatzes {
         let gpu = ctx.gpu;
         let (scene, uniforms, direct, gbuffer) =
             (ctx.gpu_scene, ctx.uniforms, ctx.direct, ctx.gbuffer);
-        ctx.profiler.gpu_stage(gpu, STAGE_VOXELIZATION, |enc| {
-            self.voxelizer.encode(enc, scene, uniforms, direct)
-        })?;
-        ctx.profiler
-            .stage_cost(STAGE_VOXELIZATION, self.costs.voxelization);
-        ctx.profiler.gpu_stage(gpu, STAGE_PROPAGATION, |enc| {
-            self.propagation.encode(enc, self.iterations)
-        })?;
+        let iterations = self.iterations;
+        match &self.light {
+            Light::Occluded {
+                voxelizer,
+                propagation,
+            } => {
+                ctx.profiler.gpu_stage(gpu, STAGE_VOXELIZATION, |enc| {
+                    voxelizer.encode(enc, scene, uniforms, direct)
+                })?;
+                ctx.profiler
+                    .stage_cost(STAGE_VOXELIZATION, self.costs.voxelization);
+                ctx.profiler.gpu_stage(gpu, STAGE_PROPAGATION, |enc| {
+                    propagation.encode(enc, iterations)
+                })?;
+            }
+            Light::Lpv {
+                rsm,
+                injection,
+                propagation,
+            } => {
+                let directional = ctx.frame.light.is_directional();
+                ctx.profiler.gpu_stage(gpu, STAGE_RSM, |enc| {
+                    rsm.encode(gpu, enc, scene, uniforms, directional)
+                })?;
+                let reached = (needed_cube_faces(&ctx.frame.light).iter())
+                    .filter(|f| **f)
+                    .count();
+                ctx.profiler.stage_cost(STAGE_RSM, rsm.cost(reached as u32));
+                ctx.profiler
+                    .gpu_stage(gpu, STAGE_INJECTION, |enc| injection.encode(enc))?;
+                ctx.profiler.stage_cost(STAGE_INJECTION, injection.cost);
+                ctx.profiler.gpu_stage(gpu, STAGE_PROPAGATION, |enc| {
+                    propagation.encode(enc, iterations)
+                })?;
+            }
+        }
         ctx.profiler
             .stage_cost(STAGE_PROPAGATION, self.costs.propagation);
         ctx.profiler.gpu_stage(gpu, STAGE_RECONSTRUCTION, |enc| {

@@ -24,7 +24,7 @@ pub(crate) const PARAMS: &[ParamSpec] = &[
         name: "mode",
         kind: ParamKind::Choice(&["occluded", "lpv"]),
         default: "occluded",
-        doc: "occluded: the paper's propagation through void cells with reflections at occupied ones (multiple bounces); lpv: plain light propagation volumes (no occlusion, one bounce)",
+        doc: "occluded: the paper's propagation through void cells with reflections at occupied ones (multiple bounces); lpv: Kaplanyan's light propagation volumes (reflective-shadow-map VPLs injected, his face weights, no occlusion, one bounce; transport and albedo do not apply)",
     },
     ParamSpec {
         name: "transport",

@@ -1,7 +1,7 @@
 // Combines the three axes' voxelizations by MAX (Gaitatzes et al. 2010 §4.1) into the voxel
 // buffer, and injects each occupied voxel's direct radiosity B as the initial radiance of the
 // propagation: a VPL's clamped-cosine lobe about the voxel's normal, L(w) = B / pi max(0, n.w).
-// Clears the accumulation (plain LPV: starts it with the injected light).
+// Clears the accumulation. (Plain LPV, `mode=lpv`, injects with lpv.wgsl instead.)
 
 @group(0) @binding(0) var rad_x: texture_2d<f32>;
 @group(0) @binding(1) var nrm_x: texture_2d<f32>;
@@ -76,9 +76,5 @@ fn combine(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     voxels[i] = v;
     propagation[i] = injected;
-    if (MODE == 1u) {
-        accumulation[i] = injected;
-    } else {
-        accumulation[i] = Sh3(vec4<f32>(0.0), vec4<f32>(0.0), vec4<f32>(0.0));
-    }
+    accumulation[i] = Sh3(vec4<f32>(0.0), vec4<f32>(0.0), vec4<f32>(0.0));
 }

@@ -30,3 +30,10 @@ fn cell_index(c: vec3<i32>) -> u32 {
 fn in_grid(c: vec3<i32>) -> bool {
     return all(c >= vec3<i32>(0)) && all(c < vec3<i32>(i32(N)));
 }
+
+// The unit axis of face k (0 +x, 1 -x, 2 +y, 3 -y, 4 +z, 5 -z).
+fn face_axis(k: u32) -> vec3<i32> {
+    var d = vec3<i32>(0);
+    d[k / 2u] = select(1, -1, (k & 1u) == 1u);
+    return d;
+}

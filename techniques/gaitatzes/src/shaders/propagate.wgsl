@@ -9,18 +9,18 @@
 // along the direction of travel (TRANSPORT 1: into void cells, with the neighbour's own angular
 // distribution instead, so a lobe keeps its direction; 2: with the distribution of the
 // neighbour's light within the face's pyramid). Void cells pass the gathered radiance on.
-// Occupied cells (MODE 0) add it to the accumulation as incident radiance and reflect it for
+// Occupied cells add it to the accumulation as incident radiance and reflect it for
 // the next bounce: mirrored along the dominant axis of their normal (the paper's
 // simplification of the rotation to the normal), times the albedo (0.5, the paper's constant,
 // or the voxel's), and send it on through the faces on their lit side only (the side their
 // normal's dominant axis points to: radiance moves through void space, not through walls).
-// Plain LPV (MODE 1): no occupancy, no reflection; every cell accumulates what passes.
+// (Plain LPV, `mode=lpv`, propagates with lpv.wgsl instead.)
 
 // What `faces` writes per cell and `propagate` reads, in two buffers (each the size of an SH
 // buffer, so that the grid's largest fits the same limit): per face k (see face_axis), in
 // rgb, the flux the cell sends through it per channel (0 through a face it does not pass light
 // through); faces 0, 2, 4 (+x, +y, +z) in `senders_pos`, 1, 3, 5 in `senders_neg`. The w
-// components, in face order: face 0, 0 for a void cell (always with MODE 1) and 1 + the
+// components, in face order: face 0, 0 for a void cell and 1 + the
 // dominant axis of its normal for an occupied one; faces 1-3, the voxel's albedo (written only
 // with STORED_ALBEDO).
 struct Sender {
@@ -81,13 +81,6 @@ fn mirror(c: vec4<f32>, axis: u32) -> vec4<f32> {
     return vec4<f32>(c.x, c.y, -c.z, c.w);
 }
 
-// The unit axis of face k (0 +x, 1 -x, 2 +y, 3 -y, 4 +z, 5 -z).
-fn face_axis(k: u32) -> vec3<i32> {
-    var d = vec3<i32>(0);
-    d[k / 2u] = select(1, -1, (k & 1u) == 1u);
-    return d;
-}
-
 fn dominant_axis(n: vec3<f32>) -> u32 {
     let a = abs(n);
     if (a.x >= a.y && a.x >= a.z) {
@@ -97,11 +90,11 @@ fn dominant_axis(n: vec3<f32>) -> u32 {
 }
 
 // Whether cell `j`, whose voxel is `v`, passes light on through its face towards `d`. Void
-// cells pass through every face. Occupied cells (MODE 0) only into void neighbours (radiance
+// cells pass through every face. Occupied cells only into void neighbours (radiance
 // moves through void space, not along the inside of a wall) on the side their normal points
 // to (a wall's back passes nothing on). Faces at the grid's edge let light out.
 fn passes(j: vec3<i32>, v: Voxel, d: vec3<i32>) -> bool {
-    if (MODE != 0u || v.normal.w <= 0.0) {
+    if (v.normal.w <= 0.0) {
         return true;
     }
     let axis = dominant_axis(v.normal.xyz);
@@ -185,7 +178,7 @@ fn faces(@builtin(global_invocation_id) id: vec3<u32>) {
     for (var k = 0u; k < 6u; k++) {
         send(i, k, vec3<f32>(r[k], g[k], b[k]));
     }
-    if (MODE == 0u && v.normal.w > 0.0) {
+    if (v.normal.w > 0.0) {
         send_w(i, 0u, 1.0 + f32(dominant_axis(v.normal.xyz)));
     } else {
         send_w(i, 0u, 0.0);
@@ -253,10 +246,6 @@ fn propagate(@builtin(global_invocation_id) id: vec3<u32>) {
         }
         destination[i] = Sh3(rho.r * mirror(g.r, axis), rho.g * mirror(g.g, axis), rho.b * mirror(g.b, axis));
     } else {
-        if (MODE == 1u) {
-            let a = accumulation[i];
-            accumulation[i] = Sh3(a.r + g.r, a.g + g.g, a.b + g.b);
-        }
         destination[i] = g;
     }
 }

@@ -4,7 +4,9 @@
 // cosine about the surface normal, E = integral of L(w) max(0, -n.w) dw, times the
 // flux-to-irradiance constant 12/7 (sh_irradiance; sh::flux_to_irradiance derives it): the
 // propagation delivers flux as unit-integral cosine lobes, whose band-limited dot product with
-// the cosine is 7/12 of the flux they carry head-on. Expects the G-buffer's read group at 0.
+// the cosine is 7/12 of the flux they carry head-on. Plain LPV (MODE 1) takes the dot product
+// as it is, as light propagation volumes do: its grid holds radiance, not flux through faces.
+// Expects the G-buffer's read group at 0.
 
 @group(0) @binding(0) var<uniform> camera: View;
 @group(0) @binding(1) var gbuffer_depth: texture_2d<f32>;
@@ -53,6 +55,9 @@ fn reconstruct(@builtin(global_invocation_id) id: vec3<u32>) {
     var e = vec3<f32>(0.0);
     if (weight > 0.0) {
         e = vec3<f32>(sh_irradiance(sum.r, n), sh_irradiance(sum.g, n), sh_irradiance(sum.b, n)) / weight;
+        if (MODE == 1u) {
+            e /= SH_FLUX_TO_IRRADIANCE;
+        }
     }
     textureStore(output, px, vec4<f32>(e, 1.0));
 }
