@@ -10,7 +10,7 @@
 //!
 //! What we took as the description: Kaplanyan's SIGGRAPH 2009 course notes and the I3D 2010
 //! paper as public implementations and Kirsch's annotations (2010) read them: RSM texels as
-//! VPLs moved half a cell along their normals, clamped-cosine intensity lobes in two SH bands,
+//! VPLs moved half a cell along their normals (and 1/64 of a cell more: `lpv.wgsl`), clamped-cosine intensity lobes in two SH bands,
 //! flux through the five faces of each neighbour weighted by their solid angles from the
 //! sending cell's centre (0.4006696846 sr for the far face, 0.4234413544 sr for a side face:
 //! [`crate::slab::kaplanyan_weights`] computes them), re-emitted as cosine lobes along the

@@ -5,7 +5,9 @@
 // centre: slab::kaplanyan_weights) and FIXED (the fixed-point range of the injection).
 //
 // Injection, per frame: every texel of the reflective shadow map is a VPL of flux Φ at its
-// surface point, moved half a cell along its normal (against self-illumination) and added to
+// surface point, moved half a cell along its normal (against self-illumination; and 1/64 of a
+// cell more, so that a surface at a cell's centre, where the grid puts the walls on the
+// scene's bounds, lands in the next cell whatever the last bits of its position) and added to
 // the cell it then lies in as a clamped-cosine intensity lobe about its normal, Φ/π max(0, n.ω),
 // divided by the cell's face area to stand for radiance. The sums are taken in fixed point with
 // integer atomics (deterministic whatever the order; GL has no float atomics): `clear` resets
@@ -66,7 +68,7 @@ fn inject(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let n = normalize(rsm_normal[id.x].xyz);
-    let p = rsm_position[id.x].xyz + 0.5 * CELL * n;
+    let p = rsm_position[id.x].xyz + (0.5 + 1.0 / 64.0) * CELL * n;
     let c = vec3<i32>(floor((p - ORIGIN) / CELL));
     if (!in_grid(c)) {
         return;

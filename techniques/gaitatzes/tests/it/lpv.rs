@@ -1,6 +1,7 @@
 //! `mode=lpv`'s passes on the GPU, on every portable backend present: the injection writes
 //! Kaplanyan's clamped-cosine coefficients (√π/2 and √(π/3) times Φ/π, per cell face area)
-//! into the cell half a cell in front of each texel, ignores texels that saw no surface, and
+//! into the cell half a cell in front of each texel (a surface at a cell's centre: the next
+//! cell), ignores texels that saw no surface, and
 //! starts afresh each frame; one propagation step sends a lobe's flux through the neighbours'
 //! faces in the shares of Kaplanyan's solid angles (`slab::kaplanyan_weights`).
 
@@ -115,6 +116,27 @@ fn injection_writes_kaplanyans_coefficients_in_front_of_each_texel() {
                 .count();
             assert_eq!(lit, 2, "{backend} frame {frame}: cells injected");
         }
+        // A surface at a cell's centre (where the grid puts the walls on the scene's bounds)
+        // goes to the next cell along its normal, not to whichever side of the boundary the
+        // last bits of half a cell take it: with cells of 0.3, (0.75 + 0.15) / 0.3 is
+        // 2.9999998 in f32.
+        let g = grid(0.3);
+        let volumes = Volumes::new(&gpu, &g).unwrap();
+        let bufs = [
+            storage(&gpu, &[[0.75, 0.75, 0.75, 1.0]]),
+            storage(&gpu, &[[0.0, 0.0, 1.0, 0.0]]),
+            storage(&gpu, &[[1.0, 1.0, 1.0, 0.0]]),
+        ];
+        let injection = Injection::new(&gpu, &g, [&bufs[0], &bufs[1], &bufs[2]], 1, &volumes)
+            .expect("the injection builds");
+        let mut enc = gpu.device.create_command_encoder(&Default::default());
+        injection.encode(&mut enc);
+        gpu.queue.submit([enc.finish()]);
+        let field = read_f32(&gpu, &volumes.propagation[0]);
+        assert!(
+            field[index(2, 2, 3)] > 0.0,
+            "{backend}: a surface at a cell's centre lands in the next cell"
+        );
     }
 }
 
