@@ -572,13 +572,14 @@ fn quality_table(runs: &[RunResult]) -> Result<Table> {
         rows,
         notes: vec![
             format!(
-                "Both modes at the same grid ({GRID}³), iterations (the paper's per scene), injection and reconstruction, \
+                "Both modes on the same grid ({GRID}³) and reconstruction, \
                  against the reference's two-bounce indirect irradiance ({reference}; the paper's Figure 6(e) is a \
                  2-bounce path-traced reference), over one pair of consecutive \
-                 frames at 256x192. occluded: `gaitatzes` (propagation through void cells, reflection at occupied ones, \
+                 frames at 256x192. occluded: `gaitatzes` at the paper's iterations per scene (the voxels' direct radiosity injected, propagation through void cells, reflection at occupied ones, \
                  accumulation where light arrives); transport carry / pyramid: the same with each lobe's direction kept through \
-                 void cells / with the light of each face's pyramid passed on (gibench's variants, not the paper's); lpv: plain light propagation volumes (Kaplanyan 2009: \
-                 no occlusion, no secondary bounces) at {LPV_FEW}, the scene's and {LPV_MANY} iterations. The paper (Figure 6): plain LPV \"completely fails to reproduce the indirect \
+                 void cells / with the light of each face's pyramid passed on (gibench's variants, not the paper's); lpv: Kaplanyan's light propagation volumes (2009: \
+                 a 64² reflective shadow map's texels injected as VPLs, his face weights, every step accumulated, no occlusion, no secondary bounces) at {LPV_FEW}, the scene's and {LPV_MANY} iterations; \
+                 his faces' solid angles pass on 1.14 times what a cell holds each step (`slab::kaplanyan_weights`), so its brightness grows with the count. The paper (Figure 6): plain LPV \"completely fails to reproduce the indirect \
                  lighting in the room\"; two bounces are needed there."
             ),
             device_note(&all),
