@@ -7,7 +7,7 @@
 //! * [`Voxelizer`] — Reads: the scene (static mesh and movers), materials and textures, the
 //!   direct light (its shadow map). Writes: three per-axis slice atlases (its own), then the
 //!   voxel buffer, the first propagation buffer (the injected direct radiosity) and the
-//!   accumulation (cleared; plain LPV: the injected light).
+//!   accumulation (cleared). (`mode=lpv` injects and propagates with [`crate::lpv`] instead.)
 //! * [`Propagation`] — Reads: the voxel buffer. Writes: its two senders buffers (its own: per
 //!   cell the flux it sends through each face), the propagation buffers (ping-pong) and the
 //!   accumulation.
@@ -31,7 +31,7 @@ pub enum Mode {
     /// Gaitatzes et al. 2010: through void cells only, reflected at occupied ones (secondary
     /// bounces), accumulated where it arrives at occupied cells.
     Occluded,
-    /// Plain light propagation volume (Kaplanyan 2009): through every cell, no reflection,
+    /// Kaplanyan's light propagation volumes ([`crate::lpv`]): through every cell, no reflection,
     /// accumulated everywhere.
     Lpv,
 }
