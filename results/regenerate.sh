@@ -6,7 +6,7 @@
 #   bash results/regenerate.sh            # everything (the targets' times in results/reproduce-all.json, then some minutes more)
 #   bash results/regenerate.sh laine      # only the targets whose output is under results/laine
 #   bash results/regenerate.sh baseline   # only CI's baseline (instruction counts, timing)
-#   bash results/regenerate.sh barczak-scenes  # only barczak on Sibenik, Sponza and Maze
+#   bash results/regenerate.sh barczak-scenes  # only barczak on Sibenik, Sponza, Maze and the conference room
 #   bash results/regenerate.sh roofline        # only the stage-efficiency runs (docs/roofline.md)
 #
 # Paper-size runs (`gibench reproduce all` without --quick) are for a GPU and are not part of
@@ -65,10 +65,10 @@ run results/baseline/instructions.json instructions --write --baseline results/b
 for i in 1 2 3 4 5; do
   run results/baseline/r$i run --frames 20 --warmup 3 --timing stages --resolution 128x96 --no-images --quiet --out results/baseline/r$i
 done
-# Barczak on the papers' large scenes (charts as patches): preparation time, peak memory and
+# Barczak on the papers' large scenes and the conference room (charts as patches): preparation time, peak memory and
 # error against the reference, one process per scene so that the peak is barczak's own
 # (results/barczak-scenes/README.md).
-for s in sibenik sponza maze; do
+for s in sibenik sponza maze conference; do
   run results/barczak-scenes/$s run --scene $s --technique barczak --frames 3 --warmup 0 --timing stages --resolution 128x96 --quality --quiet --out results/barczak-scenes/$s
 done
 # Stage efficiency against the device's bounds (docs/roofline.md): every technique on the

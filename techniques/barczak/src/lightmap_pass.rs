@@ -226,7 +226,7 @@ pub struct LightMapPass {
 /// The bytes of the light-map buffer for `leaves` leaves of `res`² texels; an error naming
 /// `light-map-res` when that is more than `limit` (what the device binds).
 pub fn buffer_size(leaves: usize, res: u32, limit: u64) -> Result<u64> {
-    let size = (leaves as u64 * (res * res) as u64 * 16).max(16);
+    let size = (leaves as u64 * (res * res) as u64 * 12).max(16);
     if size > limit {
         return Err(Error::param(
             "light-map-res",
@@ -328,10 +328,10 @@ impl LightMapPass {
 
     /// Writes `maps` (same leaves and resolution) to the GPU.
     pub fn upload(&self, gpu: &GpuContext, maps: &LightMaps) {
-        let mut data: Vec<[f32; 4]> =
+        let mut data: Vec<[f32; 3]> =
             Vec::with_capacity(self.leaves.tiles.len() * (self.res * self.res) as usize);
         for &(r, n) in &self.leaves.tiles {
-            data.extend(maps.texels(r, n).iter().map(|t| [t.x, t.y, t.z, 0.0]));
+            data.extend(maps.texels(r, n).iter().map(|t| t.to_array()));
         }
         gpu.queue
             .write_buffer(&self.texels, 0, bytemuck::cast_slice(&data));

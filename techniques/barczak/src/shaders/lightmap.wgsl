@@ -14,8 +14,10 @@ struct LightMapParams {
     counts: vec4<u32>,
 };
 @group(2) @binding(0) var<storage, read> lm_params: LightMapParams;
-// Leaf l's texels: lm_texels[l * res * res + j * res + i], i along the leaf's first edge.
-@group(2) @binding(1) var<storage, read> lm_texels: array<vec4<f32>>;
+// Leaf l's texels: texel t = l * res * res + j * res + i (i along the leaf's first edge) is
+// lm_texels[3t .. 3t + 3], its red, green and blue (12 bytes a texel, not a vec4's 16: the
+// conference room's 131,000 leaves fit the buffers a device binds).
+@group(2) @binding(1) var<storage, read> lm_texels: array<f32>;
 
 struct LeafOut {
     @builtin(position) clip: vec4<f32>,
@@ -35,7 +37,8 @@ fn vs_leaf(@location(0) position: vec3<f32>, @location(1) leaf: u32, @location(3
 
 fn texel(leaf: u32, i: u32, j: u32) -> vec3<f32> {
     let res = lm_params.counts.x;
-    return lm_texels[leaf * res * res + j * res + i].xyz;
+    let t = 3u * (leaf * res * res + j * res + i);
+    return vec3<f32>(lm_texels[t], lm_texels[t + 1u], lm_texels[t + 2u]);
 }
 
 @fragment
