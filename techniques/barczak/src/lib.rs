@@ -55,7 +55,9 @@
 //! lights). Stages: `visibility` (CPU: movers in the database, light-map updates, schedule,
 //! pass planning), `shadow-maps`, `light-maps`, `edges`, `low-res`, `lights`, `prt-lighting`
 //! (CPU), `prt`; counters `vpls`, `maps-rendered`, `map-faces` (octahedral faces drawn into:
-//! `face-cull=on` skips those without occluders), `light-draws`, `elements`,
+//! `face-cull=on` skips those without occluders), `light-draws`, `elements`, `passes` and
+//! `passes-unmerged` (the light draws planned, and what the same elements would have needed
+//! before Figure 4-10's render-pass optimiser merged them: its saving, at level `full`),
 //! `light-map-changes`, and the database's size: `patches` (the scene's recorded patches or
 //! generated charts) and `leaves` (their light-mapped sub-patches).
 
@@ -272,6 +274,9 @@ impl Technique for Barczak {
         ctx.profiler.count("map-faces", counts.map_faces as f64);
         ctx.profiler.count("light-draws", counts.light_draws as f64);
         ctx.profiler.count("elements", counts.elements as f64);
+        ctx.profiler.count("passes", counts.passes as f64);
+        ctx.profiler
+            .count("passes-unmerged", counts.passes_unmerged as f64);
         ctx.profiler
             .count("light-map-changes", counts.light_map_changes as f64);
         let (patches, leaves) = self.patches_and_leaves;

@@ -36,7 +36,7 @@ use gibench_harness::{wgpu, Error, Result};
 use crate::database::VisibilityDatabase;
 use crate::lightmap_pass::{color_pass, target_pass, Leaves};
 use crate::lowres::{accumulate, mask_depth, LowRes};
-use crate::passes::{one_per_object, optimise, Element, LightSet};
+use crate::passes::{one_per_object, optimise, total_passes, Element, LightSet};
 use crate::visibility::LightState;
 
 /// Lights one draw handles at most.
@@ -105,6 +105,8 @@ pub struct LightDraws {
     draws: Vec<(Range<u32>, u32)>,
     /// Elements of the last plan (for the results: passes made).
     elements: usize,
+    /// The draws the last plan's elements would have needed unmerged.
+    unmerged: usize,
 }
 
 impl LightDraws {
@@ -147,6 +149,7 @@ impl LightDraws {
             scratch_records: Vec::new(),
             draws: Vec::new(),
             elements: 0,
+            unmerged: 0,
         })
     }
 
@@ -196,7 +199,9 @@ impl LightDraws {
         records.clear();
         self.draws.clear();
         self.elements = 0;
+        self.unmerged = 0;
         for (elements, lookup) in groups {
+            self.unmerged += total_passes(&elements, self.k as usize);
             let elements = if optimise_passes {
                 optimise(elements, self.k as usize)
             } else {
@@ -251,6 +256,12 @@ impl LightDraws {
     /// Elements of the last plan.
     pub fn elements(&self) -> usize {
         self.elements
+    }
+
+    /// The draws (passes) of the last plan, and those its elements would have needed before
+    /// the render-pass optimiser merged them (the same when it did not run): its saving.
+    pub fn passes(&self) -> (usize, usize) {
+        (self.draws.len(), self.unmerged)
     }
 
     /// Records the planned draws into `target` at full resolution: kept for [`Level::Full`]

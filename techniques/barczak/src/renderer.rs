@@ -183,6 +183,10 @@ pub struct FrameCounts {
     /// Draws of lights over leaves (the thesis' passes; the low-resolution pass draws twice).
     pub light_draws: u32,
     pub elements: u32,
+    /// The light draws planned (the thesis' passes) and those the same elements would have
+    /// needed before the render-pass optimiser merged them.
+    pub passes: u32,
+    pub passes_unmerged: u32,
     pub light_map_changes: u32,
 }
 
@@ -501,6 +505,8 @@ impl Renderer {
                 .plan(gpu, &self.bz.db, level.draws(), level == Optimisation::Full)?;
         }
         counts.elements = self.draws.elements() as u32;
+        let (passes, unmerged) = self.draws.passes();
+        (counts.passes, counts.passes_unmerged) = (passes as u32, unmerged as u32);
         Ok(counts)
     }
 
