@@ -71,6 +71,10 @@ done
 for s in sibenik sponza maze conference; do
   run results/barczak-scenes/$s run --scene $s --technique barczak --frames 3 --warmup 0 --timing stages --resolution 128x96 --quality --quiet --out results/barczak-scenes/$s
 done
+# ism's error against the VPL count in finer steps than the ism-vpls target, with either warp
+# (results/ism/README.md: why one count's figure carries its point set's luck).
+run results/ism/vpl-counts sweep --technique ism --sweep vpls=128,192,256,320,384,448,512,576,640,768,1024 --quality --frames 8 --warmup 3 --timing stages --no-images --quiet --out results/ism/vpl-counts
+run results/ism/vpl-counts-flat sweep --technique ism --sweep vpls=128,192,256,320,384,448,512,576,640,768,1024 --param vpl-warp=flat --quality --frames 8 --warmup 3 --timing stages --no-images --quiet --out results/ism/vpl-counts-flat
 # Stage efficiency against the device's bounds (docs/roofline.md): every technique on the
 # Cornell box at the default size, and gaitatzes on Sibenik; `gibench report DIR --detailed`
 # prints their roofline tables.
