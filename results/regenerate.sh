@@ -40,6 +40,7 @@ elif [ "$only" != baseline ]; then
   case "results/gaitatzes/transfer" in "results/$only"*) transfer_only=1 ;; *) transfer_only=0 ;; esac
   case "results/barczak-scenes/" in "results/$only"*) scenes_only=1 ;; *) scenes_only=0 ;; esac
   case "results/roofline/" in "results/$only"*) scenes_only=1 ;; esac
+  case "results/ism/vpl-counts" in "results/$only"*) scenes_only=1 ;; esac
   if [ -n "$targets" ]; then
     echo "== gibench reproduce all --quick --html --only $targets"
     "$g" reproduce all --quick --html --only "$targets" --out results
