@@ -315,6 +315,15 @@ pub const TARGETS: &[Target] = &[
             paper: "sweep --scene gaitatzes-room --technique gaitatzes --sweep transport=cosine,carry,pyramid --param iterations=64 --quality --quality-reference multi-bounce --resolution 512x512 --frames 100 --warmup 10 --timing stages",
         },
     },
+    Target {
+        name: "gaitatzes-sibenik",
+        dir: "gaitatzes/sibenik",
+        what: "gaitatzes' three transports on Sibenik against the multi-bounce reference (32³, the default 12 iterations)",
+        kind: Kind::Command {
+            quick: "sweep --scene sibenik --technique gaitatzes --sweep transport=cosine,carry,pyramid --quality --quality-reference multi-bounce --frames 4 --warmup 3 --timing stages",
+            paper: "sweep --scene sibenik --technique gaitatzes --sweep transport=cosine,carry,pyramid --quality --quality-reference multi-bounce --resolution 512x512 --frames 100 --warmup 10 --timing stages",
+        },
+    },
 ];
 
 /// The order `all --budget` runs the targets in: the papers' headline tables first (Laine's
@@ -345,6 +354,7 @@ pub const PRIORITY: &[&str] = &[
     "gaitatzes-grid",
     "gaitatzes-iterations",
     "gaitatzes-transport",
+    "gaitatzes-sibenik",
     "laine-sibenik-1024",
     "laine-sibenik-vpls",
     "keller-lag",
