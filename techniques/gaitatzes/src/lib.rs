@@ -24,8 +24,11 @@
 //! and 15 % through each side face, and the side lobes send 15 % back, so light diffuses rather
 //! than travels. Between two infinite walls the share of the emitted flux that reaches the
 //! facing wall, converged, is 70 / 45 / 28 / 16 / 9 % at 2 / 4 / 8 / 16 / 30 cells apart; the
-//! rest returns to the emitter as spurious self-irradiance. More iterations or a finer grid do
-//! not recover it. This is the method class's (second-order SH propagation through cell faces,
+//! rest returns to the emitter as spurious self-irradiance; those shares are already the
+//! converged ones, so more iterations do not raise them (between walls a given number of
+//! cells apart). Where light has not yet arrived, more iterations do bring more of it: the
+//! ceiling 16 cells above a lit floor gets 0.09 of its exact irradiance at 64 iterations and
+//! 0.52 converged (results/gaitatzes/transfer/). This is the method class's (second-order SH propagation through cell faces,
 //! as in light propagation volumes), not a missing constant. Two variants, not the paper's:
 //! `transport=carry` keeps each lobe's direction through void cells: all the flux reaches the
 //! facing wall (in about 2.5 iterations per cell), at the price of beams that widen too little
