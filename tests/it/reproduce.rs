@@ -382,3 +382,65 @@ fn carried_targets_name_the_commit_their_files_record() {
     assert!(md.contains("from git 0123abc"), "{md}");
     assert!(!md.contains("(driver )"), "{md}");
 }
+
+/// Catches: a smoke run (`--test-size tiny`, `GIBENCH_TEST_SIZE=tiny`, `--frames`) without
+/// `--out` writing into `results/` over the committed results (it once deleted 12 committed
+/// Laine runs and cut the manifest). Refused before any work, naming `out`; `results/` is
+/// left as it was.
+#[test]
+fn smoke_runs_without_out_are_refused_and_leave_results_alone() {
+    let tmp = tempfile::tempdir().unwrap();
+    let results = tmp.path().join("results");
+    std::fs::create_dir_all(results.join("laine")).unwrap();
+    std::fs::write(results.join("reproduce-all.json"), "committed").unwrap();
+    std::fs::write(results.join("laine/table.md"), "committed").unwrap();
+    for (args, env) in [
+        (
+            &["reproduce", "all", "--quick", "--test-size", "tiny"][..],
+            None,
+        ),
+        (&["reproduce", "all", "--quick"][..], Some("tiny")),
+        (&["reproduce", "all", "--quick", "--frames", "2"][..], None),
+        (
+            &["reproduce", "laine-dispersion", "--quick", "--frames", "2"][..],
+            None,
+        ),
+    ] {
+        let mut c = support::GIBENCH.command();
+        c.current_dir(tmp.path()).args(args);
+        match env {
+            Some(v) => c.env("GIBENCH_TEST_SIZE", v),
+            None => c.env_remove("GIBENCH_TEST_SIZE"),
+        };
+        let o = c.output().unwrap();
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert!(
+            !o.status.success() && stderr.contains("parameter 'out'") && stderr.contains("--out"),
+            "{args:?}: {stderr}"
+        );
+        let mut left: Vec<_> = walk(&results);
+        left.sort();
+        assert_eq!(left, ["laine/table.md", "reproduce-all.json"], "{args:?}");
+        for f in ["reproduce-all.json", "laine/table.md"] {
+            assert_eq!(
+                std::fs::read_to_string(results.join(f)).unwrap(),
+                "committed"
+            );
+        }
+    }
+}
+
+/// The files under `dir`, relative to it.
+fn walk(dir: &std::path::Path) -> Vec<String> {
+    let mut out = Vec::new();
+    for e in std::fs::read_dir(dir).unwrap() {
+        let p = e.unwrap().path();
+        if p.is_dir() {
+            let name = p.file_name().unwrap().to_string_lossy().to_string();
+            out.extend(walk(&p).into_iter().map(|f| format!("{name}/{f}")));
+        } else {
+            out.push(p.file_name().unwrap().to_string_lossy().to_string());
+        }
+    }
+    out
+}

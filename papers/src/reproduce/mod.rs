@@ -296,6 +296,20 @@ pub fn exec(args: &ReproduceArgs) -> Result<()> {
     if let Some(frames) = args.frames {
         crate::params::check_frame_number("frames", frames)?;
     }
+    // A smoke run's tables must not replace the committed results by default.
+    if args.out.is_none() && !args.list && (args.tiny() || args.frames.is_some()) {
+        let what = if args.tiny() {
+            "--test-size tiny (or GIBENCH_TEST_SIZE=tiny)"
+        } else {
+            "--frames"
+        };
+        return Err(Error::param(
+            "out",
+            format!(
+                "{what} makes a smoke run, and without --out it would write into results/, replacing the committed results and their times in results/reproduce-all.json; name a folder (e.g. --out /tmp/smoke), or --out results to replace them on purpose"
+            ),
+        ));
+    }
     if args.tiny() {
         eprintln!(
             "gibench reproduce: TEST SIZE tiny (--test-size / GIBENCH_TEST_SIZE): every target cut to \
