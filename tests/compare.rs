@@ -363,6 +363,62 @@ fn a_run_on_one_side_only_is_listed_and_fails_require_all() {
     assert!(!out.exists(), "nothing is written when --require-all fails");
 }
 
+/// Catches: runs from two devices compared as if from one (their difference read as a
+/// change, neither device named), and a flag that does not label such a comparison. Without
+/// `--cross-device` the command fails naming both devices and the flag, writing nothing; with
+/// it, the verdicts come and the table's notes say ACROSS DEVICES with both names; from one
+/// device, the notes name it.
+#[test]
+fn runs_from_two_devices_are_refused_unless_asked_and_then_labelled() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let cal = serde_json::json!(10.0);
+    synthetic(&dir.join("base"), &BASE, |_| 1.0, cal.clone());
+    let current = [1.01, 0.99, 1.02, 1.0, 0.985];
+    synthetic(&dir.join("current"), &current, |_| 1.0, cal);
+    let device = baseline_direct()["device"]["adapter"]
+        .as_str()
+        .unwrap()
+        .to_string();
+    let (ok, _, stderr) = compare(dir, "base", "current");
+    assert!(
+        ok && stderr.contains(&format!("Both sides on {device}")),
+        "{stderr}"
+    );
+    for i in 0..current.len() {
+        let f = dir.join(format!("current/r{i}/cornell-direct.json"));
+        let mut v: Value = serde_json::from_slice(&std::fs::read(&f).unwrap()).unwrap();
+        v["device"]["adapter"] = serde_json::json!("Other GPU 9000");
+        std::fs::write(&f, serde_json::to_vec_pretty(&v).unwrap()).unwrap();
+    }
+    let out = dir.join("refused");
+    let o = support::GIBENCH
+        .command()
+        .arg("compare")
+        .arg(dir.join("base"))
+        .arg(dir.join("current"))
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success()
+            && stderr.contains("--cross-device")
+            && stderr.contains(&device)
+            && stderr.contains("Other GPU 9000"),
+        "{stderr}"
+    );
+    assert!(!out.exists(), "nothing is written when refused");
+    let (ok, rows, stderr) = compare_with(dir, "base", "current", &["--cross-device"]);
+    assert!(ok && rows.len() == STAGES.len(), "{stderr}");
+    let md = std::fs::read_to_string(dir.join("cmp-base-current/compare.md")).unwrap();
+    assert!(
+        md.contains("ACROSS DEVICES") && md.contains(&device) && md.contains("Other GPU 9000"),
+        "{md}"
+    );
+}
+
 /// The synthetic BASE repeats' factors.
 const BASE: [f64; 5] = [1.0, 1.03, 0.98, 1.01, 0.99];
 

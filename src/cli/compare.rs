@@ -64,6 +64,11 @@ pub(crate) struct CompareArgs {
     /// the exit status.
     #[arg(long, value_enum)]
     fail_on: Option<FailOn>,
+    /// Compare runs made on different devices (adapter and backend) all the same: their
+    /// difference would read as a change, so without this a cross-device comparison is
+    /// refused. Both sides' devices are named either way.
+    #[arg(long)]
+    cross_device: bool,
 }
 
 /// The exit status of `gibench compare --fail-on` when a verdict it names is found (1 is an
@@ -112,6 +117,28 @@ pub(crate) fn exec(args: &CompareArgs) -> Result<ExitCode> {
         base.into_iter().map(|(_, r)| r).collect(),
         current.into_iter().map(|(_, r)| r).collect(),
     );
+    let devices = [devices(&base), devices(&current)];
+    let same_devices = devices[0] == devices[1];
+    if !same_devices && !args.cross_device {
+        return Err(Error::param(
+            "cross-device",
+            format!(
+                "BASE ran on {} and CURRENT on {}: the devices' difference would read as a change; compare runs from one device, or pass --cross-device to compare them anyway",
+                devices[0].join(", "),
+                devices[1].join(", ")
+            ),
+        ));
+    }
+    let device_note = if same_devices {
+        format!("Both sides on {}.", devices[0].join(", "))
+    } else {
+        format!(
+            "ACROSS DEVICES (--cross-device): BASE on {}, CURRENT on {}; the ratios include the devices' difference.",
+            devices[0].join(", "),
+            devices[1].join(", ")
+        )
+    };
+    eprintln!("{device_note}");
     let unmatched = gibench_harness::report::compare::unmatched(&base, &current);
     let listing: Vec<String> = ["BASE", "CURRENT"]
         .iter()
@@ -132,7 +159,8 @@ pub(crate) fn exec(args: &CompareArgs) -> Result<ExitCode> {
     }
     let rows = gibench_harness::report::compare::compare(&base, &current, &settings)?;
     let mut table = gibench_harness::report::compare::compare_table(&rows, &settings);
-    let mut notes = Vec::new();
+    table.notes.push(device_note.clone());
+    let mut notes = vec![device_note];
     if !listing.is_empty() {
         let note = format!("Not compared (on one side only): {}.", listing.join("; "));
         eprintln!("warning: {note}");
@@ -188,6 +216,16 @@ pub(crate) fn exec(args: &CompareArgs) -> Result<ExitCode> {
         }
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// The devices `runs` were made on, as `adapter (backend)`, sorted and without repeats.
+fn devices(runs: &[RunResult]) -> Vec<String> {
+    let mut d: Vec<String> = (runs.iter())
+        .map(|r| format!("{} ({})", r.device.adapter, r.device.backend))
+        .collect();
+    d.sort_unstable();
+    d.dedup();
+    d
 }
 
 /// Refuses a comparison of runs with themselves: BASE and CURRENT the same folder, a results
