@@ -115,6 +115,11 @@ pub struct RunSpec<'s> {
 
 /// What [`execute`] reports as it goes.
 pub enum Progress<'a> {
+    /// A technique's once-per-scene preparation starts (`TechniqueInfo::prepare` and a first
+    /// build: charts, visibility databases, PRT transfer …).
+    Preparing(&'a str),
+    /// It ended, after this many seconds (the frames that follow make no progress until then).
+    Prepared(&'a str, f64),
     /// A technique's pass starts (its name, and "(quality)" for the quality pass).
     Technique(&'a str),
     /// One frame was rendered.
@@ -188,12 +193,18 @@ pub fn execute_skipping(
     let mut prepared = Vec::with_capacity(spec.runs.len());
     let mut skipped = Vec::new();
     for run in &spec.runs {
+        progress(Progress::Preparing(run.info.name));
+        let started = std::time::Instant::now();
         let ready = harness
             .prepare(run.info, &run.params, &spec.config)
             .and_then(|p| {
                 drop(harness.build(run.info, &run.params, &spec.config, &p)?);
                 Ok(p)
             });
+        progress(Progress::Prepared(
+            run.info.name,
+            started.elapsed().as_secs_f64(),
+        ));
         match ready {
             Ok(p) => prepared.push((run, p)),
             Err(e) if skip_unfit => skipped.push(Skipped {

@@ -26,17 +26,33 @@ pub fn execute_skipping_with_bar(
     let executed = match bars {
         Bars::Own(quiet) => {
             let bar = progress_bar(*quiet, spec.total_frames());
+            let scene = &spec.scene.descriptor.name;
             let executed = session::execute_skipping(gpu, spec, skip_unfit, &mut |p| match p {
+                Progress::Preparing(name) => bar.set_message(format!("{name}: preparing")),
+                Progress::Prepared(name, s) => match slow_preparation(name, scene, s) {
+                    Some(line) if !*quiet && bar.is_hidden() => eprintln!("{line}"),
+                    Some(line) if !*quiet => bar.println(line),
+                    _ => {}
+                },
                 Progress::Technique(name) => bar.set_message(name.to_string()),
                 Progress::Frame => bar.inc(1),
             });
             bar.finish_and_clear();
             executed
         }
-        Bars::Shared(all) => session::execute_skipping(gpu, spec, skip_unfit, &mut |p| match p {
-            Progress::Technique(name) => all.technique(name),
-            Progress::Frame => all.frame(),
-        }),
+        Bars::Shared(all) => {
+            let scene = &spec.scene.descriptor.name;
+            session::execute_skipping(gpu, spec, skip_unfit, &mut |p| match p {
+                Progress::Preparing(name) => all.technique(&format!("{name}: preparing")),
+                Progress::Prepared(name, s) => {
+                    if let Some(line) = slow_preparation(name, scene, s) {
+                        all.note(&line);
+                    }
+                }
+                Progress::Technique(name) => all.technique(name),
+                Progress::Frame => all.frame(),
+            })
+        }
     };
     if let Ok((results, skipped)) = &executed {
         for s in skipped {
@@ -52,6 +68,16 @@ pub fn execute_skipping_with_bar(
         }
     }
     executed
+}
+
+/// Preparations shorter than this pass without a line (the bar's message says "preparing"
+/// while they run).
+const SLOW_PREPARATION_S: f64 = 2.0;
+
+/// The line that reports a preparation of `seconds` when it was slow enough to notice.
+fn slow_preparation(technique: &str, scene: &str, seconds: f64) -> Option<String> {
+    (seconds >= SLOW_PREPARATION_S)
+        .then(|| format!("prepared {technique} on {scene} in {seconds:.1} s"))
 }
 
 /// Where a command reports its progress: a bar of its own (hidden when quiet), or its share of
@@ -93,4 +119,18 @@ pub fn progress_bar(quiet: bool, total: u64) -> indicatif::ProgressBar {
         .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
     );
     bar
+}
+
+#[cfg(test)]
+mod tests {
+    /// Catches: every preparation reported (a line per technique per run), or a slow one not:
+    /// barczak's 8-28 s on Sibenik printed nothing until the first frame.
+    #[test]
+    fn only_slow_preparations_get_a_line() {
+        assert_eq!(super::slow_preparation("laine", "cornell", 0.01), None);
+        assert_eq!(
+            super::slow_preparation("barczak", "sibenik", 8.34).as_deref(),
+            Some("prepared barczak on sibenik in 8.3 s")
+        );
+    }
 }
