@@ -168,7 +168,10 @@ pub(crate) fn exec(args: &CompareArgs) -> Result<ExitCode> {
         notes.push(note);
     }
     match args.format {
-        OutputFormat::Table => println!("{}", table.to_terminal()),
+        OutputFormat::Table => println!(
+            "{}",
+            gibench_harness::report::compare::compare_terminal(&rows, &settings, &notes)
+        ),
         OutputFormat::Markdown => print!(
             "{}",
             gibench_harness::report::compare::compare_markdown(

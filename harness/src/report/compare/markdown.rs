@@ -10,7 +10,7 @@ use crate::report::Cell;
 /// is the only one; `cornell/ism/256x192 (vpls=256)` among a sweep's points). The parameters
 /// are read back from the key (`NAME=VALUE` pairs joined by ", "); a key that does not parse so
 /// keeps its whole self.
-fn short_labels(rows: &[CompareRow]) -> BTreeMap<&str, String> {
+pub(super) fn short_labels(rows: &[CompareRow]) -> BTreeMap<&str, String> {
     type Params<'a> = Vec<(&'a str, &'a str)>;
     let mut by_base: BTreeMap<&str, Vec<(&str, Params)>> = BTreeMap::new();
     for r in rows {

@@ -50,7 +50,9 @@ use crate::report::{Cell, Table};
 use crate::{Error, Result};
 
 mod markdown;
+mod terminal;
 pub use markdown::compare_markdown;
+pub use terminal::compare_terminal;
 
 /// Repeats each side needs of every run it is compared on: with 5 against 5 the rank test's
 /// smallest two-sided p-value is 2/252 ≈ 0.008, so a shift can reach alpha 0.05 (with 3
