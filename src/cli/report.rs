@@ -32,6 +32,11 @@ pub(crate) struct ReportArgs {
     /// reference (from their folders), error maps, time versus error.
     #[arg(long)]
     html: bool,
+    /// Also compare the devices the runs were made on: per run made on the first device and
+    /// another, each stage's and the frame's time on both and the speedup (the first device's
+    /// time over the other's), printed and written as `{stem}-speedup.{md,csv,tex}`.
+    #[arg(long)]
+    speedup: bool,
 }
 
 /// `gibench report`: the tables, plots and page of the given results.
@@ -39,6 +44,11 @@ pub(crate) fn exec(args: &ReportArgs) -> Result<()> {
     check_stem(&args.stem)?;
     let runs = read_results_with_folders(&args.inputs)?;
     let results: Vec<RunResult> = runs.iter().map(|(_, r)| r.clone()).collect();
+    // Checked before anything is written.
+    let speedup = args
+        .speedup
+        .then(|| report::speedup_table(&results))
+        .transpose()?;
     let set = OutputSet::begin("out", &args.out)?;
     let table = report::stage_table(&results);
     println!("{}", table.to_terminal());
@@ -49,6 +59,10 @@ pub(crate) fn exec(args: &ReportArgs) -> Result<()> {
         }
     }
     report::write_tables(&table, &args.out, &args.stem)?;
+    if let Some(speedup) = &speedup {
+        println!("{}", speedup.to_terminal());
+        report::write_tables(speedup, &args.out, &format!("{}-speedup", args.stem))?;
+    }
     let mut figures = vec![args.out.join(format!("{}.svg", args.stem))];
     report::stacked_bar_svg(&results, &figures[0], "Per-stage times")?;
     if !report::time_error_points(&results).is_empty() {

@@ -26,6 +26,7 @@ mod layout;
 mod output_sets;
 mod raycast;
 mod readme_examples;
+mod report;
 mod reproduce;
 mod roofline;
 mod run;

@@ -59,6 +59,7 @@ mod pareto;
 mod plot;
 mod roofline;
 mod runs;
+mod speedup;
 mod stages;
 mod table;
 mod terminal;
@@ -72,6 +73,7 @@ pub use plot::{
 };
 pub use roofline::roofline_table;
 pub use runs::stage_ms;
+pub use speedup::speedup_table;
 pub use stages::{
     device_label, stage_table, stage_table_detailed, tile_balance_cell, vpl_count_cell,
 };
