@@ -28,6 +28,12 @@ fn a_paper_targets_second_quality_run_renders_no_reference() {
             .collect();
         runs.sort();
         assert_eq!(runs.len(), 6, "{runs:?}");
+        // A smoke run's tables say so (they must never pass for benchmark results).
+        let md = std::fs::read_to_string(out.join("gaitatzes-quality.md")).unwrap();
+        assert!(
+            md.starts_with("### SMOKE RUN: ") && md.contains("SMOKE RUN (--test-size tiny"),
+            "{md}"
+        );
         runs.iter()
             .map(|p| {
                 let mut v: serde_json::Value =

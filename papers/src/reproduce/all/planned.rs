@@ -147,7 +147,13 @@ impl Planned {
                 self.target.name
             ))),
             (None, Kind::Paper(m)) => {
-                let (tables, runs) = (m.reproduce)(self.target.name, &self.args, gpu, bars)?;
+                let (mut tables, runs) = (m.reproduce)(self.target.name, &self.args, gpu, bars)?;
+                if let Some(smoke) = smoke_marker(&self.args) {
+                    for (table, _) in &mut tables {
+                        table.title = format!("SMOKE RUN: {}", table.title);
+                        table.notes.insert(0, smoke.clone());
+                    }
+                }
                 let mut written = Vec::new();
                 for (table, stem) in &tables {
                     bars.table(table);
@@ -185,4 +191,15 @@ fn set_option(argv: &mut Vec<String>, name: &str, value: &str) {
         Some(i) if i + 1 < argv.len() => argv[i + 1] = value.to_string(),
         _ => argv.extend([name.to_string(), value.to_string()]),
     }
+}
+
+/// The note that marks a paper target's tables as a smoke run's (`--test-size tiny` or a
+/// `--frames` override), so that they never pass for benchmark results; `None` for a real run.
+fn smoke_marker(args: &crate::reproduce::ReproduceArgs) -> Option<String> {
+    let what = match (args.tiny(), args.frames) {
+        (true, _) => "--test-size tiny: every target cut to a few frames at tiny sizes".to_string(),
+        (false, Some(n)) => format!("--frames {n}: every target's frame count overridden"),
+        (false, None) => return None,
+    };
+    Some(format!("SMOKE RUN ({what}): not benchmark results."))
 }
