@@ -319,10 +319,7 @@ fn markdown_lists_regressions_first_and_fail_on_sets_the_status() {
 fn a_run_on_one_side_only_is_listed_and_fails_require_all() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path();
-    let cal = serde_json::json!(10.0);
-    synthetic(&dir.join("base"), &BASE, |_| 1.0, cal.clone());
-    let current = [1.01, 0.99, 1.02, 1.0, 0.985];
-    synthetic(&dir.join("current"), &current, |_| 1.0, cal);
+    let current = unchanged_pair(dir);
     for i in 0..current.len() {
         let d = dir.join(format!("current/r{i}"));
         let mut v: Value =
@@ -372,10 +369,7 @@ fn a_run_on_one_side_only_is_listed_and_fails_require_all() {
 fn runs_from_two_devices_are_refused_unless_asked_and_then_labelled() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path();
-    let cal = serde_json::json!(10.0);
-    synthetic(&dir.join("base"), &BASE, |_| 1.0, cal.clone());
-    let current = [1.01, 0.99, 1.02, 1.0, 0.985];
-    synthetic(&dir.join("current"), &current, |_| 1.0, cal);
+    let current = unchanged_pair(dir);
     let device = baseline_direct()["device"]["adapter"]
         .as_str()
         .unwrap()
@@ -421,6 +415,16 @@ fn runs_from_two_devices_are_refused_unless_asked_and_then_labelled() {
 
 /// The synthetic BASE repeats' factors.
 const BASE: [f64; 5] = [1.0, 1.03, 0.98, 1.01, 0.99];
+
+/// Writes `dir/base` and `dir/current`: the same synthetic run with no change between the
+/// sides, one calibration; returns CURRENT's repeat factors.
+fn unchanged_pair(dir: &Path) -> [f64; 5] {
+    let cal = serde_json::json!(10.0);
+    synthetic(&dir.join("base"), &BASE, |_| 1.0, cal.clone());
+    let current = [1.01, 0.99, 1.02, 1.0, 0.985];
+    synthetic(&dir.join("current"), &current, |_| 1.0, cal);
+    current
+}
 
 /// A hostile edit of a results file: its name, the edit, what the error must say.
 type Edit = (&'static str, fn(&mut Value), &'static str);
