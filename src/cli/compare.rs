@@ -224,7 +224,7 @@ pub(crate) fn exec(args: &CompareArgs) -> Result<ExitCode> {
 /// The devices `runs` were made on, as `adapter (backend)`, sorted and without repeats.
 fn devices(runs: &[RunResult]) -> Vec<String> {
     let mut d: Vec<String> = (runs.iter())
-        .map(|r| format!("{} ({})", r.device.adapter, r.device.backend))
+        .map(gibench_harness::report::device_label)
         .collect();
     d.sort_unstable();
     d.dedup();

@@ -10,14 +10,9 @@
 use super::compare::run_key;
 use super::pareto::frame_time_ms;
 use super::runs::stage_ms;
-use super::{Cell, Table};
+use super::{device_label as device, Cell, Table};
 use crate::measure::results::RunResult;
 use crate::{Error, Result};
-
-/// The device a run was made on, as the table names it.
-fn device(r: &RunResult) -> String {
-    format!("{} ({})", r.device.adapter, r.device.backend)
-}
 
 /// The speedup table of `runs` (see the module docs); an error naming `speedup` when they come
 /// from fewer than two devices or no run was made on two.

@@ -69,7 +69,6 @@ use gibench_harness::kit::technique::{
 use gibench_harness::{wgpu, Result};
 
 use gibench_harness::kit::ir::rsm::ReflectiveShadowMap;
-use gibench_harness::kit::passes::needed_cube_faces;
 use gibench_harness::measure::roofline::StageCost;
 use params::PARAMS;
 use volume::{Grid, Mode, Propagation, Reconstruction, Volumes, Voxelizer, CELL_BYTES};
@@ -77,7 +76,7 @@ use volume::{Grid, Mode, Propagation, Reconstruction, Volumes, Voxelizer, CELL_B
 /// Stage: voxelization, combine and injection.
 pub const STAGE_VOXELIZATION: &str = "voxelization";
 /// Stage (`mode=lpv`): the reflective shadow map.
-pub const STAGE_RSM: &str = "rsm";
+pub const STAGE_RSM: &str = gibench_harness::kit::ir::rsm::STAGE;
 /// Stage (`mode=lpv`): its texels injected into the grid.
 pub const STAGE_INJECTION: &str = "injection";
 /// Stage: the propagation iterations.
@@ -277,14 +276,7 @@ impl Technique for Gaitatzes {
                 injection,
                 propagation,
             } => {
-                let directional = ctx.frame.light.is_directional();
-                ctx.profiler.gpu_stage(gpu, STAGE_RSM, |enc| {
-                    rsm.encode(gpu, enc, scene, uniforms, directional)
-                })?;
-                let reached = (needed_cube_faces(&ctx.frame.light).iter())
-                    .filter(|f| **f)
-                    .count();
-                ctx.profiler.stage_cost(STAGE_RSM, rsm.cost(reached as u32));
+                rsm.record(ctx)?;
                 ctx.profiler
                     .gpu_stage(gpu, STAGE_INJECTION, |enc| injection.encode(enc))?;
                 ctx.profiler.stage_cost(STAGE_INJECTION, injection.cost);

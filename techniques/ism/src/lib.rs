@@ -47,7 +47,7 @@ use gibench_harness::kit::ir::raster::StoreViews;
 use gibench_harness::kit::ir::rsm::ReflectiveShadowMap;
 use gibench_harness::kit::ir::splat::PointSplat;
 use gibench_harness::kit::ir::vpl_sample::{RsmTexels, VplSampler};
-use gibench_harness::kit::passes::{needed_cube_faces, DrawSet};
+use gibench_harness::kit::passes::DrawSet;
 use gibench_harness::kit::technique::{
     cornell_boxes, Conformance, Converged, FrameContext, Params, PrepareContext, Prepared,
     Technique, TechniqueInfo,
@@ -57,7 +57,7 @@ use gibench_harness::{wgpu, Error, Result};
 use params::{CLASSIC_PARAMS, GATHER, OWN_PARAMS};
 
 /// Stage: rendering the reflective shadow map and exporting its texels.
-pub const STAGE_RSM: &str = "rsm";
+pub const STAGE_RSM: &str = gibench_harness::kit::ir::rsm::STAGE;
 /// Stage: sampling the VPLs from the map.
 pub const STAGE_VPL_SAMPLING: &str = "vpl-sampling";
 /// Stage: splatting every VPL's points into its imperfect map.
@@ -317,17 +317,7 @@ fn create_classic(
 impl Technique for Ism {
     fn render(&mut self, ctx: &mut FrameContext) -> Result<()> {
         let gpu = ctx.gpu;
-        let (scene, uniforms) = (ctx.gpu_scene, ctx.uniforms);
-        let directional = ctx.frame.light.is_directional();
-        ctx.profiler.gpu_stage(gpu, STAGE_RSM, |enc| {
-            self.rsm.encode(gpu, enc, scene, uniforms, directional)
-        })?;
-        let reached = needed_cube_faces(&ctx.frame.light)
-            .iter()
-            .filter(|f| **f)
-            .count();
-        ctx.profiler
-            .stage_cost(STAGE_RSM, self.rsm.cost(reached as u32));
+        self.rsm.record(ctx)?;
         ctx.profiler
             .gpu_stage(gpu, STAGE_VPL_SAMPLING, |enc| self.sampler.encode(enc))?;
         ctx.profiler

@@ -22,8 +22,12 @@ use crate::kit::passes::{
     begin_gbuffer_pass, compute_pipeline, draw_light_faces, render_target, scene_pipeline,
     Bindings, FrameUniforms, GpuScene, ALBEDO_FORMAT, DEPTH_FORMAT, NORMAL_FORMAT, PARAMS_USAGE,
 };
+use crate::kit::technique::FrameContext;
 use crate::measure::roofline::StageCost;
 use crate::Result;
+
+/// The stage name the map is timed under ([`ReflectiveShadowMap::record`]).
+pub const STAGE: &str = "rsm";
 
 /// The map, its render pipeline and its export pass (see the module docs).
 pub struct ReflectiveShadowMap {
@@ -161,6 +165,22 @@ impl ReflectiveShadowMap {
     /// Position, normal and reflected-flux buffers (see the module docs).
     pub fn buffers(&self) -> [&wgpu::Buffer; 3] {
         [&self.buffers[0], &self.buffers[1], &self.buffers[2]]
+    }
+
+    /// Records this frame's map as the GPU stage [`STAGE`] with its declared cost (the faces
+    /// the frame's light reaches).
+    pub fn record(&self, ctx: &mut FrameContext) -> Result<()> {
+        let gpu = ctx.gpu;
+        let (scene, uniforms) = (ctx.gpu_scene, ctx.uniforms);
+        let directional = ctx.frame.light.is_directional();
+        ctx.profiler.gpu_stage(gpu, STAGE, |enc| {
+            self.encode(gpu, enc, scene, uniforms, directional)
+        })?;
+        let reached = (crate::kit::passes::needed_cube_faces(&ctx.frame.light).iter())
+            .filter(|f| **f)
+            .count();
+        ctx.profiler.stage_cost(STAGE, self.cost(reached as u32));
+        Ok(())
     }
 
     /// Records the faces `faces` lists (the sun: face 0 only) and the export of every texel.
