@@ -225,6 +225,12 @@ fn merge_shards(dirs: &[PathBuf], out: &Path) -> Result<()> {
     }
     writable_dir("out", out)?;
     let set = OutputSet::begin("out", out)?;
+    let mut stale = Vec::new();
+    if first.command != "sweep" {
+        for scene in &scenes {
+            stale.extend(crate::run::replace_scene_files(&set, out, scene)?);
+        }
+    }
     for (_, _, files) in &results {
         for f in files {
             let bytes = std::fs::read(f).map_err(|e| Error::Io {
@@ -249,6 +255,7 @@ fn merge_shards(dirs: &[PathBuf], out: &Path) -> Result<()> {
             &setting("sweep"),
             out,
             quality,
+            None,
         )?;
         println!("{}", table.to_terminal());
         if html {
@@ -279,7 +286,8 @@ fn merge_shards(dirs: &[PathBuf], out: &Path) -> Result<()> {
             if runs.is_empty() {
                 continue;
             }
-            let (table, files) = crate::run::write_summary(&runs, &notes, out, scene, quality)?;
+            let (table, files) =
+                crate::run::write_summary(&runs, &notes, out, scene, quality, None)?;
             println!("{}", table.to_terminal());
             if html {
                 let page = out.join(format!("{scene}-report.html"));
@@ -302,5 +310,8 @@ fn merge_shards(dirs: &[PathBuf], out: &Path) -> Result<()> {
         first.command,
         out.display()
     );
+    if let Some(note) = crate::run::removed_note(&stale) {
+        eprintln!("{note}");
+    }
     Ok(())
 }

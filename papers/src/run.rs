@@ -90,6 +90,10 @@ pub struct RunArgs {
     /// sweep): tables, images beside the reference, error maps, time versus error.
     #[arg(long)]
     pub html: bool,
+    /// Not an option: set by `reproduce all` for a smoke run (`--test-size tiny`, `--frames`),
+    /// the note its tables carry ([`gibench_harness::report::Table::mark_smoke`]).
+    #[arg(skip)]
+    pub smoke: Option<String>,
     #[command(flatten)]
     pub reference: ReferenceOpts,
     #[command(flatten)]
@@ -370,12 +374,9 @@ pub fn exec(args: &RunArgs) -> Result<()> {
         None => None,
     };
     let set = OutputSet::begin("out", &args.out)?;
-    if args.technique.is_empty() {
-        // A run over every technique says which it skipped; one that skipped none leaves no
-        // earlier run's list behind.
-        for (_, p) in &plans {
-            set.replace_files(&skipped_file(&p.desc.name))?;
-        }
+    let mut stale = Vec::new();
+    for (_, p) in &plans {
+        stale.extend(replace_scene_files(&set, &args.out, &p.desc.name)?);
     }
     let mut ran: Vec<(String, String)> = Vec::new();
     let mut lines: Vec<String> = Vec::new();
@@ -407,8 +408,50 @@ pub fn exec(args: &RunArgs) -> Result<()> {
         }
     }
     set.publish()?;
+    lines.extend(removed_note(&stale));
     eprintln!("{}", lines.join("\n"));
     Ok(())
+}
+
+/// The files about scene `name` as a whole that a run or a merge writes only with some options
+/// (`--html`, `--quality`, a technique skipped), declared replaced in `set`: at publication
+/// those this command did not write are removed, so that no page, plot or list of an earlier
+/// command into `out` is left beside tables of other runs (a page kept the old numbers over
+/// the new images). The run's own results files are not among them: runs of other techniques
+/// made into the same folder stay. Returns those of the files present now.
+pub fn replace_scene_files(set: &OutputSet, out: &Path, name: &str) -> Result<Vec<PathBuf>> {
+    let files = [
+        format!("{name}-report.html"),
+        format!("{name}-rmse-per-frame.svg"),
+        format!("{name}-flicker-per-frame.svg"),
+        format!("{name}-time-vs-error.svg"),
+        skipped_file(name),
+    ];
+    let mut present = Vec::new();
+    for f in files {
+        set.replace_files(&f)?;
+        let path = out.join(&f);
+        if path.is_file() {
+            present.push(path);
+        }
+    }
+    Ok(present)
+}
+
+/// A note naming the files of [`replace_scene_files`] an earlier command had left that this
+/// one removed (`None` if none).
+pub fn removed_note(before: &[PathBuf]) -> Option<String> {
+    let gone: Vec<String> = before
+        .iter()
+        .filter(|p| !p.exists())
+        .map(|p| file_name(p))
+        .collect();
+    (!gone.is_empty()).then(|| {
+        format!(
+            "note: removed {} of an earlier command into this folder (they described other runs than this one's tables)",
+            gone.join(", ")
+        )
+    })
 }
 
 /// Units of equal weight (a run's or a sweep's units share one size and frame count).
@@ -490,8 +533,14 @@ fn run_planned_skipping(
     let notes: Vec<(String, String)> = (skipped.iter())
         .map(|s| (s.technique.clone(), s.reason.clone()))
         .collect();
-    let (table, mut written) =
-        write_summary(&results, &notes, &args.out, name, plan.quality.is_some())?;
+    let (table, mut written) = write_summary(
+        &results,
+        &notes,
+        &args.out,
+        name,
+        plan.quality.is_some(),
+        args.smoke.as_deref(),
+    )?;
     bars.table(&table);
     if !skipped.is_empty() {
         let list: Vec<serde_json::Value> = (skipped.iter())
@@ -534,18 +583,23 @@ fn run_planned_skipping(
 
 /// The tables and plots of a run on scene `name` from its `results` (and the techniques it
 /// `skipped`, with why): `{name}-summary.md/.csv/.tex/.svg` and with `quality` the error
-/// plots, into `out`. `gibench run` and `gibench merge` (pooling shards) both write them here.
-/// Returns the table and the files written.
+/// plots, into `out`, the table marked with `smoke`'s note for a smoke run. `gibench run` and
+/// `gibench merge` (pooling shards) both write them here. Returns the table and the files
+/// written.
 pub fn write_summary(
     results: &[RunResult],
     skipped: &[(String, String)],
     out: &Path,
     name: &str,
     quality: bool,
+    smoke: Option<&str>,
 ) -> Result<(report::Table, Vec<String>)> {
     let mut table = report::stage_table(results);
     for (technique, reason) in skipped {
         table.notes.push(format!("Skipped {technique}: {reason}"));
+    }
+    if let Some(note) = smoke {
+        table.mark_smoke(note);
     }
     let stem = format!("{name}-summary");
     let mut written: Vec<String> = report::write_tables(&table, out, &stem)?

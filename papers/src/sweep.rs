@@ -62,10 +62,16 @@ pub fn exec(args: &SweepArgs) -> Result<()> {
     // The folder's points of this scene, technique and parameter are this sweep's alone: an
     // earlier sweep's points at values this one does not run are removed when it publishes
     // (they would otherwise sit beside its table as if part of it).
+    // Its page and error plot likewise: written only with --html / --quality, an earlier
+    // sweep's would otherwise describe other points.
     if !planned.plans.is_empty() {
         for stale in planned.earlier_points(&args.run.out) {
             gibench_harness::output::replace_in_open_set(&stale)?;
         }
+        let first = &planned.plans[0];
+        let stem = summary_stem(&first.desc.name, first.techniques[0].name, &planned.name);
+        set.replace_files(&format!("{stem}.html"))?;
+        set.replace_files(&format!("{stem}-time-vs-error.svg"))?;
     }
     if let Some(mut record) = record {
         let mut done = "this shard has no points to run".to_string();
@@ -275,6 +281,7 @@ pub fn sweep_planned(
         &name,
         &args.run.out,
         first.quality.is_some(),
+        args.run.smoke.as_deref(),
     )?;
     bars.table(&table);
     let results: Vec<RunResult> = points.iter().map(|(_, r)| r.clone()).collect();
@@ -304,8 +311,9 @@ pub fn sweep_planned(
 
 /// The table and plots of a sweep of `technique` on `scene` over `name` from its `points`
 /// (value, results): `{scene}-{technique}-sweep-{name}.md/.csv/.tex/.svg` and with `quality`
-/// the time-versus-error plot, into `out`. `gibench sweep` and `gibench merge` (pooling
-/// shards) both write them here. Returns the table, the figures and the stem.
+/// the time-versus-error plot, into `out`, the table marked with `smoke`'s note for a smoke
+/// run. `gibench sweep` and `gibench merge` (pooling shards) both write them here. Returns
+/// the table, the figures and the stem.
 pub fn write_summary(
     points: &[(String, RunResult)],
     technique: &str,
@@ -313,15 +321,26 @@ pub fn write_summary(
     name: &str,
     out: &Path,
     quality: bool,
+    smoke: Option<&str>,
 ) -> Result<(report::Table, Vec<PathBuf>, String)> {
     let results: Vec<RunResult> = points.iter().map(|(_, r)| r.clone()).collect();
     let mut table = report::stage_table(&results);
     table.title = format!("{technique} on {scene}: per-stage time (median ms) against {name}");
+    // The swept value leads each row; a setting column would only repeat it.
+    if let Some(c) = table.columns.iter().position(|c| c == "setting") {
+        table.columns.remove(c);
+        table.rows.iter_mut().for_each(|r| {
+            r.remove(c);
+        });
+    }
     table.columns.insert(0, name.to_string());
     for (row, (v, _)) in table.rows.iter_mut().zip(points) {
         row.insert(0, report::Cell::text(v));
     }
-    let stem = format!("{scene}-{technique}-sweep-{name}");
+    if let Some(note) = smoke {
+        table.mark_smoke(note);
+    }
+    let stem = summary_stem(scene, technique, name);
     report::write_tables(&table, out, &stem)?;
     report::sweep_plot_svg(
         points,
@@ -340,4 +359,9 @@ pub fn write_summary(
         figures.push(svg);
     }
     Ok((table, figures, stem))
+}
+
+/// The stem of a sweep's tables, plots and page: `{scene}-{technique}-sweep-{name}`.
+fn summary_stem(scene: &str, technique: &str, name: &str) -> String {
+    format!("{scene}-{technique}-sweep-{name}")
 }

@@ -37,6 +37,15 @@ pub(crate) struct ReportArgs {
     /// time over the other's), printed and written as `{stem}-speedup.{md,csv,tex}`.
     #[arg(long)]
     speedup: bool,
+    /// The summary table's columns after its identifying ones (scene, technique, resolution,
+    /// setting), comma-separated, by header in lower case with `-` for spaces: e.g.
+    /// `frame,fps,relmse,flip` or stage names; `sum` for "Σ stages". Default: every column.
+    #[arg(long, value_delimiter = ',')]
+    columns: Vec<String>,
+    /// Which table files to write: `markdown`, `csv`, `latex` (comma-separated; default all
+    /// three).
+    #[arg(long, value_delimiter = ',')]
+    format: Vec<String>,
 }
 
 /// `gibench report`: the tables, plots and page of the given results.
@@ -49,8 +58,18 @@ pub(crate) fn exec(args: &ReportArgs) -> Result<()> {
         .speedup
         .then(|| report::speedup_table(&results))
         .transpose()?;
+    let formats = if args.format.is_empty() {
+        report::TableFormat::ALL.to_vec()
+    } else {
+        (args.format.iter())
+            .map(|f| report::TableFormat::parse("format", f.trim()))
+            .collect::<Result<Vec<_>>>()?
+    };
+    let mut table = report::stage_table(&results);
+    if !args.columns.is_empty() {
+        table = table.select_columns("columns", &args.columns)?;
+    }
     let set = OutputSet::begin("out", &args.out)?;
-    let table = report::stage_table(&results);
     println!("{}", table.to_terminal());
     if args.detailed {
         for r in &results {
@@ -58,7 +77,7 @@ pub(crate) fn exec(args: &ReportArgs) -> Result<()> {
             println!("{}", report::roofline_table(r).to_terminal());
         }
     }
-    report::write_tables(&table, &args.out, &args.stem)?;
+    report::write_tables_as(&table, &args.out, &args.stem, &formats)?;
     if let Some(speedup) = &speedup {
         println!("{}", speedup.to_terminal());
         report::write_tables(speedup, &args.out, &format!("{}-speedup", args.stem))?;

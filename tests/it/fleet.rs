@@ -233,6 +233,14 @@ fn shards_from_slurm_and_kubernetes_merge_to_the_unsharded_tables() {
             ("SLURM_ARRAY_TASK_COUNT", "3".into()),
         ]
     });
+    // A command target's table at the tiny size is marked as a smoke run's, as the paper
+    // targets' are (it said nothing before).
+    let tiles = slurm.join("single/keller/tiles/cornell-keller-full-sweep-tiles.md");
+    let md = std::fs::read_to_string(&tiles).unwrap();
+    assert!(
+        md.starts_with("### SMOKE RUN: ") && md.contains("SMOKE RUN (--test-size tiny"),
+        "{md}"
+    );
     // The shard and where it came from are printed.
     assert!(
         logs[1].contains("shard 1/3") && logs[1].contains("SLURM_ARRAY_TASK_ID=1"),

@@ -61,9 +61,15 @@ fn verdict(browser: &Path, page: &Path) -> String {
 
 /// The value of attribute `name` (written by the page's scripts) in the DOM Chromium dumps.
 fn attribute(browser: &Path, page: &Path, name: &str) -> String {
+    attribute_in(browser, page, name, None)
+}
+
+/// [`attribute`] with the page opened in a window of `size` ("W,H"; else Chromium's default).
+fn attribute_in(browser: &Path, page: &Path, name: &str, size: Option<&str>) -> String {
     let profile = tempfile::tempdir().unwrap();
     let o = Command::new(browser)
         .args(FLAGS)
+        .args(size.map(|s| format!("--window-size={s}")))
         .arg(format!("--user-data-dir={}", profile.path().display()))
         .arg("--dump-dom")
         .arg(url(page))
@@ -93,12 +99,17 @@ fn assert_clean(browser: &Path, page: &Path) {
 }
 
 fn screenshot(browser: &Path, page: &Path, png: &Path) {
+    screenshot_in(browser, page, png, "1400,2600");
+}
+
+/// [`screenshot`] of a window of `size` ("W,H").
+fn screenshot_in(browser: &Path, page: &Path, png: &Path, size: &str) {
     let profile = tempfile::tempdir().unwrap();
     std::fs::create_dir_all(png.parent().unwrap()).unwrap();
     let o = Command::new(browser)
         .args(FLAGS)
         .arg(format!("--user-data-dir={}", profile.path().display()))
-        .arg("--window-size=1400,2600")
+        .arg(format!("--window-size={size}"))
         .arg(format!("--screenshot={}", png.display()))
         .arg(url(page))
         .output()
@@ -328,5 +339,52 @@ fn reproduce_all_index_page_loads_clean() {
         !html.contains("keller/"),
         "a target that did not run is listed"
     );
+    assert_clean(&browser, &page);
+}
+
+/// The default run's page (every technique with `--quality --html`, as the README's first
+/// command, at a small size) answers on its first screen: opened in a 1400x900 window, every
+/// technique's frame time and error in the glance lie within it (the page's own measure,
+/// `data-first-screen`); a screenshot of that screen is kept in the target folder
+/// (`html-report/first-screen.png`). The glance comes before the stage table, the
+/// time-versus-error plot beside it. Catches the page that opened on the 42-column stage table
+/// with the errors off-screen to the right and the plot 4,900 pixels down (issue 56), and a
+/// glance missing a technique.
+#[test]
+fn default_page_shows_every_techniques_time_and_error_on_its_first_screen() {
+    let Some(browser) = chromium() else { return };
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("run");
+    let cache = tmp.path().join("cache");
+    #[rustfmt::skip]
+    gibench(&[
+        "run", "--quality", "--html", "--resolution", "64x48", "--frames", "2", "--warmup", "3",
+        "--quality-pairs", "1", "--spp", "8", "--quiet",
+        "--out", out.to_str().unwrap(), "--cache", cache.to_str().unwrap(),
+    ]);
+    let runs = std::fs::read_dir(&out)
+        .unwrap()
+        .filter(|e| {
+            let name = e.as_ref().unwrap().file_name();
+            let name = name.to_string_lossy();
+            name.starts_with("cornell-") && name.ends_with(".json") && !name.contains("skipped")
+        })
+        .count();
+    assert!(runs >= 7, "{runs} techniques ran");
+    let page = out.join("cornell-report.html");
+    let html = std::fs::read_to_string(&page).unwrap();
+    let glance = html
+        .find("<table class=\"sortable glance\">")
+        .expect("a glance table");
+    let stages = html.find("Per-stage GPU/CPU time").unwrap();
+    let plot = html.find("src=\"cornell-time-vs-error.svg\"").unwrap();
+    assert!(
+        glance < plot && plot < stages,
+        "glance, plot, then the stage table"
+    );
+    let v = attribute_in(&browser, &page, "data-first-screen", Some("1400,900"));
+    assert_eq!(v, format!("ok {runs}"));
+    let shot = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("html-report/first-screen.png");
+    screenshot_in(&browser, &page, &shot, "1400,900");
     assert_clean(&browser, &page);
 }

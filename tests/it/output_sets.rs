@@ -391,3 +391,40 @@ fn a_link_below_out_is_refused_and_its_target_untouched() {
         assert_eq!(names, ["precious.txt"], "{only}");
     }
 }
+
+/// A run leaves no page, error plot or skipped list of an earlier run on the same scene: after
+/// `run --quality --html`, a plain run into the same folder removes `cornell-report.html` and
+/// the error plots (they described the earlier runs, the page over the new images), says so,
+/// and leaves another scene's page alone. Catches the page kept with old numbers (issue 56).
+#[test]
+fn a_later_run_removes_the_earlier_runs_page_and_error_plots() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    let direct = ["run", "--technique", "direct", "--quiet"];
+    small_ok(&[&direct[..], &["--quality", "--html"]].concat(), &out);
+    let earlier = [
+        "cornell-report.html",
+        "cornell-time-vs-error.svg",
+        "cornell-rmse-per-frame.svg",
+    ];
+    for f in earlier {
+        assert!(out.join(f).is_file(), "{f} not written");
+    }
+    std::fs::write(out.join("sibenik-report.html"), b"another scene's page").unwrap();
+    let o = gibench()
+        .args(direct)
+        .args(SMALL)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{stderr}");
+    for f in earlier {
+        assert!(!out.join(f).exists(), "{f} left behind");
+        assert!(stderr.contains(f), "{f} not named: {stderr}");
+    }
+    assert!(stderr.contains("note: removed"), "{stderr}");
+    assert!(out.join("sibenik-report.html").is_file());
+    assert!(out.join("cornell-summary.md").is_file());
+}

@@ -94,3 +94,102 @@ fn speedup_gives_each_stage_the_ratio_between_two_devices() {
     );
     assert!(!lone.exists());
 }
+
+/// `pdflatex` (TeX Live; `.ci/run` installs it); `None` only when the user skips LaTeX checks
+/// knowingly with `GIBENCH_NO_LATEX=1`.
+fn pdflatex() -> Option<PathBuf> {
+    let found = std::env::var_os("PATH").and_then(|path| {
+        std::env::split_paths(&path)
+            .map(|d| d.join("pdflatex"))
+            .find(|p| p.is_file())
+    });
+    if found.is_none() && std::env::var_os("GIBENCH_NO_LATEX").is_some_and(|v| v == "1") {
+        eprintln!(
+            "SKIPPED: pdflatex is missing and GIBENCH_NO_LATEX=1: the LaTeX table was not compiled"
+        );
+        return None;
+    }
+    Some(found.expect(
+        "pdflatex is missing: the LaTeX tables are compiled in a test. Install TeX Live \
+         (Debian: apt-get install texlive-latex-recommended); GIBENCH_NO_LATEX=1 skips it knowingly",
+    ))
+}
+
+/// `report --format latex --columns frame,relmse,flip,sum` over committed quality runs (Laine's
+/// clamp sweep on Sibenik against one-bounce, gaitatzes' modes against multi-bounce) writes only
+/// the `.tex`, with the identifying columns (scene, technique, resolution, and the setting that
+/// tells a technique's runs apart), then exactly those asked for; it compiles with pdflatex in
+/// a document with booktabs. An unknown column is refused by name, listing those there are,
+/// and nothing is written. Catches a table with every column, rows that read the same (no
+/// setting), and a header LaTeX cannot set ("Σ stages" unescaped fails it: tried).
+#[test]
+fn latex_with_chosen_columns_compiles() {
+    let Some(pdflatex) = pdflatex() else { return };
+    let tmp = tempfile::tempdir().unwrap();
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("results");
+    let runs = tmp.path().join("runs");
+    std::fs::create_dir_all(&runs).unwrap();
+    for f in [
+        "clamp/sibenik-laine/sibenik-laine-clamp-1.json",
+        "clamp/sibenik-laine/sibenik-laine-clamp-30.json",
+        "gaitatzes/quality/runs/gaitatzes-room-gaitatzes-pyramid-256x192.json",
+        "gaitatzes/quality/runs/gaitatzes-room-gaitatzes-256x192.json",
+    ] {
+        let p = root.join(f);
+        std::fs::copy(&p, runs.join(p.file_name().unwrap())).unwrap();
+    }
+    let out = tmp.path().join("out");
+    let report = |columns: &str| {
+        support::GIBENCH.run(&[
+            "report".as_ref(),
+            runs.as_os_str(),
+            "--format".as_ref(),
+            "latex".as_ref(),
+            "--columns".as_ref(),
+            columns.as_ref(),
+            "--stem".as_ref(),
+            "t".as_ref(),
+            "--out".as_ref(),
+            out.as_os_str(),
+        ])
+    };
+    let o = report("frame,nonsense");
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success());
+    assert!(
+        stderr.contains("parameter 'columns'")
+            && stderr.contains("'nonsense'")
+            && stderr.contains("relmse"),
+        "{stderr}"
+    );
+    assert!(!out.join("t.tex").exists());
+    let o = report("frame,relmse,flip,sum");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(!out.join("t.md").exists() && !out.join("t.csv").exists());
+    let tex = std::fs::read_to_string(out.join("t.tex")).unwrap();
+    assert!(
+        tex.contains(
+            "scene & technique & resolution & setting & frame (median ms) & relMSE & FLIP & $\\Sigma$ stages \\\\"
+        ),
+        "{tex}"
+    );
+    assert!(
+        tex.contains("clamp=30") && tex.contains("transport=pyramid"),
+        "{tex}"
+    );
+    std::fs::write(
+        out.join("doc.tex"),
+        "\\documentclass{article}\n\\usepackage{booktabs}\n\\begin{document}\n\\input{t.tex}\n\\end{document}\n",
+    )
+    .unwrap();
+    let o = std::process::Command::new(pdflatex)
+        .args(["-interaction=nonstopmode", "-halt-on-error", "doc.tex"])
+        .current_dir(&out)
+        .output()
+        .unwrap();
+    assert!(
+        o.status.success() && out.join("doc.pdf").is_file(),
+        "{}",
+        String::from_utf8_lossy(&o.stdout)
+    );
+}

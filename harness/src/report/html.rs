@@ -6,7 +6,7 @@
 //! Reads: [`RunResult`]s (and the folder each was read from), tables, SVG figures.
 //! Writes: the page.
 //!
-//! Sections: the summary table and any further tables (a paper's rows beside ours), sortable
+//! Sections: the glance (below), the summary table and any further tables (a paper's rows beside ours), sortable
 //! by any column; per scene, an image viewer flipping or sliding between any two of the
 //! reference's and every technique's images (composed, and indirect light alone at one
 //! exposure), with the FLIP error maps, and a frame player stepping through the (last 16) compared
@@ -20,6 +20,13 @@
 //! advances to another tile of strips of the expected size (`data-players="ok N"`), which
 //! `tests/it/html.rs` reads from headless Chromium. A failed check also shows a warning at the top
 //! of the page (a checkout keeps only some of the images: `results/.gitignore`).
+//!
+//! A page of runs with quality data opens on the glance table ([`report::glance_table`]: per
+//! run frame ms, FPS, the reference component, relMSE, FLIP and Pareto rank) with the
+//! time-versus-error plot beside it; the page records whether every glance row's frame time
+//! and error lie within the window it was opened in (`data-first-screen="ok N"`). The leading
+//! text columns of every table (scene, technique, resolution) stay in view when it scrolls
+//! sideways.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -89,13 +96,17 @@ pub fn relative_url(from_dir: &Path, target: &Path) -> String {
 }
 
 /// A table as sortable HTML (numbers sort numerically; click a header).
-fn table_html(t: &Table) -> String {
+fn table_html(t: &Table, class: &str) -> String {
     let mut h = format!(
-        "<h3>{}</h3>\n<div class=\"scroll\"><table class=\"sortable\"><thead><tr>",
+        "<h3>{}</h3>\n<div class=\"scroll\"><table class=\"sortable {class}\"><thead><tr>",
         esc(&t.title)
     );
-    for c in &t.columns {
-        let _ = write!(h, "<th>{}</th>", esc(c));
+    // The identifying columns (the leading text columns: scene, technique, resolution, ...)
+    // stay in view while the table scrolls sideways.
+    let ids = t.identifying_columns();
+    let id = |c: usize| if c < ids { " class=\"id\"" } else { "" };
+    for (i, c) in t.columns.iter().enumerate() {
+        let _ = write!(h, "<th{}>{}</th>", id(i), esc(c));
     }
     h.push_str("</tr></thead><tbody>\n");
     for row in &t.rows {
@@ -112,8 +123,8 @@ fn table_html(t: &Table) -> String {
         } else {
             "<tr>"
         });
-        for c in row {
-            let _ = write!(h, "<td>{}</td>", esc(&c.display()));
+        for (i, c) in row.iter().enumerate() {
+            let _ = write!(h, "<td{}>{}</td>", id(i), esc(&c.display()));
         }
         h.push_str("</tr>\n");
     }
@@ -145,14 +156,18 @@ impl Page {
     pub fn render(&self, dir: &Path) -> String {
         let mut body = String::new();
         let _ = writeln!(body, "<h1>{}</h1>", esc(&self.title));
+        let shown = self.glance(dir, &mut body);
         body.push_str(&self.provenance());
         for t in &self.tables {
-            body.push_str(&table_html(t));
+            body.push_str(&table_html(t, ""));
         }
         body.push_str(&self.viewers(dir));
-        if !self.figures.is_empty() {
+        let figures: Vec<&PathBuf> = (self.figures.iter())
+            .filter(|f| Some(*f) != shown)
+            .collect();
+        if !figures.is_empty() {
             body.push_str("<h2>Figures</h2>\n");
-            for f in &self.figures {
+            for f in figures {
                 let _ = writeln!(
                     body,
                     "<figure><img class=\"plot\" src=\"{}\" alt=\"{}\"></figure>",
@@ -168,6 +183,28 @@ impl Page {
              <script>{UI_SCRIPT}</script>\n</body>\n</html>\n",
             esc(&self.title)
         )
+    }
+
+    /// The first screen, where a run has quality data: the glance table
+    /// ([`report::glance_table`]) with the time-versus-error plot beside it (if among the
+    /// figures), appended to `body`. Returns the plot shown, which the figures then leave out.
+    fn glance(&self, dir: &Path, body: &mut String) -> Option<&PathBuf> {
+        let runs: Vec<RunResult> = self.runs.iter().map(|(_, r)| r.clone()).collect();
+        let table = report::glance_table(&runs)?;
+        let plot =
+            (self.figures.iter()).find(|f| f.to_string_lossy().ends_with("-time-vs-error.svg"));
+        body.push_str("<section class=\"glance\"><div>");
+        body.push_str(&table_html(&table, "glance"));
+        body.push_str("</div>");
+        if let Some(f) = plot {
+            let _ = write!(
+                body,
+                "<figure><img class=\"plot\" src=\"{}\" alt=\"time versus error\"></figure>",
+                esc(&relative_url(dir, f))
+            );
+        }
+        body.push_str("</section>\n");
+        plot
     }
 
     /// Writes the page to `path` (atomically; staged inside an open output set).
@@ -613,7 +650,10 @@ tr.paper td{background:#fff7e0;font-style:italic}.note{font-size:13px;color:#555
 .strip{display:flex;flex-wrap:wrap;gap:8px}.strip figure{margin:0;font-size:12px;max-width:260px}\
 .thumb{width:256px;image-rendering:pixelated;cursor:pointer}img.plot{max-width:100%}.scroll{overflow-x:auto}\
 .tile{overflow:hidden;line-height:0}.tile img.film{max-width:none;image-rendering:pixelated}\
-dl.provenance{display:grid;grid-template-columns:max-content auto;gap:2px 12px;font-size:14px}dt{font-weight:bold}";
+dl.provenance{display:grid;grid-template-columns:max-content auto;gap:2px 12px;font-size:14px}dt{font-weight:bold}\
+th.id,td.id{position:sticky;z-index:1;background:#fff}th.id{background:#eee}\
+.glance{display:flex;flex-wrap:wrap;gap:16px;align-items:flex-start}.glance>div{max-width:760px}\
+.glance figure{margin:0}.glance img.plot{width:600px}";
 
 /// Runs first: records script errors, `console.error` calls and images that fail to decode,
 /// and on load writes the verdict on the root element.
@@ -656,7 +696,16 @@ q.films.forEach(function(f){if(f.naturalWidth!=+q.p.dataset.stripWidth||f.natura
 var before=q.films.map(function(f){return f.style.transform;});q.p.querySelector('.step').click();\
 var after=q.films.map(function(f){return f.style.transform;});\
 if(+q.p.dataset.frame!==1||before.some(function(t,j){return t===after[j];}))bad.push('player '+k+': the next frame shows the same tile');q.show(0);});\
-document.documentElement.setAttribute('data-players',bad.length?('fail '+JSON.stringify(bad)):('ok '+players.length));});";
+document.documentElement.setAttribute('data-players',bad.length?('fail '+JSON.stringify(bad)):('ok '+players.length));});\
+window.addEventListener('load',function(){document.querySelectorAll('table.sortable').forEach(function(t){\
+Array.prototype.forEach.call(t.rows,function(row){var left=0;for(var c=0;c<row.cells.length&&row.cells[c].classList.contains('id');c++){\
+row.cells[c].style.left=left+'px';left+=row.cells[c].offsetWidth;}});});\
+var g=document.querySelector('table.glance');if(!g)return;var cols=[];\
+Array.prototype.forEach.call(g.tHead.rows[0].cells,function(th,i){var n=th.textContent.trim();if(n==='frame ms'||n==='relMSE')cols.push(i);});\
+var off=[],n=0;Array.prototype.forEach.call(g.tBodies[0].rows,function(r){var ok=cols.length===2&&cols.every(function(i){\
+var b=r.cells[i].getBoundingClientRect();return b.width>0&&b.bottom<=window.innerHeight&&b.right<=window.innerWidth;});\
+if(ok)n++;else off.push(r.cells[0].textContent);});\
+document.documentElement.setAttribute('data-first-screen',off.length?('fail '+JSON.stringify(off)):('ok '+n));});";
 
 #[cfg(test)]
 mod tests {

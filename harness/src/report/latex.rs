@@ -19,6 +19,8 @@ impl Table {
         let spec: String = (0..self.columns.len())
             .map(|c| if self.right_aligned(c) { 'r' } else { 'l' })
             .collect();
+        // Compact: narrower column gaps, kept within the table's own group.
+        let _ = writeln!(out, "{{\\setlength{{\\tabcolsep}}{{4pt}}%");
         let _ = writeln!(out, "\\begin{{tabular}}{{{spec}}}");
         out.push_str("\\toprule\n");
         let line = |cells: Vec<String>| format!("{} \\\\\n", cells.join(" & "));
@@ -29,16 +31,36 @@ impl Table {
         for r in self.display_rows() {
             out.push_str(&line(r.iter().map(|c| latex_escape(c)).collect()));
         }
-        out.push_str("\\bottomrule\n\\end{tabular}\n");
+        out.push_str("\\bottomrule\n\\end{tabular}}\n");
         if !self.notes.is_empty() {
             out.push_str("\n{\\footnotesize\n");
             for n in &self.notes {
-                let _ = writeln!(out, "{}\\par", latex_escape(n));
+                let _ = writeln!(out, "{}\\par", latex_text(n));
             }
             out.push_str("}\n");
         }
         out
     }
+}
+
+/// A note's text in LaTeX: escaped ([`latex_escape`]), and what it quotes as code between
+/// backticks (Markdown's inline code) in `\texttt`.
+pub(super) fn latex_text(s: &str) -> String {
+    let parts: Vec<&str> = s.split('`').collect();
+    // An odd count of backticks leaves the last one as it is.
+    let pairs = (parts.len() - 1) / 2;
+    let mut out = String::new();
+    for (i, p) in parts.iter().enumerate() {
+        if i % 2 == 1 && i <= 2 * pairs {
+            let _ = write!(out, "\\texttt{{{}}}", latex_escape(p));
+        } else {
+            if i > 2 * pairs {
+                out.push_str("\\textasciigrave{}");
+            }
+            out.push_str(&latex_escape(p));
+        }
+    }
+    out
 }
 
 /// Escapes LaTeX specials and spells a few non-ASCII symbols the tables use in ASCII LaTeX.
@@ -58,6 +80,20 @@ pub(super) fn latex_escape(s: &str) -> String {
             'Σ' => out.push_str("$\\Sigma$"),
             '×' => out.push_str("$\\times$"),
             'µ' | 'μ' => out.push_str("$\\mu$"),
+            '→' => out.push_str("$\\rightarrow$"),
+            '≤' => out.push_str("$\\leq$"),
+            '≥' => out.push_str("$\\geq$"),
+            '±' => out.push_str("$\\pm$"),
+            '·' => out.push_str("$\\cdot$"),
+            '≈' => out.push_str("$\\approx$"),
+            'ρ' => out.push_str("$\\rho$"),
+            'π' => out.push_str("$\\pi$"),
+            '²' => out.push_str("$^2$"),
+            '³' => out.push_str("$^3$"),
+            '⁻' => out.push_str("$^-$"),
+            '¹' => out.push_str("$^1$"),
+            '°' => out.push_str("$^\\circ$"),
+            'ꟻ' => out.push('F'),
             '\r' | '\n' => out.push(' '),
             _ => out.push(ch),
         }

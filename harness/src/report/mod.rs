@@ -12,6 +12,9 @@
 //!   `gibench report` writes.
 //! * [`stage_table_detailed`]: one run, one row per stage, with median/mean/p5/p95/min/max of both
 //!   the GPU timestamp and the wall-clock timings (`gibench report --detailed`);
+//! * [`glance_table`]: the first screen of a page: per run its frame time, error against its
+//!   reference component and Pareto rank ([`pareto_line`]: the front in one line, the stage
+//!   table's last note);
 //! * [`roofline_table`]: one run, one row per GPU stage, its achieved fractions of the device's
 //!   measured bandwidth and arithmetic rate ([`crate::measure::roofline`]; also `--detailed`).
 //!
@@ -52,6 +55,7 @@
 
 pub mod compare;
 mod csv;
+mod glance;
 pub mod html;
 mod latex;
 mod markdown;
@@ -66,6 +70,7 @@ mod terminal;
 #[cfg(test)]
 mod tests;
 
+pub use glance::{component_of, glance_table, pareto_line, pareto_ranks};
 pub use pareto::{distinct_label, frame_time_ms, pareto_front, time_error_points};
 pub use plot::{
     check_per_frame_metric, lines_svg, per_frame_lines, quality_over_frames_svg, stacked_bar_svg,
@@ -77,5 +82,5 @@ pub use speedup::speedup_table;
 pub use stages::{
     device_label, stage_table, stage_table_detailed, tile_balance_cell, vpl_count_cell,
 };
-pub use table::{write_tables, Cell, Table};
+pub use table::{column_key, write_tables, write_tables_as, Cell, Table, TableFormat};
 pub use terminal::TERMINAL_WIDTH;

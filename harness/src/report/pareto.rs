@@ -6,25 +6,37 @@ use crate::measure::results::RunResult;
 /// "technique" plus the parameters whose values differ between runs of that technique in
 /// `all` (e.g. "laine clamp=3"), to tell sweep points apart.
 pub fn distinct_label(all: &[RunResult], r: &RunResult) -> String {
+    let mut label = r.technique.clone();
+    let setting = distinct_setting(all, r);
+    if !setting.is_empty() {
+        label.push(' ');
+        label.push_str(&setting);
+    }
+    if all.iter().any(|o| o.scene != r.scene) {
+        label.push_str(&format!(" @ {}", r.scene));
+    }
+    label
+}
+
+/// The parameters whose values differ between the runs of `r`'s technique on its scene in
+/// `all`, as "name=value" joined by spaces ("" where none differ).
+pub fn distinct_setting(all: &[RunResult], r: &RunResult) -> String {
     let same: Vec<&RunResult> = all
         .iter()
         .filter(|o| o.technique == r.technique && o.scene == r.scene)
         .collect();
-    let mut label = r.technique.clone();
+    let mut out: Vec<String> = Vec::new();
     for (k, v) in &r.parameters {
         if same.iter().any(|o| o.parameters.get(k) != Some(v)) {
-            label.push_str(&format!(
-                " {k}={}",
+            out.push(format!(
+                "{k}={}",
                 v.as_str()
                     .map(String::from)
                     .unwrap_or_else(|| v.to_string())
             ));
         }
     }
-    if all.iter().any(|o| o.scene != r.scene) {
-        label.push_str(&format!(" @ {}", r.scene));
-    }
-    label
+    out.join(" ")
 }
 
 /// A run's time per frame for the time-versus-error plot: the median of whole frames where
@@ -40,17 +52,24 @@ pub fn frame_time_ms(r: &RunResult) -> Option<f64> {
 /// The points of the time-versus-error plot: (label, frame ms, mean relative MSE against the
 /// reference), runs without quality left out.
 pub fn time_error_points(results: &[RunResult]) -> Vec<(String, f64, f64)> {
-    results
-        .iter()
-        .filter_map(|r| {
-            let q = r.quality.as_ref()?;
-            let t = frame_time_ms(r)?;
-            q.rel_mse
-                .mean
-                .is_finite()
-                .then(|| (distinct_label(results, r), t, q.rel_mse.mean))
-        })
-        .collect()
+    time_error_points_of(results).0
+}
+
+/// [`time_error_points`] with the index in `results` of the run each point is of: runs with
+/// quality data, a frame time and an error that are numbers.
+pub(super) fn time_error_points_of(results: &[RunResult]) -> (Vec<(String, f64, f64)>, Vec<usize>) {
+    let mut points = Vec::new();
+    let mut runs = Vec::new();
+    for (i, r) in results.iter().enumerate() {
+        let (Some(q), Some(t)) = (r.quality.as_ref(), frame_time_ms(r)) else {
+            continue;
+        };
+        if q.rel_mse.mean.is_finite() {
+            points.push((distinct_label(results, r), t, q.rel_mse.mean));
+            runs.push(i);
+        }
+    }
+    (points, runs)
 }
 
 /// Indices of the Pareto front of (time, error) points: those no other point beats in both

@@ -134,7 +134,8 @@ pub fn tile_balance_cell(r: &RunResult) -> Cell {
     }
 }
 
-/// One row per run: scene, technique, resolution "WxH", "VPLs (mean / min)" and "tile VPLs
+/// One row per run: scene, technique, resolution "WxH", "setting" (the parameters that tell
+/// runs of one technique apart, where any do), "VPLs (mean / min)" and "tile VPLs
 /// (fewest / most)" when any run counts them, one column per stage (median ms: flushed wall time, else GPU timestamps),
 /// "Σ stages", "frame (median ms)", "frame p95", "frame p99", "GPU frame span" (median ms),
 /// "FPS". Notes say how the times were taken and on which
@@ -145,6 +146,15 @@ pub fn stage_table(results: &[RunResult]) -> Table {
     let mut columns: Vec<String> = ["scene", "technique", "resolution"]
         .map(String::from)
         .into();
+    // Runs of one technique that differ in parameters: a column says how (a sweep's points
+    // read the same otherwise).
+    let settings: Vec<String> = (results.iter())
+        .map(|r| super::pareto::distinct_setting(results, r))
+        .collect();
+    let setting = settings.iter().any(|s| !s.is_empty());
+    if setting {
+        columns.push("setting".into());
+    }
     // Results pooled from several devices: one column says which each row ran on.
     let mut adapters: Vec<String> = results.iter().map(device_label).collect();
     adapters.sort();
@@ -177,18 +187,31 @@ pub fn stage_table(results: &[RunResult]) -> Table {
     let quality = results.iter().any(|r| r.quality.is_some());
     if quality {
         columns.extend(
-            ["RMSE", "relMSE", "bias", "FLIP", "flicker", "flicker floor"].map(String::from),
+            [
+                "reference",
+                "RMSE",
+                "relMSE",
+                "bias",
+                "FLIP",
+                "flicker",
+                "flicker floor",
+            ]
+            .map(String::from),
         );
     }
 
     let rows = results
         .iter()
-        .map(|r| {
+        .zip(&settings)
+        .map(|(r, s)| {
             let mut row = vec![
                 Cell::text(&r.scene),
                 Cell::text(&r.technique),
                 Cell::text(format!("{}x{}", r.resolution[0], r.resolution[1])),
             ];
+            if setting {
+                row.push(Cell::text(if s.is_empty() { "–" } else { s }));
+            }
             if pooled {
                 row.insert(0, Cell::text(device_label(r)));
             }
@@ -214,6 +237,7 @@ pub fn stage_table(results: &[RunResult]) -> Table {
             row.push(Cell::Num(frame.map(|f| f.fps), 1));
             if quality {
                 let q = r.quality.as_ref();
+                row.push(Cell::text(super::glance::component_of(r).unwrap_or("–")));
                 row.push(Cell::Num(q.map(|q| q.rmse.mean), 4));
                 row.push(Cell::Num(q.map(|q| q.rel_mse.mean), 4));
                 row.push(Cell::Num(q.map(|q| q.bias.mean), 4));
@@ -239,9 +263,12 @@ pub fn stage_table(results: &[RunResult]) -> Table {
              tonemapped composed images; flicker: RMS of the frame-to-frame change of indirect irradiance \
              beyond the reference's change; flicker floor: the reference's own frame-to-frame noise \
              (up to three compared pairs rendered again with the next seed), which every flicker \
-             includes: a flicker at or below it is at the floor.",
+             includes: a flicker at or below it is at the floor. Each run is compared with the \
+             reference component its technique computes (column reference); errors against \
+             different components are not comparable.",
             refs.join("; ")
         ));
+        notes.extend(super::glance::pareto_line(results));
     }
     Table {
         title: "Per-stage GPU/CPU time (median ms)".to_string(),

@@ -69,8 +69,22 @@ pub struct Table {
 }
 
 impl Table {
+    /// Marks the table as a smoke run's, never to pass for benchmark results: its title opens
+    /// with "SMOKE RUN" and `note` (what made it one) comes first under it.
+    pub fn mark_smoke(&mut self, note: &str) {
+        self.title = format!("SMOKE RUN: {}", self.title);
+        self.notes.insert(0, note.to_string());
+    }
+
     pub(super) fn cell(&self, row: usize, col: usize) -> Option<&Cell> {
         self.rows[row].get(col)
+    }
+
+    /// How many of the leading columns say which run a row is ([`IDENTIFYING`]).
+    pub(super) fn identifying_columns(&self) -> usize {
+        (self.columns.iter())
+            .take_while(|c| IDENTIFYING.contains(&c.as_str()))
+            .count()
     }
 
     pub(super) fn right_aligned(&self, col: usize) -> bool {
@@ -93,24 +107,130 @@ impl Table {
     }
 }
 
+/// A rendering of a table written to a file ([`write_tables_as`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TableFormat {
+    Markdown,
+    Csv,
+    Latex,
+}
+
+impl TableFormat {
+    pub const ALL: [TableFormat; 3] = [TableFormat::Markdown, TableFormat::Csv, TableFormat::Latex];
+
+    /// `markdown`, `csv` or `latex` (the error names `option`).
+    pub fn parse(option: &str, s: &str) -> Result<TableFormat> {
+        match s {
+            "markdown" | "md" => Ok(TableFormat::Markdown),
+            "csv" => Ok(TableFormat::Csv),
+            "latex" | "tex" => Ok(TableFormat::Latex),
+            _ => Err(Error::param(
+                option,
+                format!("expected markdown, csv or latex (got '{s}')"),
+            )),
+        }
+    }
+
+    fn extension(self) -> &'static str {
+        match self {
+            TableFormat::Markdown => "md",
+            TableFormat::Csv => "csv",
+            TableFormat::Latex => "tex",
+        }
+    }
+
+    fn render(self, table: &Table) -> String {
+        match self {
+            TableFormat::Markdown => table.to_markdown(),
+            TableFormat::Csv => table.to_csv(),
+            TableFormat::Latex => table.to_latex(),
+        }
+    }
+}
+
 /// Writes `stem.md`, `stem.csv` and `stem.tex` into `dir` (created if needed), each atomically;
 /// returns their paths in that order.
 pub fn write_tables(table: &Table, dir: &Path, stem: &str) -> Result<Vec<PathBuf>> {
+    write_tables_as(table, dir, stem, &TableFormat::ALL)
+}
+
+/// [`write_tables`] in the given formats only.
+pub fn write_tables_as(
+    table: &Table,
+    dir: &Path,
+    stem: &str,
+    formats: &[TableFormat],
+) -> Result<Vec<PathBuf>> {
     if stem.is_empty() || stem.contains(['/', '\\']) {
         return Err(Error::Invalid(format!(
             "table file stem '{stem}' must be a non-empty file name"
         )));
     }
-    let outputs = [
-        ("md", table.to_markdown()),
-        ("csv", table.to_csv()),
-        ("tex", table.to_latex()),
-    ];
-    let mut paths = Vec::with_capacity(outputs.len());
-    for (ext, text) in outputs {
-        let path = dir.join(format!("{stem}.{ext}"));
-        crate::output::write_atomic(&path, text.as_bytes())?;
+    let mut paths = Vec::with_capacity(formats.len());
+    for f in formats {
+        let path = dir.join(format!("{stem}.{}", f.extension()));
+        crate::output::write_atomic(&path, f.render(table).as_bytes())?;
         paths.push(path);
     }
     Ok(paths)
+}
+
+/// The key a column is chosen by (`gibench report --columns`): its header in lower case with
+/// spaces as `-` ("frame p95": `frame-p95`, "relMSE": `relmse`), "Σ stages" as `sum`.
+pub fn column_key(header: &str) -> String {
+    let bare = header.split(" (").next().unwrap_or(header).trim();
+    match bare {
+        "Σ stages" => "sum".to_string(),
+        h => h.to_lowercase().replace(' ', "-"),
+    }
+}
+
+/// The headers of the columns that say which run a row is (kept by
+/// [`Table::select_columns`], frozen in the HTML page), when they lead a table.
+const IDENTIFYING: [&str; 6] = [
+    "device",
+    "scene",
+    "technique",
+    "resolution",
+    "setting",
+    "run",
+];
+
+impl Table {
+    /// This table with its identifying columns ([`Table::identifying_columns`]: scene,
+    /// technique, resolution, setting) and then the columns `keys` name ([`column_key`]), in their
+    /// order. A key naming no column is an error that names it, `option`, and the keys there
+    /// are — before anything is written.
+    pub fn select_columns(&self, option: &str, keys: &[String]) -> Result<Table> {
+        let ids = self.identifying_columns();
+        let mut picked: Vec<usize> = (0..ids).collect();
+        for k in keys {
+            let k = k.trim().to_lowercase();
+            match (self.columns.iter()).position(|c| column_key(c) == k) {
+                Some(c) if !picked.contains(&c) => picked.push(c),
+                Some(_) => {}
+                None => {
+                    let there: Vec<String> = (self.columns.iter().skip(ids))
+                        .map(|c| column_key(c))
+                        .collect();
+                    return Err(Error::param(
+                        option,
+                        format!("no column '{k}' in this table; it has {}", there.join(", ")),
+                    ));
+                }
+            }
+        }
+        Ok(Table {
+            title: self.title.clone(),
+            columns: picked.iter().map(|&c| self.columns[c].clone()).collect(),
+            rows: (self.rows.iter())
+                .map(|r| {
+                    (picked.iter())
+                        .map(|&c| r.get(c).cloned().unwrap_or(Cell::Ms(None)))
+                        .collect()
+                })
+                .collect(),
+            notes: self.notes.clone(),
+        })
+    }
 }

@@ -532,3 +532,99 @@ fn empty_input_is_an_error_not_a_panic() {
     );
     let _ = (t.to_csv(), t.to_latex(), t.to_terminal());
 }
+
+/// A run with quality data: `rel_mse` against `component`, frame median `frame_ms`.
+fn scored(technique: &str, frame_ms: f64, rel_mse: f64, component: &str) -> RunResult {
+    let mut r = run("cornell", technique, vec![], frame_ms);
+    let frame = crate::measure::metrics::FrameQuality {
+        frame: 1,
+        rmse: rel_mse.sqrt(),
+        rel_mse,
+        mae: 0.1,
+        flip_mean: 0.05,
+        bias: 0.0,
+        temporal: None,
+    };
+    r.quality = Some(crate::measure::metrics::summarize(
+        format!("{component}, 256 spp, seed 0"),
+        vec![frame],
+    ));
+    r
+}
+
+/// Ranks peel the front off: the front is rank 1, the front of the rest rank 2. Catches ranks
+/// taken by time or by error alone, and a point beaten by one of rank 2 given rank 2.
+#[test]
+fn pareto_ranks_peel_fronts() {
+    let p = |t: f64, e: f64| (String::new(), t, e);
+    let points = vec![
+        p(10.0, 0.5),
+        p(5.0, 0.9),
+        p(20.0, 0.1),
+        p(12.0, 0.6),
+        p(13.0, 0.7),
+    ];
+    assert_eq!(pareto_ranks(&points), vec![1, 1, 1, 2, 3]);
+}
+
+/// The glance lists the runs fastest first with their component and rank, and the Pareto line
+/// joins the front fastest first; runs scored against different components are said not to
+/// be comparable in the glance, the line, the stage table (its reference column) and the
+/// plot's legend; one component says nothing of it. Catches a glance in run order, a rank
+/// put on the wrong row once sorted, and mixed references left unsaid.
+#[test]
+fn glance_and_pareto_line_name_the_components() {
+    let runs = vec![
+        scored("laine", 8.0, 0.2, "one-bounce"),
+        scored("direct", 2.0, 1.0, "one-bounce"),
+        scored("ism", 9.0, 0.5, "one-bounce"),
+    ];
+    let g = glance_table(&runs).unwrap();
+    let col = |name: &str| g.columns.iter().position(|c| c == name).unwrap();
+    let cells: Vec<(String, String)> = g
+        .rows
+        .iter()
+        .map(|r| (r[0].display(), r[col("Pareto rank")].display()))
+        .collect();
+    let want = [("direct", "1"), ("laine", "1"), ("ism", "2")];
+    assert_eq!(
+        cells,
+        want.map(|(a, b)| (a.to_string(), b.to_string())),
+        "{cells:?}"
+    );
+    assert_eq!(g.rows[0][col("reference")].display(), "one-bounce");
+    assert!(!g.notes.iter().any(|n| n.contains("Not comparable")));
+    let line = pareto_line(&runs).unwrap();
+    assert!(
+        line.contains("direct 2.00 ms 1.0000 → laine 8.00 ms 0.2000.")
+            && !line.contains("not comparable"),
+        "{line}"
+    );
+    let stage = stage_table(&runs);
+    assert_eq!(stage.notes.last(), Some(&line));
+    let mut mixed = runs.clone();
+    mixed.push(scored("gaitatzes", 3.0, 0.6, "multi-bounce"));
+    let g = glance_table(&mixed).unwrap();
+    assert!(
+        g.notes
+            .iter()
+            .any(|n| n.contains("Not comparable") && n.contains("multi-bounce: gaitatzes")),
+        "{:?}",
+        g.notes
+    );
+    assert!(pareto_line(&mixed).unwrap().contains("not comparable"));
+    let stage = stage_table(&mixed);
+    let reference = stage.columns.iter().position(|c| c == "reference").unwrap();
+    let of: Vec<String> = stage.rows.iter().map(|r| r[reference].display()).collect();
+    assert_eq!(
+        of,
+        ["one-bounce", "one-bounce", "one-bounce", "multi-bounce"]
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let svg = dir.path().join("t.svg");
+    time_vs_error_svg(&mixed, &svg, "t").unwrap();
+    let text = std::fs::read_to_string(&svg).unwrap();
+    assert!(text.contains("gaitatzes vs multi-bounce"), "{text}");
+    time_vs_error_svg(&runs, &svg, "t").unwrap();
+    assert!(!std::fs::read_to_string(&svg).unwrap().contains(" vs "));
+}

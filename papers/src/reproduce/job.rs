@@ -61,6 +61,16 @@ impl Job {
         }
     }
 
+    /// Marks the tables a run or sweep writes as a smoke run's ([`gibench_harness::report::Table::mark_smoke`];
+    /// a reference command writes no table of timings).
+    pub fn mark_smoke(&mut self, note: String) {
+        match self {
+            Job::Run(a, _) => a.smoke = Some(note),
+            Job::Sweep(a, _) => a.run.smoke = Some(note),
+            Job::Reference(..) => {}
+        }
+    }
+
     pub fn needs_gpu(&self) -> bool {
         !matches!(self, Job::Reference(..))
     }

@@ -6,13 +6,17 @@ use plotters::prelude::*;
 
 use super::{axis_max, chart_svg, stage_color, ChartFrame, Mark};
 use crate::measure::results::RunResult;
-use crate::report::pareto::{pareto_front, time_error_points};
+use crate::report::glance::{component_of, mixed_components};
+use crate::report::pareto::{pareto_front, time_error_points_of};
 use crate::{Error, Result};
 
 /// Time versus error: one point per run with quality (technique and setting), the Pareto
-/// front joined by a line and drawn filled, the others hollow. Errors when no run has both.
+/// front joined by a line and drawn filled, the others hollow. The error is each run's against
+/// its own reference component: the axis says so, and where the runs' components differ each
+/// legend entry names its own ("vs multi-bounce"). Errors when no run has both.
 pub fn time_vs_error_svg(results: &[RunResult], path: &Path, title: &str) -> Result<()> {
-    let points = time_error_points(results);
+    let (points, runs) = time_error_points_of(results);
+    let mixed = mixed_components(results).is_some();
     if points.is_empty() {
         return Err(Error::Invalid(format!(
             "{}: no run has both a frame time and an error against the reference (run with --quality)",
@@ -27,7 +31,7 @@ pub fn time_vs_error_svg(results: &[RunResult], path: &Path, title: &str) -> Res
         size: (1000, 600),
         label_areas: (50, 80),
         x_desc: "time per frame (ms; median frame, else Σ stage medians)",
-        y_desc: Some("relative MSE against the reference (mean)"),
+        y_desc: Some("relative MSE against the run's reference component (mean)"),
         categories: None,
         legend_title: "technique, setting",
     };
@@ -47,7 +51,11 @@ pub fn time_vs_error_svg(results: &[RunResult], path: &Path, title: &str) -> Res
             };
             chart.draw_series(std::iter::once(Circle::new((*t, *e), 6, style)))?;
             let mark = if on_front { " (Pareto front)" } else { "" };
-            entries.push((format!("{label}{mark}"), color, Mark::Box));
+            let vs = match component_of(&results[runs[k]]) {
+                Some(c) if mixed => format!(" vs {c}"),
+                _ => String::new(),
+            };
+            entries.push((format!("{label}{vs}{mark}"), color, Mark::Box));
         }
         Ok(entries)
     })

@@ -97,13 +97,16 @@ impl Planned {
                     argv.push("--html".into());
                 }
                 set_option(&mut argv, "--out", &out.display().to_string());
-                let job = Job::plan(&argv).map_err(|e| {
+                let mut job = Job::plan(&argv).map_err(|e| {
                     Error::Invalid(format!(
                         "target '{}' (gibench {}): {e}",
                         target.name,
                         argv.join(" ")
                     ))
                 })?;
+                if let Some(smoke) = smoke_marker(args) {
+                    job.mark_smoke(smoke);
+                }
                 let (frames, units) = job.work();
                 Ok(Planned {
                     target,
@@ -150,8 +153,7 @@ impl Planned {
                 let (mut tables, runs) = (m.reproduce)(self.target.name, &self.args, gpu, bars)?;
                 if let Some(smoke) = smoke_marker(&self.args) {
                     for (table, _) in &mut tables {
-                        table.title = format!("SMOKE RUN: {}", table.title);
-                        table.notes.insert(0, smoke.clone());
+                        table.mark_smoke(&smoke);
                     }
                 }
                 let mut written = Vec::new();
