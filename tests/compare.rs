@@ -603,7 +603,7 @@ const SLOWED: &str = "direct-light";
 ///   full-screen pass bound by memory) follows it: over 48 runs in a row its fastest frame was
 ///   0.50–0.54 ms for 16 runs and 0.68–0.82 ms for 15 others, while `direct-light` (2.1 ms of
 ///   shading) moved 2.0–2.3 ms. The calibration kernel did not follow the drift, so
-///   `--calibrate` cannot remove it, and no rank test tells 30 % from 35 % of drift: the test
+///   `--calibrate` cannot remove it, and no rank test tells 30 % from 40 % of drift: the test
 ///   slows `direct-light`, and draws the same slots on every side so the phases are alike
 ///   there (users alternate runs for the same reason, docs/comparing.md);
 /// - a run of 30 frames (0.5 s) now and then had *every* frame of `direct-light` 1.7 or 1.95

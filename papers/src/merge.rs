@@ -226,9 +226,12 @@ fn merge_shards(dirs: &[PathBuf], out: &Path) -> Result<()> {
     writable_dir("out", out)?;
     let set = OutputSet::begin("out", out)?;
     let mut stale = Vec::new();
-    if first.command != "sweep" {
+    if first.command == "sweep" {
+        let stem = crate::sweep::summary_stem(&scenes[0], &setting("technique"), &setting("sweep"));
+        stale.extend(crate::sweep::replace_sweep_files(&set, out, &stem)?);
+    } else {
         for scene in &scenes {
-            stale.extend(crate::run::replace_scene_files(&set, out, scene)?);
+            stale.extend(crate::run::replace_scene_files(&set, out, scene, false)?);
         }
     }
     for (_, _, files) in &results {

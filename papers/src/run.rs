@@ -376,7 +376,7 @@ pub fn exec(args: &RunArgs) -> Result<()> {
     let set = OutputSet::begin("out", &args.out)?;
     let mut stale = Vec::new();
     for (_, p) in &plans {
-        stale.extend(replace_scene_files(&set, &args.out, &p.desc.name)?);
+        stale.extend(replace_scene_files(&set, &args.out, &p.desc.name, true)?);
     }
     let mut ran: Vec<(String, String)> = Vec::new();
     let mut lines: Vec<String> = Vec::new();
@@ -418,15 +418,23 @@ pub fn exec(args: &RunArgs) -> Result<()> {
 /// those this command did not write are removed, so that no page, plot or list of an earlier
 /// command into `out` is left beside tables of other runs (a page kept the old numbers over
 /// the new images). The run's own results files are not among them: runs of other techniques
-/// made into the same folder stay. Returns those of the files present now.
-pub fn replace_scene_files(set: &OutputSet, out: &Path, name: &str) -> Result<Vec<PathBuf>> {
-    let files = [
+/// made into the same folder stay; the skipped list only where `skipped_list` (a merge writes
+/// none, so it leaves the folder's). Returns those of the files present now.
+pub fn replace_scene_files(
+    set: &OutputSet,
+    out: &Path,
+    name: &str,
+    skipped_list: bool,
+) -> Result<Vec<PathBuf>> {
+    let mut files = vec![
         format!("{name}-report.html"),
         format!("{name}-rmse-per-frame.svg"),
         format!("{name}-flicker-per-frame.svg"),
         format!("{name}-time-vs-error.svg"),
-        skipped_file(name),
     ];
+    if skipped_list {
+        files.push(skipped_file(name));
+    }
     let mut present = Vec::new();
     for f in files {
         set.replace_files(&f)?;
@@ -595,8 +603,14 @@ pub fn write_summary(
     smoke: Option<&str>,
 ) -> Result<(report::Table, Vec<String>)> {
     let mut table = report::stage_table(results);
-    for (technique, reason) in skipped {
-        table.notes.push(format!("Skipped {technique}: {reason}"));
+    // Before the Pareto front's line, which ends the notes.
+    let at = (table.notes.iter())
+        .position(|n| n.starts_with("Pareto front"))
+        .unwrap_or(table.notes.len());
+    for (k, (technique, reason)) in skipped.iter().enumerate() {
+        table
+            .notes
+            .insert(at + k, format!("Skipped {technique}: {reason}"));
     }
     if let Some(note) = smoke {
         table.mark_smoke(note);

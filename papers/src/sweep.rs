@@ -59,19 +59,19 @@ pub fn exec(args: &SweepArgs) -> Result<()> {
         None => None,
     };
     let set = OutputSet::begin("out", &args.run.out)?;
+    let mut stale = Vec::new();
     // The folder's points of this scene, technique and parameter are this sweep's alone: an
     // earlier sweep's points at values this one does not run are removed when it publishes
     // (they would otherwise sit beside its table as if part of it).
     // Its page and error plot likewise: written only with --html / --quality, an earlier
     // sweep's would otherwise describe other points.
     if !planned.plans.is_empty() {
-        for stale in planned.earlier_points(&args.run.out) {
-            gibench_harness::output::replace_in_open_set(&stale)?;
+        for point in planned.earlier_points(&args.run.out) {
+            gibench_harness::output::replace_in_open_set(&point)?;
         }
         let first = &planned.plans[0];
         let stem = summary_stem(&first.desc.name, first.techniques[0].name, &planned.name);
-        set.replace_files(&format!("{stem}.html"))?;
-        set.replace_files(&format!("{stem}-time-vs-error.svg"))?;
+        stale = replace_sweep_files(&set, &args.run.out, &stem)?;
     }
     if let Some(mut record) = record {
         let mut done = "this shard has no points to run".to_string();
@@ -86,12 +86,18 @@ pub fn exec(args: &SweepArgs) -> Result<()> {
         record.write(&args.run.out)?;
         set.publish()?;
         eprintln!("{done}");
+        if let Some(note) = crate::run::removed_note(&stale) {
+            eprintln!("{note}");
+        }
         return Ok(());
     }
     let gpu = open_gpu(&args.run)?;
     let done = sweep_planned(args, &planned, &gpu, &Bars::Own(args.run.quiet))?;
     set.publish()?;
     eprintln!("{done}");
+    if let Some(note) = crate::run::removed_note(&stale) {
+        eprintln!("{note}");
+    }
     Ok(())
 }
 
@@ -362,6 +368,21 @@ pub fn write_summary(
 }
 
 /// The stem of a sweep's tables, plots and page: `{scene}-{technique}-sweep-{name}`.
-fn summary_stem(scene: &str, technique: &str, name: &str) -> String {
+pub(crate) fn summary_stem(scene: &str, technique: &str, name: &str) -> String {
     format!("{scene}-{technique}-sweep-{name}")
+}
+
+/// A sweep's page and time-versus-error plot (`{stem}.html`, `{stem}-time-vs-error.svg`),
+/// written only with `--html` / `--quality`, declared replaced in `set` (`sweep` and `merge`
+/// of a sweep's shards): an earlier command's would describe other points. Returns those
+/// present now ([`crate::run::removed_note`]).
+pub(crate) fn replace_sweep_files(set: &OutputSet, out: &Path, stem: &str) -> Result<Vec<PathBuf>> {
+    let mut present = Vec::new();
+    for f in [format!("{stem}.html"), format!("{stem}-time-vs-error.svg")] {
+        set.replace_files(&f)?;
+        if out.join(&f).is_file() {
+            present.push(out.join(f));
+        }
+    }
+    Ok(present)
 }

@@ -42,8 +42,8 @@ pub(crate) struct ReportArgs {
     /// `frame,fps,relmse,flip` or stage names; `sum` for "Σ stages". Default: every column.
     #[arg(long, value_delimiter = ',')]
     columns: Vec<String>,
-    /// Which table files to write: `markdown`, `csv`, `latex` (comma-separated; default all
-    /// three).
+    /// Which table files to write (the summary's and `--speedup`'s): `markdown`, `csv`,
+    /// `latex` (comma-separated; default all three).
     #[arg(long, value_delimiter = ',')]
     format: Vec<String>,
 }
@@ -80,7 +80,12 @@ pub(crate) fn exec(args: &ReportArgs) -> Result<()> {
     report::write_tables_as(&table, &args.out, &args.stem, &formats)?;
     if let Some(speedup) = &speedup {
         println!("{}", speedup.to_terminal());
-        report::write_tables(speedup, &args.out, &format!("{}-speedup", args.stem))?;
+        report::write_tables_as(
+            speedup,
+            &args.out,
+            &format!("{}-speedup", args.stem),
+            &formats,
+        )?;
     }
     let mut figures = vec![args.out.join(format!("{}.svg", args.stem))];
     report::stacked_bar_svg(&results, &figures[0], "Per-stage times")?;

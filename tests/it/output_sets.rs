@@ -428,3 +428,38 @@ fn a_later_run_removes_the_earlier_runs_page_and_error_plots() {
     assert!(out.join("sibenik-report.html").is_file());
     assert!(out.join("cornell-summary.md").is_file());
 }
+
+/// A sweep likewise: after `sweep --html`, the same sweep without it removes the earlier page
+/// (`{stem}.html`) and says so. Catches a sweep's page left over new points.
+#[test]
+fn a_later_sweep_removes_the_earlier_sweeps_page() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    let sweep = [
+        "sweep",
+        "--technique",
+        "keller-full",
+        "--quiet",
+        "--no-images",
+    ];
+    let values = ["--sweep", "vpls=8,16"];
+    small_ok(&[&sweep[..], &values, &["--html"]].concat(), &out);
+    let page = "cornell-keller-full-sweep-vpls.html";
+    assert!(out.join(page).is_file());
+    let o = gibench()
+        .args(sweep)
+        .args(values)
+        .args(SMALL)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{stderr}");
+    assert!(!out.join(page).exists(), "{page} left behind");
+    assert!(
+        stderr.contains(&format!("note: removed {page}")),
+        "{stderr}"
+    );
+    assert!(out.join("cornell-keller-full-sweep-vpls.md").is_file());
+}

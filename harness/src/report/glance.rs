@@ -63,21 +63,72 @@ pub(super) fn mixed_components(results: &[RunResult]) -> Option<String> {
     })
 }
 
+/// The runs a Pareto front is taken over: one scene at one resolution on one device (a front
+/// over runs of different scenes or devices would rank what cannot be compared).
+fn group_of(r: &RunResult) -> (String, [u32; 2], String) {
+    (
+        r.scene.clone(),
+        r.resolution,
+        super::stages::device_label(r),
+    )
+}
+
+/// The groups of [`group_of`] among `results`, in first-seen order.
+fn groups(results: &[RunResult]) -> Vec<(String, [u32; 2], String)> {
+    let mut out: Vec<(String, [u32; 2], String)> = Vec::new();
+    for r in results {
+        let g = group_of(r);
+        if !out.contains(&g) {
+            out.push(g);
+        }
+    }
+    out
+}
+
+/// A run's label in the glance: [`distinct_label`] (technique, the parameters that tell its
+/// runs apart, the scene where several), with the resolution and the device where those differ
+/// between the runs.
+fn glance_label(results: &[RunResult], r: &RunResult) -> String {
+    let mut label = distinct_label(results, r);
+    if results.iter().any(|o| o.resolution != r.resolution) {
+        label.push_str(&format!(" {}x{}", r.resolution[0], r.resolution[1]));
+    }
+    let device = super::stages::device_label(r);
+    if results
+        .iter()
+        .any(|o| super::stages::device_label(o) != device)
+    {
+        label.push_str(&format!(" on {device}"));
+    }
+    label
+}
+
+/// Each run's Pareto rank within its group ([`group_of`]); `None` for a run without both a
+/// frame time and an error.
+fn ranks_by_group(results: &[RunResult]) -> Vec<Option<usize>> {
+    let (points, runs) = time_error_points_of(results);
+    let mut rank = vec![None; results.len()];
+    for g in groups(results) {
+        let members: Vec<usize> = (0..points.len())
+            .filter(|&p| group_of(&results[runs[p]]) == g)
+            .collect();
+        let sub: Vec<(String, f64, f64)> = members.iter().map(|&p| points[p].clone()).collect();
+        for (k, r) in pareto_ranks(&sub).into_iter().enumerate() {
+            rank[runs[members[k]]] = Some(r);
+        }
+    }
+    rank
+}
+
 /// The first screen of a report: one row per run, fastest first: frame ms, FPS, the reference
-/// component its errors are against, relMSE, FLIP and Pareto rank. `None` when no run has
-/// quality data (there is nothing to weigh the time against).
+/// component its errors are against, relMSE, FLIP and its Pareto rank among the runs of its
+/// scene, resolution and device. `None` when no run has quality data (there is nothing to
+/// weigh the time against).
 pub fn glance_table(results: &[RunResult]) -> Option<Table> {
     if results.iter().all(|r| r.quality.is_none()) {
         return None;
     }
-    let (points, point_runs) = time_error_points_of(results);
-    let ranks = pareto_ranks(&points);
-    let rank_of = |i: usize| {
-        point_runs
-            .iter()
-            .position(|&j| j == i)
-            .map(|p| ranks[p] as f64)
-    };
+    let ranks = ranks_by_group(results);
     let mut order: Vec<usize> = (0..results.len()).collect();
     order.sort_by(|&a, &b| {
         let t = |i: usize| frame_time_ms(&results[i]).unwrap_or(f64::INFINITY);
@@ -89,22 +140,23 @@ pub fn glance_table(results: &[RunResult]) -> Option<Table> {
             let r = &results[i];
             let q = r.quality.as_ref();
             vec![
-                Cell::text(distinct_label(results, r)),
+                Cell::text(glance_label(results, r)),
                 Cell::Ms(frame_time_ms(r)),
                 Cell::Num(r.frame.as_ref().map(|f| f.fps), 1),
                 Cell::text(component_of(r).unwrap_or("–")),
                 Cell::Num(q.map(|q| q.rel_mse.mean), 4),
                 Cell::Num(q.map(|q| q.flip_mean.mean), 4),
-                Cell::Num(rank_of(i), 0),
+                Cell::Num(ranks[i].map(|k| k as f64), 0),
             ]
         })
         .collect();
     let mut notes = vec![
         "frame ms: the median whole frame where frames were timed, else the sum of the stages' \
          medians; FPS: 1000 / mean frame time; relMSE (of indirect irradiance) and FLIP: means over \
-         the compared frames against the reference component named; Pareto rank 1: no other run \
-         is both faster and of lower relMSE, 2: the same once the rank-1 runs are set aside, and \
-         so on. The full per-stage table follows."
+         the compared frames against the reference component named; Pareto rank, among the runs \
+         of the same scene, resolution and device: 1 on the front (no other run is as fast or \
+         faster at no higher relMSE; of two identical runs the first listed), 2 on the front once \
+         those are set aside, and so on. The full per-stage table follows."
             .to_string(),
     ];
     if let Some(mixed) = mixed_components(results) {
@@ -132,24 +184,41 @@ pub fn glance_table(results: &[RunResult]) -> Option<Table> {
 }
 
 /// The Pareto front in one line: "Pareto front (frame ms, relMSE): a 1.20 ms 0.9812 → b …",
-/// fastest first, with a warning where the runs' errors are against different components;
-/// `None` when no run has both numbers.
+/// fastest first, one front per scene, resolution and device where the runs span several
+/// ("… on cornell 256x192: …; on sibenik …"), with a warning where the runs' errors are
+/// against different components; `None` when no run has both numbers.
 pub fn pareto_line(results: &[RunResult]) -> Option<String> {
-    let (points, _) = time_error_points_of(results);
-    let front = pareto_front(&points);
-    if front.is_empty() {
+    let (points, runs) = time_error_points_of(results);
+    let all = groups(results);
+    let mut fronts: Vec<String> = Vec::new();
+    for g in &all {
+        let members: Vec<usize> = (0..points.len())
+            .filter(|&p| &group_of(&results[runs[p]]) == g)
+            .collect();
+        let sub: Vec<(String, f64, f64)> = members.iter().map(|&p| points[p].clone()).collect();
+        let steps: Vec<String> = pareto_front(&sub)
+            .iter()
+            .map(|&k| {
+                let (label, t, e) = &sub[k];
+                format!("{label} {t:.2} ms {e:.4}")
+            })
+            .collect();
+        if steps.is_empty() {
+            continue;
+        }
+        let on = if all.len() > 1 {
+            format!(" on {} {}x{} ({})", g.0, g.1[0], g.1[1], g.2)
+        } else {
+            String::new()
+        };
+        fronts.push(format!("{on}: {}", steps.join(" → ")));
+    }
+    if fronts.is_empty() {
         return None;
     }
-    let steps: Vec<String> = front
-        .iter()
-        .map(|&i| {
-            let (label, t, e) = &points[i];
-            format!("{label} {t:.2} ms {e:.4}")
-        })
-        .collect();
     let mut line = format!(
-        "Pareto front (frame ms and relMSE; no other run is both faster and more accurate): {}.",
-        steps.join(" → ")
+        "Pareto front (frame ms and relMSE; no other run is as fast or faster at no higher error){}.",
+        fronts.join(";")
     );
     if mixed_components(results).is_some() {
         line.push_str(

@@ -24,9 +24,9 @@
 //! A page of runs with quality data opens on the glance table ([`report::glance_table`]: per
 //! run frame ms, FPS, the reference component, relMSE, FLIP and Pareto rank) with the
 //! time-versus-error plot beside it; the page records whether every glance row's frame time
-//! and error lie within the window it was opened in (`data-first-screen="ok N"`). The leading
-//! text columns of every table (scene, technique, resolution) stay in view when it scrolls
-//! sideways.
+//! and error lie within the window it was opened in (`data-first-screen="ok N"`). A table's
+//! leading identifying columns (device, scene, technique, resolution, setting, run) stay in
+//! view when it scrolls sideways.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};

@@ -264,8 +264,9 @@ pub fn stage_table(results: &[RunResult]) -> Table {
              beyond the reference's change; flicker floor: the reference's own frame-to-frame noise \
              (up to three compared pairs rendered again with the next seed), which every flicker \
              includes: a flicker at or below it is at the floor. Each run is compared with the \
-             reference component its technique computes (column reference); errors against \
-             different components are not comparable.",
+             reference component in column reference (the one its technique computes unless \
+             --quality-reference named another); errors against different components are not \
+             comparable.",
             refs.join("; ")
         ));
         notes.extend(super::glance::pareto_line(results));

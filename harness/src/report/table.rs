@@ -226,7 +226,7 @@ impl Table {
             rows: (self.rows.iter())
                 .map(|r| {
                     (picked.iter())
-                        .map(|&c| r.get(c).cloned().unwrap_or(Cell::Ms(None)))
+                        .map(|&c| r.get(c).cloned().unwrap_or(Cell::text("")))
                         .collect()
                 })
                 .collect(),

@@ -628,3 +628,36 @@ fn glance_and_pareto_line_name_the_components() {
     time_vs_error_svg(&runs, &svg, "t").unwrap();
     assert!(!std::fs::read_to_string(&svg).unwrap().contains(" vs "));
 }
+
+/// Ranks and fronts are taken per scene (and resolution and device): a run on another scene,
+/// faster and more accurate than every Cornell run, leaves their ranks as they were, gets rank
+/// 1 of its own, and the line gives one front per scene. Catches one front over scenes that
+/// cannot be compared.
+#[test]
+fn pareto_ranks_are_per_scene() {
+    let mut other = scored("laine", 1.0, 0.01, "one-bounce");
+    other.scene = "sibenik".into();
+    let runs = vec![
+        scored("laine", 8.0, 0.2, "one-bounce"),
+        scored("ism", 9.0, 0.5, "one-bounce"),
+        other,
+    ];
+    let g = glance_table(&runs).unwrap();
+    let rank = g.columns.iter().position(|c| c == "Pareto rank").unwrap();
+    let cells: Vec<(String, String)> = g
+        .rows
+        .iter()
+        .map(|r| (r[0].display(), r[rank].display()))
+        .collect();
+    let want = [
+        ("laine @ sibenik", "1"),
+        ("laine @ cornell", "1"),
+        ("ism @ cornell", "2"),
+    ];
+    assert_eq!(cells, want.map(|(a, b)| (a.to_string(), b.to_string())));
+    let line = pareto_line(&runs).unwrap();
+    assert!(
+        line.contains(" on cornell 1280x720 (") && line.contains(" on sibenik 1280x720 ("),
+        "{line}"
+    );
+}
