@@ -435,10 +435,20 @@ pub fn replace_scene_files(
     if skipped_list {
         files.push(skipped_file(name));
     }
+    replace_listing_present(set, out, &files)
+}
+
+/// Declares the files `names` of `out` replaced in `set` ([`OutputSet::replace_files`]);
+/// returns the paths of those present now, for [`removed_note`] after publication.
+pub(crate) fn replace_listing_present(
+    set: &OutputSet,
+    out: &Path,
+    names: &[String],
+) -> Result<Vec<PathBuf>> {
     let mut present = Vec::new();
-    for f in files {
-        set.replace_files(&f)?;
-        let path = out.join(&f);
+    for f in names {
+        set.replace_files(f)?;
+        let path = out.join(f);
         if path.is_file() {
             present.push(path);
         }

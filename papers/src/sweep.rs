@@ -377,12 +377,6 @@ pub(crate) fn summary_stem(scene: &str, technique: &str, name: &str) -> String {
 /// of a sweep's shards): an earlier command's would describe other points. Returns those
 /// present now ([`crate::run::removed_note`]).
 pub(crate) fn replace_sweep_files(set: &OutputSet, out: &Path, stem: &str) -> Result<Vec<PathBuf>> {
-    let mut present = Vec::new();
-    for f in [format!("{stem}.html"), format!("{stem}-time-vs-error.svg")] {
-        set.replace_files(&f)?;
-        if out.join(&f).is_file() {
-            present.push(out.join(f));
-        }
-    }
-    Ok(present)
+    let names = [format!("{stem}.html"), format!("{stem}-time-vs-error.svg")];
+    crate::run::replace_listing_present(set, out, &names)
 }

@@ -103,18 +103,37 @@ fn glance_label(results: &[RunResult], r: &RunResult) -> String {
     label
 }
 
+/// A group ([`group_of`]), its runs' time-versus-error points, and each point's run's index.
+type GroupPoints = (
+    (String, [u32; 2], String),
+    Vec<(String, f64, f64)>,
+    Vec<usize>,
+);
+
+/// Per group ([`groups`], in order): the group, and its runs' time-versus-error points each
+/// with the index of its run in `results`.
+fn points_by_group(results: &[RunResult]) -> Vec<GroupPoints> {
+    let (points, runs) = time_error_points_of(results);
+    groups(results)
+        .into_iter()
+        .map(|g| {
+            let members: Vec<usize> = (0..points.len())
+                .filter(|&p| group_of(&results[runs[p]]) == g)
+                .collect();
+            let sub = members.iter().map(|&p| points[p].clone()).collect();
+            let of = members.iter().map(|&p| runs[p]).collect();
+            (g, sub, of)
+        })
+        .collect()
+}
+
 /// Each run's Pareto rank within its group ([`group_of`]); `None` for a run without both a
 /// frame time and an error.
 fn ranks_by_group(results: &[RunResult]) -> Vec<Option<usize>> {
-    let (points, runs) = time_error_points_of(results);
     let mut rank = vec![None; results.len()];
-    for g in groups(results) {
-        let members: Vec<usize> = (0..points.len())
-            .filter(|&p| group_of(&results[runs[p]]) == g)
-            .collect();
-        let sub: Vec<(String, f64, f64)> = members.iter().map(|&p| points[p].clone()).collect();
+    for (_, sub, of) in points_by_group(results) {
         for (k, r) in pareto_ranks(&sub).into_iter().enumerate() {
-            rank[runs[members[k]]] = Some(r);
+            rank[of[k]] = Some(r);
         }
     }
     rank
@@ -188,15 +207,11 @@ pub fn glance_table(results: &[RunResult]) -> Option<Table> {
 /// ("… on cornell 256x192: …; on sibenik …"), with a warning where the runs' errors are
 /// against different components; `None` when no run has both numbers.
 pub fn pareto_line(results: &[RunResult]) -> Option<String> {
-    let (points, runs) = time_error_points_of(results);
-    let all = groups(results);
+    let all = points_by_group(results);
+    let several = all.len() > 1;
     let mut fronts: Vec<String> = Vec::new();
-    for g in &all {
-        let members: Vec<usize> = (0..points.len())
-            .filter(|&p| &group_of(&results[runs[p]]) == g)
-            .collect();
-        let sub: Vec<(String, f64, f64)> = members.iter().map(|&p| points[p].clone()).collect();
-        let steps: Vec<String> = pareto_front(&sub)
+    for (g, sub, _) in &all {
+        let steps: Vec<String> = pareto_front(sub)
             .iter()
             .map(|&k| {
                 let (label, t, e) = &sub[k];
@@ -206,7 +221,7 @@ pub fn pareto_line(results: &[RunResult]) -> Option<String> {
         if steps.is_empty() {
             continue;
         }
-        let on = if all.len() > 1 {
+        let on = if several {
             format!(" on {} {}x{} ({})", g.0, g.1[0], g.1[1], g.2)
         } else {
             String::new()
