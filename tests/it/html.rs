@@ -352,7 +352,6 @@ fn reproduce_all_index_page_loads_clean() {
 /// glance missing a technique.
 #[test]
 fn default_page_shows_every_techniques_time_and_error_on_its_first_screen() {
-    let Some(browser) = chromium() else { return };
     let tmp = tempfile::tempdir().unwrap();
     let out = tmp.path().join("run");
     let cache = tmp.path().join("cache");
@@ -371,6 +370,8 @@ fn default_page_shows_every_techniques_time_and_error_on_its_first_screen() {
         })
         .count();
     assert!(runs >= 7, "{runs} techniques ran");
+    errors_against_both_components_in_every_format(&out, runs);
+    let Some(browser) = chromium() else { return };
     let page = out.join("cornell-report.html");
     let html = std::fs::read_to_string(&page).unwrap();
     let glance = html
@@ -387,4 +388,62 @@ fn default_page_shows_every_techniques_time_and_error_on_its_first_screen() {
     let shot = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("html-report/first-screen.png");
     screenshot_in(&browser, &page, &shot, "1400,900");
     assert_clean(&browser, &page);
+}
+
+/// In the default run's Markdown, LaTeX and CSV summaries, every run's row has its relMSE
+/// against both components, the own one marked with `*` (CSV: bare numbers, the reference
+/// column naming the own); the time-versus-error plot names the component it plots (issue 56).
+/// Catches a run scored against its own component only ("–" in the other column) and an own
+/// error unmarked or marked in the wrong column.
+fn errors_against_both_components_in_every_format(out: &Path, runs: usize) {
+    let csv = std::fs::read_to_string(out.join("cornell-summary.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|c| *c == name).expect(name);
+    let (reference, one, multi) = (
+        col("reference"),
+        col("relMSE one-bounce"),
+        col("relMSE multi-bounce"),
+    );
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), runs);
+    for r in &rows {
+        for c in [one, multi] {
+            assert!(
+                r[c].parse::<f64>().is_ok(),
+                "{} in {}: {r:?}",
+                r[c],
+                header[c]
+            );
+        }
+    }
+    // Each row's own, as the Markdown and LaTeX show it: "0.1234*" in its component's column.
+    let own: Vec<String> = (rows.iter())
+        .map(|r| {
+            let c = match r[reference] {
+                "one-bounce" => one,
+                "multi-bounce" => multi,
+                other => panic!("reference {other}"),
+            };
+            format!("{}*", r[c])
+        })
+        .collect();
+    for file in ["cornell-summary.md", "cornell-summary.tex"] {
+        let text = std::fs::read_to_string(out.join(file)).unwrap();
+        assert!(text.contains("relMSE multi-bounce"), "{file}");
+        for (r, own) in rows.iter().zip(&own) {
+            let line = (text.lines())
+                .find(|l| l.contains(&format!(" {} ", r[1].replace('_', "\\_"))))
+                .unwrap_or_else(|| panic!("{file}: no row of {}", r[1]));
+            assert!(line.contains(own.as_str()), "{file}: {own} not in {line}");
+            let other = if own == &format!("{}*", r[one]) {
+                r[multi]
+            } else {
+                r[one]
+            };
+            assert!(line.contains(other), "{file}: {other} not in {line}");
+        }
+    }
+    let svg = std::fs::read_to_string(out.join("cornell-time-vs-error.svg")).unwrap();
+    assert!(svg.contains("relative MSE against the multi-bounce reference"));
 }

@@ -118,7 +118,8 @@ fn pdflatex() -> Option<PathBuf> {
 /// `report --format latex --columns frame,relmse,flip,sum` over committed quality runs (Laine's
 /// clamp sweep on Sibenik against one-bounce, gaitatzes' modes against multi-bounce) writes only
 /// the `.tex`, with the identifying columns (scene, technique, resolution, and the setting that
-/// tells a technique's runs apart), then exactly those asked for; it compiles with pdflatex in
+/// tells a technique's runs apart), then exactly those asked for (`relmse`: against each
+/// component); it compiles with pdflatex in
 /// a document with booktabs. An unknown column is refused by name, listing those there are,
 /// and nothing is written. Catches a table with every column, rows that read the same (no
 /// setting), and a header LaTeX cannot set ("Σ stages" unescaped fails it: tried).
@@ -169,7 +170,8 @@ fn latex_with_chosen_columns_compiles() {
     let tex = std::fs::read_to_string(out.join("t.tex")).unwrap();
     assert!(
         tex.contains(
-            "scene & technique & resolution & setting & frame (median ms) & relMSE & FLIP & $\\Sigma$ stages \\\\"
+            "scene & technique & resolution & setting & frame (median ms) & relMSE one-bounce & \
+             relMSE multi-bounce & FLIP one-bounce & FLIP multi-bounce & $\\Sigma$ stages \\\\"
         ),
         "{tex}"
     );

@@ -7,8 +7,9 @@ use crate::support;
 /// A paper target's quality runs use the reference cache as `gibench run --quality` does (the
 /// default `results/cache`, here under the test's working folder): `gaitatzes-quality` on the
 /// Cornell box renders its two reference frames once, for its first run (its other five read
-/// them), and those two again with the next seed once (the reference's flicker floor), and run
-/// again renders none, every run saying so in `quality.reference_work`; the reference images
+/// them), those two again with the next seed once (the reference's flicker floor) and with one
+/// bounce once (the one-bounce component every run is also scored against), and run again
+/// renders none, every run saying so in `quality.reference_work`; the reference images
 /// and every run's quality figures are the first invocation's. Catches a typed target that
 /// renders its references again on every run (as they all did with no cache).
 #[test]
@@ -49,13 +50,13 @@ fn a_paper_targets_second_quality_run_renders_no_reference() {
     let again = run("again");
     assert_eq!(
         first.iter().map(|r| rendered(&r.0)).collect::<Vec<_>>(),
-        [Some(4), Some(0), Some(0), Some(0), Some(0), Some(0)],
-        "the first invocation renders the two frames once, and once more with the next seed \
-         (the reference's flicker floor)"
+        [Some(6), Some(0), Some(0), Some(0), Some(0), Some(0)],
+        "the first invocation renders the two frames once, once more with the next seed (the \
+         reference's flicker floor) and once with one bounce (the one-bounce component)"
     );
     for ((q1, png1), (q2, png2)) in first.iter().zip(&again) {
         assert_eq!(rendered(q2), Some(0), "rendered again: {q2}");
-        assert_eq!(q2["reference_work"]["cached"].as_u64(), Some(4));
+        assert_eq!(q2["reference_work"]["cached"].as_u64(), Some(6));
         assert!(png1 == png2, "the cached reference's image differs");
         assert_eq!(q1["frames"], q2["frames"], "the quality figures differ");
     }

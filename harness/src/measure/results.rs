@@ -6,6 +6,7 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
+use crate::measure::metrics::ComponentErrors;
 use crate::measure::stats::Stats;
 use crate::{Error, Result};
 
@@ -320,6 +321,20 @@ impl RunResult {
             ] {
                 non_negative(stats)
                     .map_err(|v| format!("quality.{field}.{v} (errors are not negative)"))?;
+            }
+            for (i, c) in q.components.iter().enumerate() {
+                if !ComponentErrors::NAMES.contains(&c.component.as_str()) {
+                    return Err(format!(
+                        "quality.components[{i}].component is '{}' (expected {})",
+                        c.component,
+                        ComponentErrors::NAMES.join(" or ")
+                    ));
+                }
+                for (field, stats) in [("rel_mse", &c.rel_mse), ("flip_mean", &c.flip_mean)] {
+                    non_negative(stats).map_err(|v| {
+                        format!("quality.components[{i}].{field}.{v} (errors are not negative)")
+                    })?;
+                }
             }
             for (i, f) in q.frames.iter().enumerate() {
                 for (field, v) in [

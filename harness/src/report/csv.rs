@@ -13,7 +13,7 @@ impl Cell {
                     false => format!("{v:.4}"),
                 })
                 .unwrap_or_default(),
-            Cell::Num(v, d) => finite(*v)
+            Cell::Num(v, d) | Cell::Own(v, d) => finite(*v)
                 .map(|v| match v.abs() >= LARGE {
                     true => format!("{v:e}"),
                     false => format!("{v:.*}", *d as usize),

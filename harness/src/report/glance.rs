@@ -4,20 +4,65 @@
 //!
 //! Reads: [`RunResult`]s with quality data. Writes: a [`Table`], a line.
 //!
-//! Errors are each run's against its own reference component (one-bounce, multi-bounce or
-//! direct): where the runs' components differ, the table and the line say that their errors,
-//! and so their ranks, are not comparable.
+//! Every run is scored against both indirect components (one-bounce and multi-bounce,
+//! [`ComponentErrors`]); the tables show both with the run's own marked ([`error_cell`]), and
+//! ranks and fronts are taken on one component ([`ranked_component`]). Only runs from results
+//! files written before that are ranked on their own components, said not comparable where those
+//! differ.
 
-use super::pareto::{distinct_label, frame_time_ms, pareto_front, time_error_points_of};
+use super::pareto::{
+    distinct_label, frame_time_ms, pareto_front, ranked_component, time_error_points_of,
+};
 use super::table::{Cell, Table};
+use crate::measure::metrics::ComponentErrors;
 use crate::measure::results::RunResult;
 
 /// The reference component a run's errors are against ("one-bounce", "multi-bounce",
 /// "direct"): the first item of its quality's reference label; `None` without quality.
 pub fn component_of(r: &RunResult) -> Option<&str> {
-    r.quality
-        .as_ref()
-        .map(|q| q.reference.split(',').next().unwrap_or_default().trim())
+    r.quality.as_ref().map(|q| q.own_component())
+}
+
+/// A cell of `r`'s error `metric` against `component` ([`ComponentErrors::NAMES`]), marked
+/// ([`Cell::Own`]) where that is the run's own component; "–" where the run has no such error.
+pub fn error_cell(
+    r: &RunResult,
+    component: &str,
+    metric: fn(&ComponentErrors) -> f64,
+    decimals: u8,
+) -> Cell {
+    let q = r.quality.as_ref();
+    let v = q.and_then(|q| q.against(component)).map(|e| metric(&e));
+    match q.is_some_and(|q| q.own_component() == component) {
+        true => Cell::Own(v, decimals),
+        false => Cell::Num(v, decimals),
+    }
+}
+
+/// The headers of [`error_cell`]s of `metric` ("relMSE one-bounce", "relMSE multi-bounce").
+pub(super) fn error_columns(metric: &str) -> impl Iterator<Item = String> + '_ {
+    (ComponentErrors::NAMES.into_iter()).map(move |c| format!("{metric} {c}"))
+}
+
+/// The note under a table of [`error_cell`]s: what the mark means and which component ranks
+/// are taken on (or, for older results files, that they are not comparable).
+pub(super) fn errors_note(results: &[RunResult]) -> String {
+    let ranked = match ranked_component(results) {
+        Some(c) => format!("Pareto ranks and fronts are taken on the errors against {c}."),
+        None => match mixed_components(results) {
+            Some(mixed) => format!(
+                "Some of these results files hold each run's errors against its own component \
+                 only, and those differ ({mixed}): their Pareto ranks are not comparable."
+            ),
+            None => "Pareto ranks are taken on each run's own errors.".to_string(),
+        },
+    };
+    format!(
+        "Errors against each indirect component of the reference: one-bounce (light that \
+         bounced once) and multi-bounce (all bounces); {} marks the run's own, the component its \
+         technique computes (column reference). {ranked}",
+        super::table::OWN_MARK
+    )
 }
 
 /// The Pareto rank of each (label, time, error) point: 1 on the front (no other point is
@@ -139,11 +184,12 @@ fn ranks_by_group(results: &[RunResult]) -> Vec<Option<usize>> {
     rank
 }
 
-/// The first screen of a report: one row per run, fastest first: frame ms, FPS, the reference
-/// component its errors are against, relMSE, FLIP and its Pareto rank among the runs of its
-/// scene, resolution and device. `None` when no run has quality data (there is nothing to
+/// The first screen of a report: one row per run, fastest first: frame ms, FPS, its own
+/// reference component, relMSE and FLIP against each component (its own marked) and its Pareto
+/// rank among the runs of its scene, resolution and device. `None` when no run has quality data (there is nothing to
 /// weigh the time against).
 pub fn glance_table(results: &[RunResult]) -> Option<Table> {
+    const NAMES: [&str; 2] = ComponentErrors::NAMES;
     if results.iter().all(|r| r.quality.is_none()) {
         return None;
     }
@@ -157,46 +203,39 @@ pub fn glance_table(results: &[RunResult]) -> Option<Table> {
         .iter()
         .map(|&i| {
             let r = &results[i];
-            let q = r.quality.as_ref();
-            vec![
+            [
                 Cell::text(glance_label(results, r)),
                 Cell::Ms(frame_time_ms(r)),
                 Cell::Num(r.frame.as_ref().map(|f| f.fps), 1),
                 Cell::text(component_of(r).unwrap_or("–")),
-                Cell::Num(q.map(|q| q.rel_mse.mean), 4),
-                Cell::Num(q.map(|q| q.flip_mean.mean), 4),
-                Cell::Num(ranks[i].map(|k| k as f64), 0),
             ]
+            .into_iter()
+            .chain(NAMES.map(|c| error_cell(r, c, |e| e.rel_mse.mean, 4)))
+            .chain(NAMES.map(|c| error_cell(r, c, |e| e.flip_mean.mean, 4)))
+            .chain([Cell::Num(ranks[i].map(|k| k as f64), 0)])
+            .collect()
         })
         .collect();
-    let mut notes = vec![
+    let notes = vec![
         "frame ms: the median whole frame where frames were timed, else the sum of the stages' \
          medians; FPS: 1000 / mean frame time; relMSE (of indirect irradiance) and FLIP: means over \
-         the compared frames against the reference component named; Pareto rank, among the runs \
-         of the same scene, resolution and device: 1 on the front (no other run is as fast or \
-         faster at no higher relMSE; of two identical runs the first listed), 2 on the front once \
-         those are set aside, and so on. The full per-stage table follows."
+         the compared frames; Pareto rank, among the runs of the same scene, resolution and \
+         device: 1 on the front (no other run is as fast or faster at no higher relMSE; of two \
+         identical runs the first listed), 2 on the front once those are set aside, and so on. \
+         The full per-stage table follows."
             .to_string(),
+        errors_note(results),
     ];
-    if let Some(mixed) = mixed_components(results) {
-        notes.push(format!(
-            "Not comparable: these runs' errors are against different reference components \
-             ({mixed}), and so are their Pareto ranks."
-        ));
-    }
+    let columns = ["run", "frame ms", "FPS", "reference"]
+        .map(String::from)
+        .into_iter()
+        .chain(error_columns("relMSE"))
+        .chain(error_columns("FLIP"))
+        .chain(["Pareto rank".to_string()])
+        .collect();
     Some(Table {
         title: "At a glance: frame time against error".to_string(),
-        columns: [
-            "run",
-            "frame ms",
-            "FPS",
-            "reference",
-            "relMSE",
-            "FLIP",
-            "Pareto rank",
-        ]
-        .map(String::from)
-        .to_vec(),
+        columns,
         rows,
         notes,
     })
@@ -231,11 +270,15 @@ pub fn pareto_line(results: &[RunResult]) -> Option<String> {
     if fronts.is_empty() {
         return None;
     }
+    let against = match ranked_component(results) {
+        Some(c) => format!(" against {c}"),
+        None => String::new(),
+    };
     let mut line = format!(
-        "Pareto front (frame ms and relMSE; no other run is as fast or faster at no higher error){}.",
+        "Pareto front (frame ms and relMSE{against}; no other run is as fast or faster at no higher error){}.",
         fronts.join(";")
     );
-    if mixed_components(results).is_some() {
+    if ranked_component(results).is_none() && mixed_components(results).is_some() {
         line.push_str(
             " Its runs' errors are against different reference components (column reference): not comparable.",
         );

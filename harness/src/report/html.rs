@@ -22,7 +22,8 @@
 //! of the page (a checkout keeps only some of the images: `results/.gitignore`).
 //!
 //! A page of runs with quality data opens on the glance table ([`report::glance_table`]: per
-//! run frame ms, FPS, the reference component, relMSE, FLIP and Pareto rank) with the
+//! run frame ms, FPS, its reference component, relMSE and FLIP against each component and
+//! Pareto rank) with the
 //! time-versus-error plot beside it; the page records whether every glance row's frame time
 //! and error lie within the window it was opened in (`data-first-screen="ok N"`). A table's
 //! leading identifying columns (device, scene, technique, resolution, setting, run) stay in
@@ -652,8 +653,8 @@ tr.paper td{background:#fff7e0;font-style:italic}.note{font-size:13px;color:#555
 .tile{overflow:hidden;line-height:0}.tile img.film{max-width:none;image-rendering:pixelated}\
 dl.provenance{display:grid;grid-template-columns:max-content auto;gap:2px 12px;font-size:14px}dt{font-weight:bold}\
 th.id,td.id{position:sticky;z-index:1;background:#fff}th.id{background:#eee}\
-.glance{display:flex;flex-wrap:wrap;gap:16px;align-items:flex-start}.glance>div{max-width:760px}\
-.glance figure{margin:0}.glance img.plot{width:600px}";
+section.glance{display:flex;flex-wrap:wrap;gap:16px;align-items:flex-start}section.glance>div{max-width:720px}\
+section.glance figure{margin:0}section.glance img.plot{width:600px}";
 
 /// Runs first: records script errors, `console.error` calls and images that fail to decode,
 /// and on load writes the verdict on the root element.
@@ -701,8 +702,8 @@ window.addEventListener('load',function(){document.querySelectorAll('table.sorta
 Array.prototype.forEach.call(t.rows,function(row){var left=0;for(var c=0;c<row.cells.length&&row.cells[c].classList.contains('id');c++){\
 row.cells[c].style.left=left+'px';left+=row.cells[c].offsetWidth;}});});\
 var g=document.querySelector('table.glance');if(!g)return;var cols=[];\
-Array.prototype.forEach.call(g.tHead.rows[0].cells,function(th,i){var n=th.textContent.trim();if(n==='frame ms'||n==='relMSE')cols.push(i);});\
-var off=[],n=0;Array.prototype.forEach.call(g.tBodies[0].rows,function(r){var ok=cols.length===2&&cols.every(function(i){\
+Array.prototype.forEach.call(g.tHead.rows[0].cells,function(th,i){var n=th.textContent.trim();if(n==='frame ms'||n.indexOf('relMSE')===0)cols.push(i);});\
+var off=[],n=0;Array.prototype.forEach.call(g.tBodies[0].rows,function(r){var ok=cols.length===3&&cols.every(function(i){\
 var b=r.cells[i].getBoundingClientRect();return b.width>0&&b.bottom<=window.innerHeight&&b.right<=window.innerWidth;});\
 if(ok)n++;else off.push(r.cells[0].textContent);});\
 document.documentElement.setAttribute('data-first-screen',off.length?('fail '+JSON.stringify(off)):('ok '+n));});";

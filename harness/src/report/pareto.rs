@@ -1,6 +1,7 @@
 //! The time-versus-error points of runs with quality data and their Pareto front.
 
 use super::runs::stage_ms;
+use crate::measure::metrics::ComponentErrors;
 use crate::measure::results::RunResult;
 
 /// "technique" plus the parameters whose values differ between runs of that technique in
@@ -49,8 +50,35 @@ pub fn frame_time_ms(r: &RunResult) -> Option<f64> {
         .filter(|t| t.is_finite())
 }
 
-/// The points of the time-versus-error plot: (label, frame ms, mean relative MSE against the
-/// reference), runs without quality left out.
+/// The reference component runs are ranked and plotted on: the one every run with quality data
+/// has its own errors against; else multi-bounce (the whole indirect light) where every such
+/// run was scored against it ([`QualitySummary::components`]); `None` where some run was not
+/// (a results file written before runs were scored against both components): then each run's
+/// own errors are used, and the tables and the plot say they are not comparable.
+///
+/// [`QualitySummary::components`]: crate::measure::metrics::QualitySummary::components
+pub fn ranked_component(results: &[RunResult]) -> Option<&'static str> {
+    let scored: Vec<_> = results.iter().filter_map(|r| r.quality.as_ref()).collect();
+    let has = |c: &str| scored.iter().all(|q| q.against(c).is_some());
+    let mut own: Vec<&str> = scored.iter().map(|q| q.own_component()).collect();
+    own.dedup();
+    (ComponentErrors::NAMES.into_iter())
+        .find(|&c| own == [c])
+        .or_else(|| Some("multi-bounce").filter(|&c| has(c)))
+}
+
+/// A run's mean relative MSE against `component` (its own errors where `None`); `None` without
+/// quality data or that component.
+pub fn rel_mse_against(r: &RunResult, component: Option<&str>) -> Option<f64> {
+    let q = r.quality.as_ref()?;
+    match component {
+        Some(c) => q.against(c).map(|e| e.rel_mse.mean),
+        None => Some(q.rel_mse.mean),
+    }
+}
+
+/// The points of the time-versus-error plot: (label, frame ms, mean relative MSE against
+/// [`ranked_component`]), runs without quality left out.
 pub fn time_error_points(results: &[RunResult]) -> Vec<(String, f64, f64)> {
     time_error_points_of(results).0
 }
@@ -58,14 +86,15 @@ pub fn time_error_points(results: &[RunResult]) -> Vec<(String, f64, f64)> {
 /// [`time_error_points`] with the index in `results` of the run each point is of: runs with
 /// quality data, a frame time and an error that are numbers.
 pub(super) fn time_error_points_of(results: &[RunResult]) -> (Vec<(String, f64, f64)>, Vec<usize>) {
+    let component = ranked_component(results);
     let mut points = Vec::new();
     let mut runs = Vec::new();
     for (i, r) in results.iter().enumerate() {
-        let (Some(q), Some(t)) = (r.quality.as_ref(), frame_time_ms(r)) else {
+        let (Some(e), Some(t)) = (rel_mse_against(r, component), frame_time_ms(r)) else {
             continue;
         };
-        if q.rel_mse.mean.is_finite() {
-            points.push((distinct_label(results, r), t, q.rel_mse.mean));
+        if e.is_finite() {
+            points.push((distinct_label(results, r), t, e));
             runs.push(i);
         }
     }

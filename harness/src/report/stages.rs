@@ -1,8 +1,10 @@
 //! The stage tables: one row per run ([`stage_table`]) or one row per stage of one run
 //! ([`stage_table_detailed`]), with the notes that say how the times were taken.
 
+use super::glance::{error_cell, error_columns};
 use super::runs::{run_label, stage_ms, stage_names, stage_sum};
 use super::table::{Cell, Table};
+use crate::measure::metrics::ComponentErrors;
 use crate::measure::results::{RunResult, StageKind};
 use crate::measure::stats::Stats;
 
@@ -186,18 +188,11 @@ pub fn stage_table(results: &[RunResult]) -> Table {
     );
     let quality = results.iter().any(|r| r.quality.is_some());
     if quality {
-        columns.extend(
-            [
-                "reference",
-                "RMSE",
-                "relMSE",
-                "bias",
-                "FLIP",
-                "flicker",
-                "flicker floor",
-            ]
-            .map(String::from),
-        );
+        columns.extend(["reference".to_string(), "RMSE".to_string()]);
+        columns.extend(error_columns("relMSE"));
+        columns.extend(error_columns("bias"));
+        columns.extend(error_columns("FLIP"));
+        columns.extend(["flicker".to_string(), "flicker floor".to_string()]);
     }
 
     let rows = results
@@ -239,9 +234,13 @@ pub fn stage_table(results: &[RunResult]) -> Table {
                 let q = r.quality.as_ref();
                 row.push(Cell::text(super::glance::component_of(r).unwrap_or("–")));
                 row.push(Cell::Num(q.map(|q| q.rmse.mean), 4));
-                row.push(Cell::Num(q.map(|q| q.rel_mse.mean), 4));
-                row.push(Cell::Num(q.map(|q| q.bias.mean), 4));
-                row.push(Cell::Num(q.map(|q| q.flip_mean.mean), 4));
+                for metric in [
+                    (|e| e.rel_mse.mean) as fn(&ComponentErrors) -> f64,
+                    |e| e.bias.mean,
+                    |e| e.flip_mean.mean,
+                ] {
+                    row.extend(ComponentErrors::NAMES.map(|c| error_cell(r, c, metric, 4)));
+                }
                 row.push(Cell::Num(q.and_then(|q| q.temporal.map(|t| t.mean)), 4));
                 row.push(Cell::Num(q.and_then(|q| q.flicker_floor), 4));
             }
@@ -251,11 +250,16 @@ pub fn stage_table(results: &[RunResult]) -> Table {
 
     let mut notes = timing_notes(&results.iter().collect::<Vec<_>>());
     if quality {
-        let mut refs: Vec<&str> = results
-            .iter()
-            .filter_map(|r| r.quality.as_ref().map(|q| q.reference.as_str()))
-            .collect();
-        refs.dedup();
+        let mut refs: Vec<&str> = Vec::new();
+        for q in results.iter().filter_map(|r| r.quality.as_ref()) {
+            let labels =
+                std::iter::once(&q.reference).chain(q.components.iter().map(|c| &c.reference));
+            for label in labels {
+                if !refs.contains(&label.as_str()) {
+                    refs.push(label);
+                }
+            }
+        }
         notes.push(format!(
             "Quality: means over the compared frames against the CPU reference ({}). RMSE, relMSE \
              (relative MSE, Rousselle et al. 2011) and bias (signed relative error of the mean) of indirect \
@@ -263,12 +267,12 @@ pub fn stage_table(results: &[RunResult]) -> Table {
              tonemapped composed images; flicker: RMS of the frame-to-frame change of indirect irradiance \
              beyond the reference's change; flicker floor: the reference's own frame-to-frame noise \
              (up to three compared pairs rendered again with the next seed), which every flicker \
-             includes: a flicker at or below it is at the floor. Each run is compared with the \
-             reference component in column reference (the one its technique computes unless \
-             --quality-reference named another); errors against different components are not \
-             comparable.",
+             includes: a flicker at or below it is at the floor. RMSE and flicker are against the \
+             run's own component, in column reference (the one its technique computes unless \
+             --quality-reference named another).",
             refs.join("; ")
         ));
+        notes.push(super::glance::errors_note(results));
         notes.extend(super::glance::pareto_line(results));
     }
     Table {

@@ -14,7 +14,14 @@ pub enum Cell {
     Ms(Option<f64>),
     /// A number with the given count of decimals, right-aligned; `None` as for [`Cell::Ms`].
     Num(Option<f64>, u8),
+    /// A [`Cell::Num`] marked as the run's own: an error against the reference component its
+    /// technique computes, beside its errors against the others. Shown with a trailing
+    /// [`OWN_MARK`]; bare in CSV (whose `reference` column names the own component).
+    Own(Option<f64>, u8),
 }
+
+/// Follows an error against the run's own reference component ([`Cell::Own`]).
+pub const OWN_MARK: &str = "*";
 
 impl Cell {
     /// A text cell.
@@ -23,7 +30,7 @@ impl Cell {
     }
 
     pub(super) fn is_numeric(&self) -> bool {
-        matches!(self, Cell::Ms(_) | Cell::Num(..))
+        matches!(self, Cell::Ms(_) | Cell::Num(..) | Cell::Own(..))
     }
 
     /// The cell as shown in the terminal, Markdown and LaTeX (before escaping).
@@ -39,6 +46,10 @@ impl Cell {
             Cell::Num(v, d) => match finite(*v) {
                 Some(v) if v.abs() >= LARGE => format!("{v:.3e}"),
                 Some(v) => format!("{v:.*}", *d as usize),
+                None => MISSING.to_string(),
+            },
+            Cell::Own(v, d) => match finite(*v) {
+                Some(_) => format!("{}{OWN_MARK}", Cell::Num(*v, *d).display()),
                 None => MISSING.to_string(),
             },
         }
@@ -199,24 +210,37 @@ const IDENTIFYING: [&str; 6] = [
 impl Table {
     /// This table with its identifying columns ([`Table::identifying_columns`]: scene,
     /// technique, resolution, setting) and then the columns `keys` name ([`column_key`]), in their
-    /// order. A key naming no column is an error that names it, `option`, and the keys there
-    /// are — before anything is written.
+    /// order; a key that names no column picks every column whose key it leads (`relmse`: the
+    /// relMSE against each component). A key that picks nothing is an error that names it,
+    /// `option`, and the keys there are — before anything is written.
     pub fn select_columns(&self, option: &str, keys: &[String]) -> Result<Table> {
         let ids = self.identifying_columns();
         let mut picked: Vec<usize> = (0..ids).collect();
         for k in keys {
             let k = k.trim().to_lowercase();
-            match (self.columns.iter()).position(|c| column_key(c) == k) {
-                Some(c) if !picked.contains(&c) => picked.push(c),
-                Some(_) => {}
-                None => {
-                    let there: Vec<String> = (self.columns.iter().skip(ids))
-                        .map(|c| column_key(c))
-                        .collect();
-                    return Err(Error::param(
-                        option,
-                        format!("no column '{k}' in this table; it has {}", there.join(", ")),
-                    ));
+            // A key names its column, else every column whose key it leads ("relmse":
+            // "relmse-one-bounce" and "relmse-multi-bounce").
+            let exact: Vec<usize> = (0..self.columns.len())
+                .filter(|&c| column_key(&self.columns[c]) == k)
+                .collect();
+            let named = match exact.is_empty() {
+                false => exact,
+                true => (0..self.columns.len())
+                    .filter(|&c| column_key(&self.columns[c]).starts_with(&format!("{k}-")))
+                    .collect(),
+            };
+            if named.is_empty() {
+                let there: Vec<String> = (self.columns.iter().skip(ids))
+                    .map(|c| column_key(c))
+                    .collect();
+                return Err(Error::param(
+                    option,
+                    format!("no column '{k}' in this table; it has {}", there.join(", ")),
+                ));
+            }
+            for c in named {
+                if !picked.contains(&c) {
+                    picked.push(c);
                 }
             }
         }

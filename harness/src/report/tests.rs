@@ -568,9 +568,9 @@ fn pareto_ranks_peel_fronts() {
 }
 
 /// The glance lists the runs fastest first with their component and rank, and the Pareto line
-/// joins the front fastest first; runs scored against different components are said not to
-/// be comparable in the glance, the line, the stage table (its reference column) and the
-/// plot's legend; one component says nothing of it. Catches a glance in run order, a rank
+/// joins the front fastest first; runs from files that hold only their own errors, against
+/// different components, are said not to be comparable in the glance, the line, the stage
+/// table (its reference column) and the plot's legend; one component says nothing of it. Catches a glance in run order, a rank
 /// put on the wrong row once sorted, and mixed references left unsaid.
 #[test]
 fn glance_and_pareto_line_name_the_components() {
@@ -593,7 +593,7 @@ fn glance_and_pareto_line_name_the_components() {
         "{cells:?}"
     );
     assert_eq!(g.rows[0][col("reference")].display(), "one-bounce");
-    assert!(!g.notes.iter().any(|n| n.contains("Not comparable")));
+    assert!(!g.notes.iter().any(|n| n.contains("not comparable")));
     let line = pareto_line(&runs).unwrap();
     assert!(
         line.contains("direct 2.00 ms 1.0000 → laine 8.00 ms 0.2000.")
@@ -608,7 +608,7 @@ fn glance_and_pareto_line_name_the_components() {
     assert!(
         g.notes
             .iter()
-            .any(|n| n.contains("Not comparable") && n.contains("multi-bounce: gaitatzes")),
+            .any(|n| n.contains("not comparable") && n.contains("multi-bounce: gaitatzes")),
         "{:?}",
         g.notes
     );
@@ -659,5 +659,98 @@ fn pareto_ranks_are_per_scene() {
     assert!(
         line.contains(" on cornell 1280x720 (") && line.contains(" on sibenik 1280x720 ("),
         "{line}"
+    );
+}
+
+/// A run scored against both components: relMSE `one` and `multi`, its own `own`.
+fn scored_both(technique: &str, frame_ms: f64, one: f64, multi: f64, own: &str) -> RunResult {
+    let own_error = if own == "one-bounce" { one } else { multi };
+    let mut r = scored(technique, frame_ms, own_error, own);
+    let q = r.quality.as_mut().unwrap();
+    q.components = (crate::measure::metrics::ComponentErrors::NAMES.iter())
+        .zip([one, multi])
+        .map(|(c, e)| crate::measure::metrics::ComponentErrors {
+            component: c.to_string(),
+            reference: format!("{c}, 256 spp, seed 0"),
+            rel_mse: Stats::of(&[e]),
+            bias: Stats::of(&[-0.1]),
+            flip_mean: Stats::of(&[0.05]),
+        })
+        .collect();
+    r
+}
+
+/// Runs of techniques that compute different components, each scored against both: every
+/// table format shows both errors with the run's own marked (CSV bare, its reference column
+/// naming the own), and ranks, the Pareto line and the plot are on multi-bounce, which they
+/// name. Catches ranks on each run's own error (laine's 0.2 one-bounce would put it on the
+/// front), an unmarked or wrongly marked own cell, and a mark that breaks CSV numbers.
+#[test]
+fn errors_against_both_components_with_the_own_marked() {
+    let runs = vec![
+        scored_both("laine", 8.0, 0.2, 0.9, "one-bounce"),
+        scored_both("gaitatzes", 3.0, 2.0, 0.6, "multi-bounce"),
+    ];
+    let g = glance_table(&runs).unwrap();
+    let col = |t: &Table, name: &str| t.columns.iter().position(|c| c == name).unwrap();
+    let row = |t: &Table, technique: &str, name: &str| {
+        let r = (t.rows.iter())
+            .find(|r| r.iter().any(|c| c.display() == technique))
+            .unwrap();
+        r[col(t, name)].display()
+    };
+    for t in [&g, &stage_table(&runs)] {
+        assert_eq!(row(t, "laine", "relMSE one-bounce"), "0.2000*");
+        assert_eq!(row(t, "laine", "relMSE multi-bounce"), "0.9000");
+        assert_eq!(row(t, "gaitatzes", "relMSE one-bounce"), "2.0000");
+        assert_eq!(row(t, "gaitatzes", "relMSE multi-bounce"), "0.6000*");
+        assert_eq!(row(t, "gaitatzes", "FLIP multi-bounce"), "0.0500*");
+        assert!(
+            (t.notes.iter()).any(|n| n.contains("taken on the errors against multi-bounce")),
+            "{:?}",
+            t.notes
+        );
+    }
+    assert_eq!(row(&g, "gaitatzes", "Pareto rank"), "1");
+    assert_eq!(row(&g, "laine", "Pareto rank"), "2");
+    let stage = stage_table(&runs);
+    assert_eq!(row(&stage, "laine", "bias multi-bounce"), "-0.1000");
+    for text in [stage.to_markdown(), stage.to_latex(), stage.to_terminal()] {
+        assert!(
+            text.contains("0.2000*") && text.contains("0.6000*") && text.contains("0.9000 "),
+            "{text}"
+        );
+    }
+    let csv = stage.to_csv();
+    let header = csv.lines().next().unwrap();
+    assert!(
+        header.contains(",reference,RMSE,relMSE one-bounce,relMSE multi-bounce,"),
+        "{header}"
+    );
+    assert!(
+        !csv.contains('*') && csv.contains(",0.2000,0.9000,"),
+        "{csv}"
+    );
+    let picked = stage
+        .select_columns("--columns", &["relmse".to_string()])
+        .unwrap();
+    assert_eq!(
+        picked.columns[picked.columns.len() - 2..],
+        ["relMSE one-bounce", "relMSE multi-bounce"]
+    );
+    let line = pareto_line(&runs).unwrap();
+    assert!(
+        line.contains("relMSE against multi-bounce")
+            && line.contains(": gaitatzes 3.00 ms 0.6000.")
+            && !line.contains("not comparable"),
+        "{line}"
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let svg = dir.path().join("t.svg");
+    time_vs_error_svg(&runs, &svg, "t").unwrap();
+    let text = std::fs::read_to_string(&svg).unwrap();
+    assert!(
+        text.contains("against the multi-bounce reference") && !text.contains(" vs "),
+        "{text}"
     );
 }

@@ -4,7 +4,10 @@
 //! back its indirect irradiance and composed radiance at chosen frames (in consecutive pairs,
 //! so that flicker can be measured), and compares them with the reference for the same frames:
 //! RMSE, relative MSE and MAE of indirect irradiance, FLIP of the tonemapped composed images,
-//! and temporal instability (see [`crate::measure::metrics`]).
+//! and temporal instability (see [`crate::measure::metrics`]). Beside the component its
+//! technique computes, every run is scored against the one-bounce and the multi-bounce
+//! component ([`errors_against`]), so runs of techniques that compute different components
+//! compare on one.
 //!
 //! References are cached on disk by (scene descriptor, frame, resolution, spp, bounces, seed,
 //! reference code version), so sweeps and repeated runs reuse them.
@@ -15,7 +18,8 @@ use glam::Vec3;
 
 use crate::cpu::bvh::SceneTrees;
 use crate::cpu::reference::{self, ReferenceImages, ReferenceSettings};
-use crate::measure::metrics::{self, FrameQuality, QualitySummary};
+use crate::measure::metrics::{self, ComponentErrors, FrameQuality, QualitySummary};
+use crate::measure::stats::Stats;
 use crate::scene::anim::FrameState;
 use crate::scene::Scene;
 use crate::{Error, Result};
@@ -569,6 +573,46 @@ pub fn flicker_floor(
     Ok((!floors.is_empty()).then(|| floors.iter().sum::<f64>() / floors.len() as f64))
 }
 
+/// The tonemapped composed images of a captured frame and of its reference (direct light plus
+/// `component`), and the FLIP between them over the pixels that hit geometry.
+fn composed_flip(
+    c: &CapturedFrame,
+    r: &ReferenceImages,
+    component: IndirectComponent,
+    exposure: f32,
+) -> Result<(Vec<u8>, Vec<u8>, metrics::FlipResult)> {
+    let test8 = metrics::tonemap_srgb8(&c.radiance, exposure);
+    let ref8 = metrics::tonemap_srgb8(&r.radiance_with(component.of(r)), exposure);
+    let flip = metrics::flip_masked(&test8, &ref8, r.size, &r.hit)?;
+    Ok((test8, ref8, flip))
+}
+
+/// The captured frames' errors against `component` of their `references` (one per frame, in
+/// order), labelled `reference` ([`QualityConfig::label`] of that component): what a run is
+/// scored with beside its own component ([`ComponentErrors`]).
+pub fn errors_against(
+    captured: &[CapturedFrame],
+    references: &[ReferenceImages],
+    component: IndirectComponent,
+    reference: String,
+    exposure: f32,
+) -> Result<ComponentErrors> {
+    let (mut rel_mse, mut bias, mut flip) = (Vec::new(), Vec::new(), Vec::new());
+    for (c, r) in captured.iter().zip(references) {
+        let target = component.of(r);
+        rel_mse.push(metrics::relative_mse(&c.indirect, target, &r.hit));
+        bias.push(metrics::relative_bias(&c.indirect, target, &r.hit));
+        flip.push(composed_flip(c, r, component, exposure)?.2.mean);
+    }
+    Ok(ComponentErrors {
+        component: component.name().to_string(),
+        reference,
+        rel_mse: Stats::of(&rel_mse),
+        bias: Stats::of(&bias),
+        flip_mean: Stats::of(&flip),
+    })
+}
+
 /// Compares captured frames with their references.
 pub fn compare(
     captured: &[CapturedFrame],
@@ -580,11 +624,8 @@ pub fn compare(
     let mut images = None;
     for (i, (c, r)) in captured.iter().zip(references).enumerate() {
         let component = config.component().of(r);
-        let ref_radiance = r.radiance_with(component);
         let size = r.size;
-        let test8 = metrics::tonemap_srgb8(&c.radiance, exposure);
-        let ref8 = metrics::tonemap_srgb8(&ref_radiance, exposure);
-        let flip = metrics::flip_masked(&test8, &ref8, size, &r.hit)?;
+        let (test8, ref8, flip) = composed_flip(c, r, config.component(), exposure)?;
         let temporal = if c.pair_end && i > 0 && captured[i - 1].frame + 1 == c.frame {
             let (pc, pr) = (&captured[i - 1], &references[i - 1]);
             let mask: Vec<bool> = r.hit.iter().zip(&pr.hit).map(|(a, b)| *a && *b).collect();

@@ -18,11 +18,13 @@ use crate::kit::passes::{Compose, DirectLight, DrawSet, FrameUniforms, GBuffer, 
 use crate::kit::technique::{
     FrameContext, Params, PrepareContext, Prepared, SceneContext, Technique, TechniqueInfo,
 };
-use crate::measure::metrics::{QualitySummary, ReferenceWork};
+use crate::measure::metrics::{ComponentErrors, QualitySummary, ReferenceWork};
 use crate::measure::results::{FrameRange, RunResult, StageKind, SCHEMA_VERSION};
 use crate::measure::roofline::{DeviceBounds, StageCost};
 use crate::run::bounds::measure_bounds;
-use crate::run::quality::{CapturedFrame, QualityConfig, QualityImages, ReferenceCache};
+use crate::run::quality::{
+    CapturedFrame, IndirectComponent, QualityConfig, QualityImages, ReferenceCache,
+};
 use crate::scene::anim::{FrameClock, FrameState};
 use crate::scene::Scene;
 use crate::{Error, Result};
@@ -648,15 +650,41 @@ impl<'a> Harness<'a> {
             quality.component(),
             &mut |f| fetch(f, &reseeded),
         )?;
+        let exposure = self.scene.descriptor.settings.exposure;
+        let (mut summary, images) =
+            crate::run::quality::compare(&captured, &references, quality, exposure)?;
+        // Every component beside its own, each from the references rendered for it (the same
+        // images every technique's column of that component is scored with).
+        for component in [IndirectComponent::OneBounce, IndirectComponent::MultiBounce] {
+            if component == quality.component() {
+                summary.components.push(ComponentErrors::own(&summary));
+                continue;
+            }
+            let other = QualityConfig {
+                component: Some(component),
+                ..quality.clone()
+            };
+            let other_settings = other.reference_settings();
+            let fetched;
+            let refs = if other_settings == settings {
+                &references
+            } else {
+                fetched = (captured.iter())
+                    .map(|c| fetch(c.frame, &other_settings))
+                    .collect::<Result<Vec<_>>>()?;
+                &fetched
+            };
+            summary.components.push(crate::run::quality::errors_against(
+                &captured,
+                refs,
+                component,
+                other.label(),
+                exposure,
+            )?);
+        }
         let builds = self.trees.builds();
         work.static_tree_builds = builds.static_tree;
         work.mover_tree_builds = builds.mover_trees;
-        let (mut summary, images) = crate::run::quality::compare(
-            &captured,
-            &references,
-            quality,
-            self.scene.descriptor.settings.exposure,
-        )?;
         summary.reference_work = Some(work);
         summary.flicker_floor = floor;
         Ok((summary, images))

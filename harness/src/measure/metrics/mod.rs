@@ -330,6 +330,62 @@ pub struct QualitySummary {
     /// How the reference images were come by; absent in files written before it was recorded.
     #[serde(skip_serializing_if = "Option::is_none", default)]
     pub reference_work: Option<ReferenceWork>,
+    /// The run's errors against each indirect component ([`ComponentErrors::NAMES`]: one-bounce
+    /// and multi-bounce), its own among them, so that runs of techniques that compute different
+    /// components compare on one; empty in files written before they were recorded.
+    #[serde(skip_serializing_if = "Vec::is_empty", default)]
+    pub components: Vec<ComponentErrors>,
+}
+
+impl QualitySummary {
+    /// The component the run's own errors (`rmse`, `rel_mse`, ...) are against: the first item
+    /// of [`QualitySummary::reference`] ("one-bounce", "multi-bounce" or "direct").
+    pub fn own_component(&self) -> &str {
+        self.reference.split(',').next().unwrap_or_default().trim()
+    }
+
+    /// The run's errors against `component` ("one-bounce" or "multi-bounce"): from
+    /// [`QualitySummary::components`], else (a file written before they were recorded) its own
+    /// errors where they are against that component.
+    pub fn against(&self, component: &str) -> Option<ComponentErrors> {
+        (self
+            .components
+            .iter()
+            .find(|c| c.component == component)
+            .cloned())
+        .or_else(|| (self.own_component() == component).then(|| ComponentErrors::own(self)))
+    }
+}
+
+/// A run's errors against one indirect component of the reference (one entry of
+/// [`QualitySummary::components`]): of indirect irradiance, relative MSE and bias; of the
+/// tonemapped composed image (direct plus that component), mean FLIP. Means over the same
+/// compared frames as the run's own errors.
+#[derive(Serialize, Deserialize, Clone, Debug, PartialEq)]
+pub struct ComponentErrors {
+    /// One of [`ComponentErrors::NAMES`].
+    pub component: String,
+    /// The reference compared with, as [`QualitySummary::reference`].
+    pub reference: String,
+    pub rel_mse: Stats,
+    pub bias: Stats,
+    pub flip_mean: Stats,
+}
+
+impl ComponentErrors {
+    /// The components every run with quality data is scored against.
+    pub const NAMES: [&'static str; 2] = ["one-bounce", "multi-bounce"];
+
+    /// The run's own errors, as the entry of its own component.
+    pub fn own(q: &QualitySummary) -> ComponentErrors {
+        ComponentErrors {
+            component: q.own_component().to_string(),
+            reference: q.reference.clone(),
+            rel_mse: q.rel_mse,
+            bias: q.bias,
+            flip_mean: q.flip_mean,
+        }
+    }
 }
 
 /// How a quality pass came by its reference images: how many it rendered and how many it read
@@ -381,6 +437,7 @@ pub fn summarize(reference: String, frames: Vec<FrameQuality>) -> QualitySummary
         flicker_floor: None,
         frames,
         reference_work: None,
+        components: Vec::new(),
     }
 }
 

@@ -7,16 +7,22 @@ use plotters::prelude::*;
 use super::{axis_max, chart_svg, stage_color, ChartFrame, Mark};
 use crate::measure::results::RunResult;
 use crate::report::glance::{component_of, mixed_components};
-use crate::report::pareto::{pareto_front, time_error_points_of};
+use crate::report::pareto::{pareto_front, ranked_component, time_error_points_of};
 use crate::{Error, Result};
 
 /// Time versus error: one point per run with quality (technique and setting), the Pareto
-/// front joined by a line and drawn filled, the others hollow. The error is each run's against
-/// its own reference component: the axis says so, and where the runs' components differ each
-/// legend entry names its own ("vs multi-bounce"). Errors when no run has both.
+/// front joined by a line and drawn filled, the others hollow. The error is every run's against
+/// one component ([`ranked_component`]), which the axis names; only for results files that hold
+/// each run's own errors alone is it each run's own, each legend entry naming its component
+/// where they differ ("vs multi-bounce"). Errors when no run has both.
 pub fn time_vs_error_svg(results: &[RunResult], path: &Path, title: &str) -> Result<()> {
     let (points, runs) = time_error_points_of(results);
-    let mixed = mixed_components(results).is_some();
+    let ranked = ranked_component(results);
+    let mixed = ranked.is_none() && mixed_components(results).is_some();
+    let y_desc = match ranked {
+        Some(c) => format!("relative MSE against the {c} reference (mean)"),
+        None => "relative MSE against the run's reference component (mean)".to_string(),
+    };
     if points.is_empty() {
         return Err(Error::Invalid(format!(
             "{}: no run has both a frame time and an error against the reference (run with --quality)",
@@ -31,7 +37,7 @@ pub fn time_vs_error_svg(results: &[RunResult], path: &Path, title: &str) -> Res
         size: (1000, 600),
         label_areas: (50, 80),
         x_desc: "time per frame (ms; median frame, else Σ stage medians)",
-        y_desc: Some("relative MSE against the run's reference component (mean)"),
+        y_desc: Some(&y_desc),
         categories: None,
         legend_title: "technique, setting",
     };
