@@ -446,8 +446,12 @@ pub(crate) fn replace_listing_present(
     names: &[String],
 ) -> Result<Vec<PathBuf>> {
     let mut present = Vec::new();
-    for f in names {
-        set.replace_files(f)?;
+    // A figure's PDF beside its SVG (`report::pdf_path`) goes with it.
+    let pdfs = (names.iter())
+        .filter_map(|f| f.strip_suffix(".svg"))
+        .map(|stem| format!("{stem}.pdf"));
+    for f in names.iter().cloned().chain(pdfs) {
+        set.replace_files(&f)?;
         let path = out.join(f);
         if path.is_file() {
             present.push(path);

@@ -394,8 +394,8 @@ fn a_link_below_out_is_refused_and_its_target_untouched() {
 
 /// A run leaves no page, error plot or skipped list of an earlier run on the same scene: after
 /// `run --quality --html`, a plain run into the same folder removes `cornell-report.html` and
-/// the error plots (they described the earlier runs, the page over the new images), says so,
-/// and leaves another scene's page alone. Catches the page kept with old numbers (issue 56).
+/// the error plots and their PDFs (they described the earlier runs, the page over the new
+/// images), says so, and leaves another scene's page alone. Catches the page kept with old numbers (issue 56).
 #[test]
 fn a_later_run_removes_the_earlier_runs_page_and_error_plots() {
     let tmp = tempfile::tempdir().unwrap();
@@ -405,6 +405,7 @@ fn a_later_run_removes_the_earlier_runs_page_and_error_plots() {
     let earlier = [
         "cornell-report.html",
         "cornell-time-vs-error.svg",
+        "cornell-time-vs-error.pdf",
         "cornell-rmse-per-frame.svg",
     ];
     for f in earlier {

@@ -40,7 +40,8 @@
 //! # Plots
 //!
 //! SVG files drawn with plotters' SVG backend (text stays text: `<text>` elements, no embedded
-//! fonts), rendered into memory and written atomically:
+//! fonts), rendered into memory and written atomically, each with the same figure as a vector
+//! PDF beside it (`name.pdf`, [`svg_to_pdf`]: for `\includegraphics`):
 //!
 //! * [`stacked_bar_svg`]: one horizontal bar per run, labelled "technique @ scene", stacked by
 //!   stage in execution order (same value rule as [`stage_table`]), with the total at the end of
@@ -73,8 +74,8 @@ mod tests;
 pub use glance::{component_of, glance_table, pareto_line, pareto_ranks};
 pub use pareto::{distinct_label, frame_time_ms, pareto_front, time_error_points};
 pub use plot::{
-    check_per_frame_metric, lines_svg, per_frame_lines, quality_over_frames_svg, stacked_bar_svg,
-    sweep_plot_svg, time_vs_error_svg, Line, PER_FRAME_METRICS,
+    check_per_frame_metric, lines_svg, pdf_path, per_frame_lines, quality_over_frames_svg,
+    stacked_bar_svg, svg_to_pdf, sweep_plot_svg, time_vs_error_svg, Line, PER_FRAME_METRICS,
 };
 pub use roofline::roofline_table;
 pub use runs::stage_ms;

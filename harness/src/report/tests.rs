@@ -399,6 +399,14 @@ fn stacked_bar_svg_has_bars_labels_and_legend() {
     let path = dir.path().join("bars.svg");
     stacked_bar_svg(&two_runs(), &path, "Stage times").unwrap();
     let svg = std::fs::read_to_string(&path).unwrap();
+    // The same figure as a PDF beside it, its text set in an embedded font (a PDF without one
+    // has lost every label: the fonts come with Chromium, which the HTML tests need too).
+    let pdf = std::fs::read(pdf_path(&path)).unwrap();
+    assert!(pdf.starts_with(b"%PDF-"), "not a PDF");
+    assert!(
+        pdf.windows(10).any(|w| w == b"/FontFile2"),
+        "the PDF embeds no font: install DejaVu Sans or Liberation Sans"
+    );
     assert!(
         svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"),
         "{svg}"

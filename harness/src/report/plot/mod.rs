@@ -89,7 +89,8 @@ fn draw_legend(
     Ok(())
 }
 
-/// Renders into an SVG string with `draw`, then writes it to `path` atomically.
+/// Renders into an SVG string with `draw`, then writes it to `path` atomically, and the same
+/// figure as a PDF beside it ([`pdf_path`], [`svg_to_pdf`]) for `\includegraphics`.
 fn write_svg(
     path: &Path,
     size: (u32, u32),
@@ -101,7 +102,49 @@ fn write_svg(
         draw(root)
             .map_err(|e| Error::Invalid(format!("{}: plotting failed: {e}", path.display())))?;
     }
-    crate::output::write_atomic(path, svg.as_bytes())
+    let pdf = svg_to_pdf(&svg)
+        .map_err(|e| Error::Invalid(format!("{}: no PDF of the figure: {e}", path.display())))?;
+    crate::output::write_atomic(path, svg.as_bytes())?;
+    crate::output::write_atomic(&pdf_path(path), &pdf)
+}
+
+/// Where the PDF of the figure at `svg` goes: the same name with `.pdf`.
+pub fn pdf_path(svg: &Path) -> std::path::PathBuf {
+    svg.with_extension("pdf")
+}
+
+/// The SVG `svg` as a one-page vector PDF (svg2pdf), its text set in the system's sans-serif
+/// font (DejaVu Sans, Liberation Sans or Arial, the first installed; the fonts are read once
+/// per process) and embedded; text is left out where none of them is installed.
+pub fn svg_to_pdf(svg: &str) -> std::result::Result<Vec<u8>, String> {
+    use std::sync::{Arc, OnceLock};
+    static FONTS: OnceLock<Arc<svg2pdf::usvg::fontdb::Database>> = OnceLock::new();
+    let fonts = FONTS.get_or_init(|| {
+        let mut db = svg2pdf::usvg::fontdb::Database::new();
+        db.load_system_fonts();
+        let installed = |family: &str| {
+            db.faces()
+                .any(|f| f.families.iter().any(|(name, _)| name == family))
+        };
+        if let Some(family) = ["DejaVu Sans", "Liberation Sans", "Arial"]
+            .into_iter()
+            .find(|f| installed(f))
+        {
+            db.set_sans_serif_family(family);
+        }
+        Arc::new(db)
+    });
+    let options = svg2pdf::usvg::Options {
+        fontdb: fonts.clone(),
+        ..Default::default()
+    };
+    let tree = svg2pdf::usvg::Tree::from_str(svg, &options).map_err(|e| e.to_string())?;
+    svg2pdf::to_pdf(
+        &tree,
+        svg2pdf::ConversionOptions::default(),
+        svg2pdf::PageOptions::default(),
+    )
+    .map_err(|e| e.to_string())
 }
 
 /// A legend entry: the name, its colour and how its swatch is drawn.
