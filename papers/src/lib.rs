@@ -12,7 +12,7 @@
 //!    `--html`), [`progress`] (progress bars, drawing what they are given) and [`shard`] (the
 //!    work split of a fleet: Slurm arrays, Kubernetes Indexed Jobs, CI matrices).
 //! 2. **Runs**: [`run`], [`sweep`] and [`reference`]: plan (every check before any GPU work),
-//!    then run and write one output set.
+//!    then run and write one output set; [`equal_time`], the knob search of `run --equal-time`.
 //! 3. **Papers**: [`reproduce`], one module per paper (its targets, runs, tables, figures and
 //!    the paper's own data, printed beside ours as labelled rows), and `reproduce::all`, the
 //!    target registry and planner (manifest, shards, budget) over the papers and runs.
@@ -26,6 +26,7 @@ pub mod progress;
 pub mod registry;
 pub mod shard;
 
+pub mod equal_time;
 pub mod reference;
 pub mod run;
 pub mod sweep;

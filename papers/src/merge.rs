@@ -289,9 +289,11 @@ fn merge_shards(dirs: &[PathBuf], out: &Path) -> Result<()> {
             if runs.is_empty() {
                 continue;
             }
-            let (table, files) =
+            let (tables, files) =
                 crate::run::write_summary(&runs, &notes, out, scene, quality, None)?;
-            println!("{}", table.to_terminal());
+            for t in &tables {
+                println!("{}", t.to_terminal());
+            }
             if html {
                 let page = out.join(format!("{scene}-report.html"));
                 let figures = (files.iter())
@@ -299,7 +301,7 @@ fn merge_shards(dirs: &[PathBuf], out: &Path) -> Result<()> {
                     .map(|f| out.join(f))
                     .collect();
                 let title = format!("gibench run on {scene} (merged from {count} shards)");
-                write_page(&page, title, vec![table], figures, with_folder(out, runs))?;
+                write_page(&page, title, tables, figures, with_folder(out, runs))?;
                 pages.push(page);
             }
             all.extend(files);

@@ -11,7 +11,7 @@ use gibench_harness::measure::results::RunResult;
 use gibench_harness::output::OutputSet;
 use gibench_harness::report;
 use gibench_harness::run::quality::{IndirectComponent, QualityConfig};
-use gibench_harness::run::runner::{RunConfig, TimingMode};
+use gibench_harness::run::runner::{Harness, RunConfig, TimingMode};
 use gibench_harness::run::session::{RunSpec, TechniqueRun};
 use gibench_harness::scene::assets::AssetPaths;
 use gibench_harness::scene::{Scene, SceneDescriptor};
@@ -86,6 +86,12 @@ pub struct RunArgs {
     /// (default: each technique's declared component, see `gibench list`).
     #[arg(long)]
     pub quality_reference: Option<String>,
+    /// Compare at equal time: set each technique's quality knob (VPLs, propagation
+    /// iterations: `gibench list`) to the largest value whose frame fits this budget on this
+    /// device (e.g. 33ms), found by a short timed search, then run at those settings; an
+    /// equal-time table beside the summary.
+    #[arg(long, value_name = "MS")]
+    pub equal_time: Option<String>,
     /// Also write an HTML page of the run (`{scene}-report.html`, or `{stem}.html` for a
     /// sweep): tables, images beside the reference, error maps, time versus error.
     #[arg(long)]
@@ -130,6 +136,9 @@ pub struct Plan {
     pub params: Vec<Params>,
     pub desc: SceneDescriptor,
     pub scene: Scene,
+    /// `--equal-time`'s budget (ms), if given: each technique's knob is tuned to it when the
+    /// plan runs ([`crate::equal_time::apply`]).
+    pub equal_time: Option<f64>,
 }
 
 /// Checks `args` (with `extra_params` after its `--param`s) and loads the scene: everything a
@@ -225,6 +234,9 @@ pub fn plan(args: &RunArgs, extra_params: &[String]) -> Result<Plan> {
     if args.quality && !args.reference.no_cache {
         writable_dir("cache", &args.reference.cache)?;
     }
+    let equal_time = (args.equal_time.as_deref())
+        .map(crate::equal_time::parse_budget)
+        .transpose()?;
     Ok(Plan {
         config,
         quality,
@@ -232,6 +244,7 @@ pub fn plan(args: &RunArgs, extra_params: &[String]) -> Result<Plan> {
         params,
         desc,
         scene,
+        equal_time,
     })
 }
 
@@ -262,14 +275,23 @@ fn other_components(
 impl Plan {
     /// The typed run of these techniques, files named `{scene}-{technique}`.
     pub fn spec(&self, args: &RunArgs) -> RunSpec<'_> {
-        let runs = self
-            .techniques
-            .iter()
-            .zip(&self.params)
-            .map(|(info, params)| TechniqueRun {
+        self.spec_with(args, &self.params, &[])
+    }
+
+    /// [`Plan::spec`] with each technique's parameters from `params` and, where `recorded` has
+    /// an entry, what its results record beside the run's settings.
+    fn spec_with(
+        &self,
+        args: &RunArgs,
+        params: &[Params],
+        recorded: &[BTreeMap<String, serde_json::Value>],
+    ) -> RunSpec<'_> {
+        let runs = (self.techniques.iter().zip(params).enumerate())
+            .map(|(i, (info, params))| TechniqueRun {
                 info,
                 params: params.clone(),
                 stem: format!("{}-{}", self.desc.name, info.name),
+                settings: recorded.get(i).cloned().unwrap_or_default(),
             })
             .collect();
         RunSpec {
@@ -301,6 +323,31 @@ pub fn announcement(plan: &Plan, gpu: &GpuContext) -> String {
     )
 }
 
+/// One plan per scene of `--scene a,b` (each with `args` for that scene alone), checked.
+pub fn plan_scenes(args: &RunArgs) -> Result<Vec<(RunArgs, Plan)>> {
+    let names: Vec<&str> = args.scene.split(',').map(str::trim).collect();
+    for (i, n) in names.iter().enumerate() {
+        if n.is_empty() || names[..i].contains(n) {
+            return Err(Error::param(
+                "scene",
+                format!(
+                    "expected distinct scene names or descriptor files, comma-separated (got '{}')",
+                    args.scene
+                ),
+            ));
+        }
+    }
+    let mut plans: Vec<(RunArgs, Plan)> = Vec::new();
+    for n in &names {
+        let mut one = args.clone();
+        one.scene = n.to_string();
+        let p = plan(&one, &[])?;
+        p.spec(&one).validate()?;
+        plans.push((one, p));
+    }
+    Ok(plans)
+}
+
 /// The adapter choice `args` ask for.
 fn gpu_options(args: &RunArgs) -> GpuOptions {
     GpuOptions {
@@ -322,26 +369,7 @@ pub fn open_gpu(args: &RunArgs) -> Result<GpuContext> {
 /// `gibench merge`.
 pub fn exec(args: &RunArgs) -> Result<()> {
     // Everything that can be checked without running is checked before anything is written.
-    let names: Vec<&str> = args.scene.split(',').map(str::trim).collect();
-    for (i, n) in names.iter().enumerate() {
-        if n.is_empty() || names[..i].contains(n) {
-            return Err(Error::param(
-                "scene",
-                format!(
-                    "expected distinct scene names or descriptor files, comma-separated (got '{}')",
-                    args.scene
-                ),
-            ));
-        }
-    }
-    let mut plans: Vec<(RunArgs, Plan)> = Vec::new();
-    for n in &names {
-        let mut one = args.clone();
-        one.scene = n.to_string();
-        let p = plan(&one, &[])?;
-        p.spec(&one).validate()?;
-        plans.push((one, p));
-    }
+    let mut plans = plan_scenes(args)?;
     let shard = args.shard.resolve()?;
     let unit = |p: &Plan, t: &TechniqueInfo| format!("{}-{}", p.desc.name, t.name);
     let record = match &shard {
@@ -431,6 +459,9 @@ pub fn replace_scene_files(
         format!("{name}-rmse-per-frame.svg"),
         format!("{name}-flicker-per-frame.svg"),
         format!("{name}-time-vs-error.svg"),
+        format!("{name}-equal-time.md"),
+        format!("{name}-equal-time.csv"),
+        format!("{name}-equal-time.tex"),
     ];
     if skipped_list {
         files.push(skipped_file(name));
@@ -510,6 +541,12 @@ pub fn settings(args: &RunArgs, plan: &Plan) -> BTreeMap<String, String> {
             "quality-reference",
             args.quality_reference.clone().unwrap_or_default(),
         ),
+        (
+            "equal-time",
+            plan.equal_time
+                .map(|ms| format!("{ms}ms"))
+                .unwrap_or_default(),
+        ),
         ("commit", gibench_harness::run::runner::git_commit()),
     ]
     .into_iter()
@@ -535,8 +572,24 @@ fn run_planned_skipping(
     gpu: &GpuContext,
     bars: &Bars,
 ) -> Result<(String, Vec<gibench_harness::run::session::Skipped>)> {
-    let spec = plan.spec(args);
     bars.note(&announcement(plan, gpu));
+    // With --equal-time, each technique's knob tuned to the budget first.
+    let (mut params, mut recorded) = (plan.params.clone(), Vec::new());
+    if let Some(budget) = plan.equal_time {
+        let h = Harness::new(gpu, &plan.scene, &plan.config)?;
+        let records = crate::equal_time::apply(
+            &plan.techniques,
+            &mut params,
+            &plan.config,
+            &h,
+            budget,
+            bars,
+        )?;
+        recorded = (records.into_iter())
+            .map(|r| BTreeMap::from([("equal_time".to_string(), r)]))
+            .collect();
+    }
+    let spec = plan.spec_with(args, &params, &recorded);
     // A run over every technique leaves out one that cannot take the scene or the device; one
     // named with --technique is an error.
     let (results, skipped) =
@@ -555,7 +608,7 @@ fn run_planned_skipping(
     let notes: Vec<(String, String)> = (skipped.iter())
         .map(|s| (s.technique.clone(), s.reason.clone()))
         .collect();
-    let (table, mut written) = write_summary(
+    let (tables, mut written) = write_summary(
         &results,
         &notes,
         &args.out,
@@ -563,7 +616,9 @@ fn run_planned_skipping(
         plan.quality.is_some(),
         args.smoke.as_deref(),
     )?;
-    bars.table(&table);
+    for t in &tables {
+        bars.table(t);
+    }
     if !skipped.is_empty() {
         let list: Vec<serde_json::Value> = (skipped.iter())
             .map(|s| serde_json::json!({ "technique": s.technique, "reason": s.reason }))
@@ -590,7 +645,7 @@ fn run_planned_skipping(
         write_page(
             &page,
             format!("gibench run on {name}"),
-            vec![table],
+            tables,
             written
                 .iter()
                 .filter(|w| w.ends_with(".svg"))
@@ -604,10 +659,11 @@ fn run_planned_skipping(
 }
 
 /// The tables and plots of a run on scene `name` from its `results` (and the techniques it
-/// `skipped`, with why): `{name}-summary.md/.csv/.tex/.svg` and with `quality` the error
-/// plots, into `out`, the table marked with `smoke`'s note for a smoke run. `gibench run` and
-/// `gibench merge` (pooling shards) both write them here. Returns the table and the files
-/// written.
+/// `skipped`, with why): `{name}-summary.md/.csv/.tex/.svg`, with `quality` the error plots,
+/// and where runs record an `--equal-time` search `{name}-equal-time.md/.csv/.tex`, into
+/// `out`, the tables marked with `smoke`'s note for a smoke run. `gibench run` and `gibench
+/// merge` (pooling shards) both write them here. Returns the tables (the summary first) and
+/// the files written.
 pub fn write_summary(
     results: &[RunResult],
     skipped: &[(String, String)],
@@ -615,7 +671,7 @@ pub fn write_summary(
     name: &str,
     quality: bool,
     smoke: Option<&str>,
-) -> Result<(report::Table, Vec<String>)> {
+) -> Result<(Vec<report::Table>, Vec<String>)> {
     let mut table = report::stage_table(results);
     // Before the Pareto front's line, which ends the notes.
     let at = (table.notes.iter())
@@ -683,5 +739,14 @@ pub fn write_summary(
             written.push(file_name(&svg));
         }
     }
-    Ok((table, written))
+    let mut tables = vec![table];
+    if let Some(mut equal) = report::equal_time_table(results) {
+        if let Some(note) = smoke {
+            equal.mark_smoke(note);
+        }
+        let files = report::write_tables(&equal, out, &format!("{name}-equal-time"))?;
+        written.extend(files.iter().map(|p| file_name(p)));
+        tables.push(equal);
+    }
+    Ok((tables, written))
 }

@@ -122,6 +122,7 @@ impl SweepPlan {
                 info,
                 params: p.params[0].clone(),
                 stem: format!("{}{v}", self.point_prefix()),
+                settings: Default::default(),
             })
             .collect();
         spec
@@ -164,6 +165,12 @@ impl SweepPlan {
 
 /// Checks a sweep's arguments and plans every point before any runs.
 pub fn sweep_plan(args: &SweepArgs) -> Result<SweepPlan> {
+    if args.run.equal_time.is_some() {
+        return Err(Error::param(
+            "equal-time",
+            "applies to gibench run (a sweep sets its swept parameter itself)",
+        ));
+    }
     let (name, values) = args
         .sweep
         .split_once('=')

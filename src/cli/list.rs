@@ -64,6 +64,13 @@ pub(crate) fn exec(args: &ListArgs) -> Result<()> {
             known_bias(t.conformance.converged.boxes)
         );
         println!("      stages: {stages}");
+        match t.knob {
+            Some(k) => println!(
+                "      quality knob (run --equal-time): {}, its declared range ({})",
+                k.param, k.why
+            ),
+            None => println!("      quality knob (run --equal-time): none"),
+        }
         if t.param_specs().next().is_none() {
             println!("      (no parameters)");
         }

@@ -87,6 +87,12 @@ pub(crate) fn exec(args: &ReportArgs) -> Result<()> {
             &formats,
         )?;
     }
+    let equal_time = report::equal_time_table(&results);
+    if let Some(equal) = &equal_time {
+        println!("{}", equal.to_terminal());
+        let stem = format!("{}-equal-time", args.stem);
+        report::write_tables_as(equal, &args.out, &stem, &formats)?;
+    }
     let mut figures = vec![args.out.join(format!("{}.svg", args.stem))];
     report::stacked_bar_svg(&results, &figures[0], "Per-stage times")?;
     if !report::time_error_points(&results).is_empty() {
@@ -96,7 +102,9 @@ pub(crate) fn exec(args: &ReportArgs) -> Result<()> {
     }
     let page = args.out.join(format!("{}.html", args.stem));
     if args.html {
-        write_page(&page, table.title.clone(), vec![table], figures, runs)?;
+        let title = table.title.clone();
+        let tables = std::iter::once(table).chain(equal_time).collect();
+        write_page(&page, title, tables, figures, runs)?;
     }
     set.publish()?;
     if args.html {

@@ -485,3 +485,48 @@ fn the_terminal_table_fits_120_columns_in_every_timing_mode() {
         );
     }
 }
+
+/// `run --equal-time`: each technique with a knob runs at the value its search kept, the
+/// largest whose step fitted the budget (within `equal_time::FIT` of it), within the knob's
+/// range; its results record the search (every step, the budget, the value), `direct` (no knob)
+/// says so, and the equal-time table lists both with their errors. The frame times themselves
+/// are the machine's (a benchmark, not asserted). Catches a run at the defaults after the
+/// search, a kept value that did not fit, and a search left out of the results.
+#[test]
+fn equal_time_runs_each_technique_at_the_value_its_search_kept() {
+    use gibench_papers::equal_time::{FIT, MAX_STEPS};
+    let tmp = tempfile::tempdir().unwrap();
+    let cache = tmp.path().join("cache");
+    #[rustfmt::skip]
+    let stdout = run_ok(
+        &["--technique", "laine,direct", "--equal-time", "8ms", "--quality", "--resolution",
+          "64x48", "--frames", "6", "--warmup", "3", "--timing", "frame", "--quality-pairs", "1",
+          "--spp", "4", "--no-images", "--cache", cache.to_str().unwrap()],
+        tmp.path(),
+    );
+    assert!(stdout.contains("Error at equal time"), "{stdout}");
+    let laine = RunResult::read(&tmp.path().join("cornell-laine.json")).unwrap();
+    let e = &laine.settings["equal_time"];
+    let steps = e["steps"].as_array().unwrap();
+    assert!(!steps.is_empty() && steps.len() <= MAX_STEPS, "{e}");
+    let kept = e["value"].as_i64().unwrap();
+    let fitted = (steps.iter())
+        .filter(|s| s["frame_ms"].as_f64().is_some_and(|ms| ms <= FIT * 8.0))
+        .map(|s| s["value"].as_i64().unwrap())
+        .max();
+    match fitted {
+        Some(v) => assert_eq!(kept, v, "{e}"),
+        // Not even one VPL fitted this machine's 8 ms: the range's end, said.
+        None => assert_eq!((kept, e["end"].as_str()), (1, Some("min")), "{e}"),
+    }
+    assert_eq!(laine.parameters["vpls"], serde_json::json!(kept));
+    assert_eq!(e["budget_ms"], 8.0);
+    let direct = RunResult::read(&tmp.path().join("cornell-direct.json")).unwrap();
+    assert!(direct.settings["equal_time"]["knob"].is_null());
+    let csv = std::fs::read_to_string(tmp.path().join("cornell-equal-time.csv")).unwrap();
+    assert!(
+        csv.contains(&format!("cornell,laine,vpls={kept}"))
+            && csv.contains("cornell,direct,– (no knob)"),
+        "{csv}"
+    );
+}

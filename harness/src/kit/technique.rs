@@ -245,6 +245,25 @@ pub fn multi_bounce(_: &Params) -> IndirectComponent {
     IndirectComponent::MultiBounce
 }
 
+/// A technique's quality knob: the integer parameter whose larger values cost more time per
+/// frame and give less error (VPLs, propagation iterations), searched over its declared range
+/// by `gibench run --equal-time` for the largest value whose frame fits a budget.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Knob {
+    /// The parameter (an integer one of the technique's).
+    pub param: &'static str,
+    /// Why time and error follow it ("each VPL adds a shadow map and a gather term").
+    pub why: &'static str,
+}
+
+impl Knob {
+    /// The VPL count of an instant-radiosity technique.
+    pub const VPLS: Knob = Knob {
+        param: "vpls",
+        why: "each VPL adds a shadow map and a term to every pixel's gather; more VPLs, less noise",
+    };
+}
+
 /// The `prepare` of a technique that prepares nothing.
 pub fn prepare_nothing(_: &Params, _: &PrepareContext) -> Result<Prepared> {
     Ok(Box::new(()))
@@ -466,6 +485,8 @@ pub struct TechniqueInfo {
     pub reference: fn(&Params) -> IndirectComponent,
     /// Its conformance bounds.
     pub conformance: Conformance,
+    /// The parameter that trades time for error (`gibench run --equal-time`), if any.
+    pub knob: Option<Knob>,
     /// Per-scene preparation, once per scene and parameter set ([`prepare_nothing`] if none).
     pub prepare: fn(&Params, &PrepareContext) -> Result<Prepared>,
     /// Builds the technique for one scene from what `prepare` made.

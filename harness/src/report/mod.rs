@@ -15,6 +15,8 @@
 //! * [`glance_table`]: the first screen of a page: per run its frame time, error against its
 //!   reference component and Pareto rank ([`pareto_line`]: the front in one line, the stage
 //!   table's last note);
+//! * [`equal_time_table`]: the settings `gibench run --equal-time` found for a budget and the
+//!   errors at them;
 //! * [`roofline_table`]: one run, one row per GPU stage, its achieved fractions of the device's
 //!   measured bandwidth and arithmetic rate ([`crate::measure::roofline`]; also `--detailed`).
 //!
@@ -56,6 +58,7 @@
 
 pub mod compare;
 mod csv;
+mod equal_time;
 mod glance;
 pub mod html;
 mod latex;
@@ -71,6 +74,7 @@ mod terminal;
 #[cfg(test)]
 mod tests;
 
+pub use equal_time::equal_time_table;
 pub use glance::{component_of, glance_table, pareto_line, pareto_ranks};
 pub use pareto::{distinct_label, frame_time_ms, pareto_front, time_error_points};
 pub use plot::{

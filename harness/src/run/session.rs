@@ -78,6 +78,8 @@ pub struct TechniqueRun {
     pub params: Params,
     /// File name stem of its outputs (unique within the run).
     pub stem: String,
+    /// Recorded in its results beside the run's settings (`gibench run --equal-time`'s search).
+    pub settings: std::collections::BTreeMap<String, serde_json::Value>,
 }
 
 impl TechniqueRun {
@@ -96,6 +98,7 @@ impl TechniqueRun {
             info,
             params: info.parse_params(&given)?,
             stem: stem.into(),
+            settings: Default::default(),
         })
     }
 }
@@ -249,6 +252,7 @@ fn execute_one(
     let (mut result, images) = harness.run(info, params, config, prepared, &mut || {
         progress(Progress::Frame)
     })?;
+    result.settings.extend(run.settings.clone());
     let mut extra_images = Vec::new();
     if let Some(q) = &spec.quality {
         let label = format!("{} (quality)", info.name);

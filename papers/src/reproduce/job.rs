@@ -9,7 +9,7 @@ use gibench_harness::{Error, Result};
 
 use crate::progress::Bars;
 use crate::reference::{reference_plan, reference_planned, ReferenceArgs, ReferencePlan};
-use crate::run::{plan, run_planned, Plan, RunArgs};
+use crate::run::{plan_scenes, run_planned, Plan, RunArgs};
 use crate::sweep::{sweep_plan, sweep_planned, SweepArgs, SweepPlan};
 
 /// The commands a target may be, parsed as `gibench run|sweep|reference ...` is.
@@ -23,7 +23,8 @@ enum TargetCommand {
 
 /// A gibench command run as a target of `gibench reproduce`, checked before anything runs.
 pub enum Job {
-    Run(Box<RunArgs>, Box<Plan>),
+    /// One plan per scene of its `--scene a,b`.
+    Run(Vec<(RunArgs, Plan)>),
     Sweep(Box<SweepArgs>, Box<SweepPlan>),
     Reference(Box<ReferenceArgs>, Box<ReferencePlan>),
 }
@@ -45,11 +46,7 @@ impl Job {
         )
         .map_err(|e| Error::Invalid(e.to_string().trim().to_string()))?;
         match command {
-            TargetCommand::Run(a) => {
-                let p = plan(&a, &[])?;
-                p.spec(&a).validate()?;
-                Ok(Job::Run(Box::new(a), Box::new(p)))
-            }
+            TargetCommand::Run(a) => Ok(Job::Run(plan_scenes(&a)?)),
             TargetCommand::Sweep(a) => {
                 let p = sweep_plan(&a)?;
                 Ok(Job::Sweep(Box::new(a), Box::new(p)))
@@ -65,7 +62,9 @@ impl Job {
     /// a reference command writes no table of timings).
     pub fn mark_smoke(&mut self, note: String) {
         match self {
-            Job::Run(a, _) => a.smoke = Some(note),
+            Job::Run(plans) => plans
+                .iter_mut()
+                .for_each(|(a, _)| a.smoke = Some(note.clone())),
             Job::Sweep(a, _) => a.run.smoke = Some(note),
             Job::Reference(..) => {}
         }
@@ -83,7 +82,9 @@ impl Job {
             (frames, frames * w as u64 * h as u64)
         };
         match self {
-            Job::Run(a, p) => of(&p.spec(a)),
+            Job::Run(plans) => (plans.iter())
+                .map(|(a, p)| of(&p.spec(a)))
+                .fold((0, 0), |(f, u), (g, v)| (f + g, u + v)),
             Job::Sweep(a, p) => of(&p.spec(a)),
             Job::Reference(a, p) => {
                 let seeds = 1 + a.error_estimate as u64;
@@ -98,7 +99,13 @@ impl Job {
         let gpu =
             || gpu.ok_or_else(|| Error::Invalid("no adapter was opened for a GPU run".into()));
         match self {
-            Job::Run(a, p) => run_planned(a, p, gpu()?, bars),
+            Job::Run(plans) => {
+                let mut lines = Vec::new();
+                for (a, p) in plans {
+                    lines.push(run_planned(a, p, gpu()?, bars)?);
+                }
+                Ok(lines.join("\n"))
+            }
             Job::Sweep(a, p) => sweep_planned(a, p, gpu()?, bars),
             Job::Reference(a, p) => reference_planned(a, p, bars),
         }

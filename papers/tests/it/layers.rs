@@ -12,7 +12,7 @@ const LAYERS: &[&[&str]] = &[
     &[
         "registry", "options", "params", "files", "page", "progress", "shard",
     ],
-    &["run", "sweep", "reference"],
+    &["run", "sweep", "reference", "equal_time"],
     &["reproduce"],
     &["merge"],
 ];

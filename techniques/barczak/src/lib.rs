@@ -81,7 +81,7 @@ pub use params::BarczakParams;
 
 use gibench_harness::kit::technique::IndirectComponent;
 use gibench_harness::kit::technique::{
-    cornell_boxes, Conformance, Converged, FrameContext, KnownBias, Params, PrepareContext,
+    cornell_boxes, Conformance, Converged, FrameContext, Knob, KnownBias, Params, PrepareContext,
     Prepared, Technique, TechniqueInfo,
 };
 use gibench_harness::{wgpu, Error, Result};
@@ -173,6 +173,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
             boxes: &cornell_boxes([(0.952, 0.125), (0.985, 0.125), (0.962, 0.515), (0.973, 0.159)]),
         },
     },
+    knob: Some(Knob::VPLS),
     prepare,
     create,
 };

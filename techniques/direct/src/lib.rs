@@ -36,6 +36,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
             boxes: &cornell_boxes([(0.0, 1.0); 4]),
         },
     },
+    knob: None,
     prepare: prepare_nothing,
     create,
 };

@@ -63,8 +63,8 @@ pub mod volume;
 pub use params::GaitatzesParams;
 
 use gibench_harness::kit::technique::{
-    cornell_boxes, prepare_nothing, Conformance, Converged, FrameContext, Params, PrepareContext,
-    Prepared, Technique, TechniqueInfo,
+    cornell_boxes, prepare_nothing, Conformance, Converged, FrameContext, Knob, Params,
+    PrepareContext, Prepared, Technique, TechniqueInfo,
 };
 use gibench_harness::{wgpu, Result};
 
@@ -72,6 +72,12 @@ use gibench_harness::kit::ir::rsm::ReflectiveShadowMap;
 use gibench_harness::measure::roofline::StageCost;
 use params::PARAMS;
 use volume::{Grid, Mode, Propagation, Reconstruction, Volumes, Voxelizer, CELL_BYTES};
+
+/// The quality knob (`gibench run --equal-time`): the propagation iterations.
+const KNOB: Knob = Knob {
+    param: "iterations",
+    why: "each iteration carries light one cell further (more of it, and more bounces, arrive) at one more pass over the grid",
+};
 
 /// Stage: voxelization, combine and injection.
 pub const STAGE_VOXELIZATION: &str = "voxelization";
@@ -120,6 +126,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
             boxes: &cornell_boxes([(0.991, 0.262), (1.003, 0.262), (1.055, 0.651), (0.987, 0.323)]),
         },
     },
+    knob: Some(KNOB),
     prepare: prepare_nothing,
     create,
 };

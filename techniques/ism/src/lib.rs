@@ -49,7 +49,7 @@ use gibench_harness::kit::ir::splat::PointSplat;
 use gibench_harness::kit::ir::vpl_sample::{RsmTexels, VplSampler};
 use gibench_harness::kit::passes::DrawSet;
 use gibench_harness::kit::technique::{
-    cornell_boxes, Conformance, Converged, FrameContext, Params, PrepareContext, Prepared,
+    cornell_boxes, Conformance, Converged, FrameContext, Knob, Params, PrepareContext, Prepared,
     Technique, TechniqueInfo,
 };
 use gibench_harness::{wgpu, Error, Result};
@@ -105,6 +105,7 @@ pub const INFO_CLASSIC: TechniqueInfo = TechniqueInfo {
             boxes: &cornell_boxes([(0.995, 0.244), (1.000, 0.247), (0.988, 0.641), (1.017, 0.397)]),
         },
     },
+    knob: Some(Knob::VPLS),
     prepare: prepare_classic,
     create: create_classic,
 };
@@ -142,6 +143,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
             boxes: &cornell_boxes([(0.981, 0.243), (0.983, 0.242), (0.933, 0.629), (1.062, 0.397)]),
         },
     },
+    knob: Some(Knob::VPLS),
     prepare,
     create,
 };

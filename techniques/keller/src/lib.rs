@@ -39,7 +39,7 @@ use gibench_harness::kit::ir::raster::AtlasClear;
 use gibench_harness::kit::passes::DrawSet;
 use gibench_harness::kit::technique::IndirectComponent;
 use gibench_harness::kit::technique::{
-    cornell_boxes, Conformance, Converged, FrameContext, Params, PrepareContext, Prepared,
+    cornell_boxes, Conformance, Converged, FrameContext, Knob, Params, PrepareContext, Prepared,
     Technique, TechniqueInfo,
 };
 use gibench_harness::{wgpu, Error, Result};
@@ -114,6 +114,7 @@ pub const FULL: TechniqueInfo = TechniqueInfo {
     required_limits: wgpu::Limits::downlevel_defaults,
     reference: computed_component,
     conformance: CONFORMANCE_FULL,
+    knob: Some(Knob::VPLS),
     prepare,
     create: create_full,
 };
@@ -130,6 +131,7 @@ pub const INCREMENTAL: TechniqueInfo = TechniqueInfo {
     required_limits: wgpu::Limits::downlevel_defaults,
     reference: computed_component,
     conformance: CONFORMANCE_INCREMENTAL,
+    knob: Some(Knob::VPLS),
     prepare,
     create: create_incremental,
 };

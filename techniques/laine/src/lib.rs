@@ -52,8 +52,8 @@ use gibench_harness::kit::ir::gather::{VplGather, GATHER_PARAMS};
 use gibench_harness::kit::ir::raster::AtlasClear;
 use gibench_harness::kit::passes::DrawSet;
 use gibench_harness::kit::technique::{
-    cornell_boxes, prepare_nothing, Conformance, Converged, FrameContext, Params, PrepareContext,
-    Prepared, Technique, TechniqueInfo,
+    cornell_boxes, prepare_nothing, Conformance, Converged, FrameContext, Knob, Params,
+    PrepareContext, Prepared, Technique, TechniqueInfo,
 };
 use gibench_harness::scene::anim::LightPose;
 use gibench_harness::{wgpu, Result};
@@ -94,6 +94,7 @@ pub const INFO: TechniqueInfo = TechniqueInfo {
             boxes: &cornell_boxes([(1.027, 0.150), (1.008, 0.128), (0.996, 0.648), (0.947, 0.207)]),
         },
     },
+    knob: Some(Knob::VPLS),
     prepare: prepare_nothing,
     create,
 };

@@ -248,11 +248,26 @@ fn quality_options_need_quality_and_reference_sizes_have_limits() {
             &["--quality", "--quality-pairs", "0"][..],
             &["quality-pairs", "at least one"][..],
         ),
+        (
+            &["--equal-time", "0ms"][..],
+            &["equal-time", "milliseconds above 0", "'0ms'"][..],
+        ),
+        (
+            &["--equal-time", "soon"][..],
+            &["equal-time", "e.g. 33ms", "'soon'"][..],
+        ),
     ] {
         let mut args = run.to_vec();
         args.extend(extra);
         command_fails(tmp.path(), &[], &args, expect);
     }
+    #[rustfmt::skip]
+    command_fails(
+        tmp.path(),
+        &[],
+        &["sweep", "--technique", "laine", "--sweep", "vpls=8,16", "--equal-time", "9ms", "--out", "o"],
+        &["equal-time", "applies to gibench run"],
+    );
     let reference = [
         "reference",
         "--resolution",

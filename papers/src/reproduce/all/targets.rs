@@ -324,6 +324,15 @@ pub const TARGETS: &[Target] = &[
             paper: "sweep --scene sibenik --technique gaitatzes --sweep transport=cosine,carry,pyramid --quality --quality-reference multi-bounce --resolution 512x512 --frames 100 --warmup 10 --timing stages",
         },
     },
+    Target {
+        name: "equal-time",
+        dir: "equal-time",
+        what: "every technique at equal time on the Cornell box and Sibenik: each quality knob (VPLs, iterations) set by a short timed search to the largest value whose frame fits the budget, then the error at those settings against both components",
+        kind: Kind::Command {
+            quick: "run --scene cornell,sibenik --equal-time 150ms --quality --quality-pairs 1 --frames 10 --warmup 3 --timing frame",
+            paper: "run --scene cornell,sibenik --equal-time 33ms --quality --resolution 1024x768 --frames 100 --warmup 10 --timing frame",
+        },
+    },
 ];
 
 /// The order `all --budget` runs the targets in: the papers' headline tables first (Laine's
@@ -355,6 +364,7 @@ pub const PRIORITY: &[&str] = &[
     "gaitatzes-iterations",
     "gaitatzes-transport",
     "gaitatzes-sibenik",
+    "equal-time",
     "laine-sibenik-1024",
     "laine-sibenik-vpls",
     "keller-lag",

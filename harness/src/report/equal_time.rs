@@ -1,0 +1,97 @@
+//! The equal-time table: techniques at the settings `gibench run --equal-time` found for one
+//! frame-time budget, with their errors against each reference component.
+//!
+//! Reads: [`RunResult`]s whose `settings.equal_time` records the search (budget, knob, value,
+//! steps; `papers::equal_time`). Writes: a [`Table`].
+
+use serde_json::Value;
+
+use super::glance::{error_cell, error_columns, errors_note};
+use super::pareto::frame_time_ms;
+use super::table::{Cell, Table};
+use crate::measure::metrics::ComponentErrors;
+use crate::measure::results::RunResult;
+
+/// A run's `settings.equal_time` record, if it has one.
+fn record(r: &RunResult) -> Option<&Value> {
+    r.settings.get("equal_time")
+}
+
+/// One row per run with an equal-time record: technique, the knob's value (marked where the
+/// knob's range ended the search), the budget, the frame time the search measured and the run
+/// measured, relMSE and FLIP against each component (the own marked), and the search's steps.
+/// `None` when no run has a record.
+pub fn equal_time_table(results: &[RunResult]) -> Option<Table> {
+    let runs: Vec<&RunResult> = results.iter().filter(|r| record(r).is_some()).collect();
+    if runs.is_empty() {
+        return None;
+    }
+    const NAMES: [&str; 2] = ComponentErrors::NAMES;
+    let rows = (runs.iter())
+        .map(|r| {
+            let e = record(r).expect("filtered above");
+            let setting = match (e["knob"].as_str(), e["value"].as_i64()) {
+                (Some(k), Some(v)) => match e["end"].as_str() {
+                    Some(end) => format!("{k}={v} (range {end})"),
+                    None => format!("{k}={v}"),
+                },
+                _ => "– (no knob)".to_string(),
+            };
+            let steps: Vec<String> = (e["steps"].as_array().into_iter().flatten())
+                .map(|s| match s["frame_ms"].as_f64() {
+                    Some(ms) => format!("{} {ms:.1}", s["value"]),
+                    None => format!("{} failed", s["value"]),
+                })
+                .collect();
+            [
+                Cell::text(&r.scene),
+                Cell::text(&r.technique),
+                Cell::text(setting),
+                Cell::Ms(e["budget_ms"].as_f64()),
+                Cell::Ms(e["frame_ms"].as_f64()),
+                Cell::Ms(frame_time_ms(r)),
+            ]
+            .into_iter()
+            .chain(NAMES.map(|c| error_cell(r, c, |e| e.rel_mse.mean, 4)))
+            .chain(NAMES.map(|c| error_cell(r, c, |e| e.flip_mean.mean, 4)))
+            .chain([Cell::text(if steps.is_empty() {
+                "–".to_string()
+            } else {
+                steps.join(" → ")
+            })])
+            .collect()
+        })
+        .collect();
+    let columns = [
+        "scene",
+        "technique",
+        "setting",
+        "budget ms",
+        "search ms",
+        "frame ms",
+    ]
+    .map(String::from)
+    .into_iter()
+    .chain(error_columns("relMSE"))
+    .chain(error_columns("FLIP"))
+    .chain(["search (value ms → …)".to_string()])
+    .collect();
+    let owned: Vec<RunResult> = runs.iter().map(|r| (*r).clone()).collect();
+    let notes = vec![
+        "Equal time: each technique's quality knob (gibench list) set to the largest value whose \
+         frame fitted the budget in a short timed search on this device (steps of a few frames \
+         after a warm-up, each value's median frame: column search), the search ending within \
+         15 % under the budget, where no untried value lay between one that fitted and one that \
+         did not, or at the knob's range end (said); frame ms: the run's own measurement at that \
+         setting, which the machine's noise may put a little off the search's. Errors are the \
+         run's at that setting."
+            .to_string(),
+        errors_note(&owned),
+    ];
+    Some(Table {
+        title: "Error at equal time".to_string(),
+        columns,
+        rows,
+        notes,
+    })
+}
