@@ -26,12 +26,19 @@ pub const LOW: f64 = 0.85;
 pub const FIT: f64 = 0.95;
 /// A new value aims at this fraction of the budget (between [`LOW`] and [`FIT`]).
 const AIM: f64 = 0.9;
-/// At most this many timed steps per technique.
+/// At most this many timed steps per technique (values that fail to run, at preparation, do
+/// not count; at most four times as many tries in all).
 pub const MAX_STEPS: usize = 8;
 /// Measured frames of a step.
 pub const STEP_FRAMES: u32 = 10;
 /// Warm-up frames of a step.
 pub const STEP_WARMUP: u32 = 3;
+
+/// The most frames a technique's search renders (its timed steps, warm-up included): what a
+/// work estimate adds for it.
+pub fn search_frames() -> u64 {
+    MAX_STEPS as u64 * (STEP_FRAMES + STEP_WARMUP) as u64
+}
 
 /// The budget given to `--equal-time` ("33ms", "33.3ms" or "33": milliseconds), in ms; an
 /// error naming the option otherwise.
@@ -56,8 +63,8 @@ pub struct Step {
 }
 
 /// What a search found: the value kept, its step's frame time, every step in order, and where
-/// the knob's range ended the search ("max": even the largest value fits; "min": even the
-/// smallest does not).
+/// the knob's range ended the search ("max": even the largest value that runs fits; "min":
+/// even the smallest does not; "over budget": no value tried fits, the smallest that ran kept).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Found {
     pub value: i64,
@@ -67,89 +74,117 @@ pub struct Found {
 }
 
 /// The largest whole value in `min..=max` whose `measure`d frame time fits `budget` ([`FIT`];
-/// see the module documentation), starting from `start`. A failed measurement counts as over the
-/// budget.
+/// see the module documentation), starting from `start`. A value that fails to run narrows
+/// the range: below a value that ran, the technique needs more (Laine's `vpls` above its
+/// `recalc-min`), so the range starts above it; otherwise the device cannot hold that many, so
+/// the range ends below it. Where nothing fits, the smallest value that ran is kept, said as
+/// "min" when it is the range's start and "over budget" otherwise; a value that failed is
+/// never kept (`None` where none ran: the error of the last step).
 pub fn search(
     (min, max): (i64, i64),
     start: i64,
     budget: f64,
     measure: &mut dyn FnMut(i64) -> Result<f64>,
-) -> Found {
+) -> Result<Found> {
+    let (mut lo, mut hi) = (min, max);
     let mut steps: Vec<Step> = Vec::new();
     let mut v = start.clamp(min, max);
+    let mut last_error = None;
     loop {
-        let step = match measure(v) {
-            Ok(ms) => Step {
+        match measure(v) {
+            Ok(ms) => steps.push(Step {
                 value: v,
                 frame_ms: ms,
                 note: None,
-            },
-            Err(e) => Step {
-                value: v,
-                frame_ms: f64::INFINITY,
-                note: Some(e.to_string()),
-            },
-        };
-        steps.push(step);
-        let fits = (steps.iter())
+            }),
+            Err(e) => {
+                if steps.iter().any(|s| s.frame_ms.is_finite() && s.value > v) {
+                    lo = lo.max(v + 1);
+                } else {
+                    hi = hi.min(v - 1);
+                }
+                steps.push(Step {
+                    value: v,
+                    frame_ms: f64::INFINITY,
+                    note: Some(e.to_string()),
+                });
+                last_error = Some(e);
+            }
+        }
+        let ran = || steps.iter().filter(|s| s.frame_ms.is_finite());
+        let fits = ran()
             .filter(|s| s.frame_ms <= FIT * budget)
             .max_by_key(|s| s.value);
-        let over = (steps.iter())
+        let over = ran()
             .filter(|s| s.frame_ms > FIT * budget)
             .min_by_key(|s| s.value);
-        if steps.len() >= MAX_STEPS || fits.is_some_and(|f| f.frame_ms >= LOW * budget) {
+        // Failed steps end at preparation (a parameter check, a buffer that does not fit), so
+        // only those that ran count against MAX_STEPS; every value is tried once at most.
+        if ran().count() >= MAX_STEPS
+            || steps.len() >= 4 * MAX_STEPS
+            || lo > hi
+            || fits.is_some_and(|f| f.frame_ms >= LOW * budget)
+        {
             break;
         }
         let aim = AIM * budget;
         let next = match (fits, over) {
-            (Some(f), Some(o)) if o.value - f.value <= 1 => break,
-            (Some(f), Some(o)) if o.frame_ms.is_finite() => {
+            (Some(f), Some(o)) => {
                 let at = (aim - f.frame_ms) / (o.frame_ms - f.frame_ms);
                 let x = f.value as f64 + (o.value - f.value) as f64 * at.clamp(0.0, 1.0);
-                (x.round() as i64).clamp(f.value + 1, o.value - 1)
+                (x.round() as i64).clamp(f.value + 1, (o.value - 1).min(hi))
             }
-            // The larger value failed to run: halve the gap.
-            (Some(f), Some(o)) => f.value + (o.value - f.value) / 2,
-            (Some(f), None) if f.value >= max => break,
             (Some(f), None) => {
                 let x = f.value.max(1) as f64 * aim / f.frame_ms.max(1e-6);
-                (x.round() as i64).clamp(f.value + 1, max)
+                match x.round() as i64 {
+                    // Beyond a value that failed to run: halfway to it.
+                    x if x > hi && hi < max => f.value + (hi - f.value + 1) / 2,
+                    x => x.clamp(f.value + 1, hi.max(f.value + 1)),
+                }
             }
-            (None, Some(o)) if o.value <= min => break,
-            (None, Some(o)) if o.frame_ms.is_finite() => {
+            // Over the budget once: a step in proportion; twice: straight to the range's start
+            // (a large fixed cost per frame makes proportional steps short).
+            (None, Some(o)) if ran().count() == 1 => {
                 let x = o.value as f64 * aim / o.frame_ms;
-                (x.round() as i64).clamp(min, o.value - 1)
+                (x.round() as i64).clamp(lo, (o.value - 1).max(lo))
             }
-            (None, Some(o)) => min + (o.value - min) / 2,
-            (None, None) => break,
+            // After a value below failed to run: halfway between it and the smallest that ran.
+            (None, Some(o)) if steps.last().is_some_and(|s| !s.frame_ms.is_finite()) => {
+                lo + (o.value - lo) / 2
+            }
+            (None, Some(_)) => lo,
+            // Nothing ran yet: halfway into what is left.
+            (None, None) => lo + (hi - lo) / 2,
         };
-        if steps.iter().any(|s| s.value == next) {
+        if next < lo || next > hi || steps.iter().any(|s| s.value == next) {
             break;
         }
         v = next;
     }
-    let fits = (steps.iter())
+    let ran = || steps.iter().filter(|s| s.frame_ms.is_finite());
+    let fits = ran()
         .filter(|s| s.frame_ms <= FIT * budget)
         .max_by_key(|s| s.value)
         .cloned();
     let (chosen, end) = match fits {
         Some(f) => {
-            let end = (f.value == max).then_some("max");
+            let end = (f.value == max || f.value == hi).then_some("max");
             (f, end)
         }
-        None => {
-            let smallest = (steps.iter()).min_by_key(|s| s.value).cloned();
-            let s = smallest.expect("at least one step");
-            let end = (s.value == min).then_some("min");
-            (s, end)
-        }
+        None => match ran().min_by_key(|s| s.value).cloned() {
+            Some(s) => {
+                let end = if s.value == lo { "min" } else { "over budget" };
+                (s, Some(end))
+            }
+            None => return Err(last_error.expect("a step failed")),
+        },
     };
-    Found {
+    Ok(Found {
         value: chosen.value,
         frame_ms: chosen.frame_ms,
         steps,
         end,
-    }
+    })
 }
 
 /// The searched range of `knob` on `info`: its integer parameter's declared range.
@@ -216,7 +251,8 @@ pub fn apply(
             ));
             Ok(ms)
         };
-        let found = search((min, max), start, budget, &mut measure);
+        let found = search((min, max), start, budget, &mut measure)
+            .map_err(|e| Error::Invalid(format!("{}: no {} ran: {e}", info.name, knob.param)))?;
         given.retain(|(k, _)| k != knob.param);
         given.push((knob.param.to_string(), found.value.to_string()));
         params[i] = info.parse_params(&given)?;
@@ -259,7 +295,7 @@ mod tests {
     /// value beyond it.
     #[test]
     fn the_search_lands_within_fifteen_percent_under_the_budget() {
-        let found = search((1, 4096), 64, 33.0, &mut affine);
+        let found = search((1, 4096), 64, 33.0, &mut affine).unwrap();
         assert!(
             found.frame_ms <= FIT * 33.0 && found.frame_ms >= LOW * 33.0,
             "{found:?}"
@@ -277,9 +313,9 @@ mod tests {
     /// as over the budget and is noted.
     #[test]
     fn range_ends_and_failed_steps_are_said() {
-        let found = search((1, 4096), 64, 1000.0, &mut affine);
+        let found = search((1, 4096), 64, 1000.0, &mut affine).unwrap();
         assert_eq!((found.value, found.end), (4096, Some("max")));
-        let found = search((1, 4096), 64, 1.0, &mut affine);
+        let found = search((1, 4096), 64, 1.0, &mut affine).unwrap();
         assert_eq!((found.value, found.end), (1, Some("min")));
         let mut limited = |v: i64| {
             if v > 200 {
@@ -288,9 +324,35 @@ mod tests {
                 affine(v)
             }
         };
-        let found = search((1, 4096), 64, 33.0, &mut limited);
-        assert!(found.value <= 200 && found.end.is_none(), "{found:?}");
+        // 200 is the largest value that runs, and it fits: said as the range's end, found in
+        // halving steps (not one value at a time down from the first failure).
+        let found = search((1, 4096), 64, 33.0, &mut limited).unwrap();
+        assert_eq!((found.value, found.end), (200, Some("max")), "{found:?}");
+        assert!(found.steps.len() <= 12, "{found:?}");
         assert!(found.steps.iter().any(|s| s.note.is_some()), "{found:?}");
+    }
+
+    /// A technique that needs a minimum (Laine: `vpls` above `recalc-min` = 4) over a budget
+    /// its default misses: the search does not keep a value that failed, and a failure below
+    /// one that ran raises the range's start instead of ending the search there. Catches the
+    /// search halving into failures down to 1 and keeping a value the run then refuses.
+    #[test]
+    fn failures_below_a_value_that_ran_raise_the_start() {
+        let mut needs_five = |v: i64| {
+            if v < 5 {
+                Err(Error::Invalid("recalc-min must be below vpls".into()))
+            } else {
+                Ok(20.0 + 0.5 * v as f64)
+            }
+        };
+        // 64: 52 ms, far over 30; the proportional step lands below 5.
+        let found = search((1, 4096), 64, 30.0, &mut needs_five).unwrap();
+        assert!(found.value >= 5, "{found:?}");
+        assert!(found.frame_ms.is_finite(), "{found:?}");
+        assert!(found.frame_ms <= FIT * 30.0, "{found:?}");
+        // Nothing fits 10 ms: the smallest value that ran, said.
+        let found = search((1, 4096), 64, 10.0, &mut needs_five).unwrap();
+        assert_eq!((found.value, found.end), (5, Some("min")), "{found:?}");
     }
 
     #[test]

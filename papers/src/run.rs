@@ -371,6 +371,14 @@ pub fn exec(args: &RunArgs) -> Result<()> {
     // Everything that can be checked without running is checked before anything is written.
     let mut plans = plan_scenes(args)?;
     let shard = args.shard.resolve()?;
+    if shard.is_some() && args.equal_time.is_some() {
+        // Each shard would tune its techniques on its own device: a merged table would compare
+        // settings found on different machines.
+        return Err(Error::param(
+            "equal-time",
+            "cannot be sharded: every technique must be tuned on one device (run it unsharded)",
+        ));
+    }
     let unit = |p: &Plan, t: &TechniqueInfo| format!("{}-{}", p.desc.name, t.name);
     let record = match &shard {
         Some(s) => {

@@ -70,6 +70,22 @@ pub(crate) fn exec(args: &ReportArgs) -> Result<()> {
         table = table.select_columns("columns", &args.columns)?;
     }
     let set = OutputSet::begin("out", &args.out)?;
+    // Files of this stem that only some reports write: an earlier report's would describe
+    // other runs.
+    let stem = &args.stem;
+    for f in [
+        format!("{stem}-equal-time.md"),
+        format!("{stem}-equal-time.csv"),
+        format!("{stem}-equal-time.tex"),
+        format!("{stem}-time-vs-error.svg"),
+        format!("{stem}-time-vs-error.pdf"),
+        format!("{stem}-speedup.md"),
+        format!("{stem}-speedup.csv"),
+        format!("{stem}-speedup.tex"),
+        format!("{stem}.html"),
+    ] {
+        set.replace_files(&f)?;
+    }
     println!("{}", table.to_terminal());
     if args.detailed {
         for r in &results {

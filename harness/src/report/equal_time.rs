@@ -6,7 +6,7 @@
 
 use serde_json::Value;
 
-use super::glance::{error_cell, error_columns, errors_note};
+use super::glance::{error_cell, error_columns};
 use super::pareto::frame_time_ms;
 use super::table::{Cell, Table};
 use crate::measure::metrics::ComponentErrors;
@@ -32,7 +32,9 @@ pub fn equal_time_table(results: &[RunResult]) -> Option<Table> {
             let e = record(r).expect("filtered above");
             let setting = match (e["knob"].as_str(), e["value"].as_i64()) {
                 (Some(k), Some(v)) => match e["end"].as_str() {
-                    Some(end) => format!("{k}={v} (range {end})"),
+                    Some("max") => format!("{k}={v} (its largest: fits)"),
+                    Some("min") => format!("{k}={v} (its smallest: over budget)"),
+                    Some(_) => format!("{k}={v} (over budget)"),
                     None => format!("{k}={v}"),
                 },
                 _ => "– (no knob)".to_string(),
@@ -47,6 +49,7 @@ pub fn equal_time_table(results: &[RunResult]) -> Option<Table> {
                 Cell::text(&r.scene),
                 Cell::text(&r.technique),
                 Cell::text(setting),
+                Cell::text(super::glance::component_of(r).unwrap_or("–")),
                 Cell::Ms(e["budget_ms"].as_f64()),
                 Cell::Ms(e["frame_ms"].as_f64()),
                 Cell::Ms(frame_time_ms(r)),
@@ -76,17 +79,23 @@ pub fn equal_time_table(results: &[RunResult]) -> Option<Table> {
     .chain(error_columns("FLIP"))
     .chain(["search (value ms → …)".to_string()])
     .collect();
-    let owned: Vec<RunResult> = runs.iter().map(|r| (*r).clone()).collect();
     let notes = vec![
         "Equal time: each technique's quality knob (gibench list) set to the largest value whose \
-         frame fitted the budget in a short timed search on this device (steps of a few frames \
-         after a warm-up, each value's median frame: column search), the search ending within \
-         15 % under the budget, where no untried value lay between one that fitted and one that \
-         did not, or at the knob's range end (said); frame ms: the run's own measurement at that \
-         setting, which the machine's noise may put a little off the search's. Errors are the \
-         run's at that setting."
+         frame fitted the budget (within 95 % of it, the rest left for the run's own \
+         measurement) in a short timed search on this device: steps of a few frames after a \
+         warm-up, each value's median frame (column search, value and ms per step), ending once \
+         a fitting value reached 85 % of the budget, where no untried value lay between one that \
+         fitted and one that did not, or at the knob's range end (said in column setting: its \
+         largest value fits, or its smallest, or every value tried, is over budget). frame ms: \
+         the run's own measurement at that setting, which the machine's noise may put a little \
+         off the search's."
             .to_string(),
-        errors_note(&owned),
+        format!(
+            "relMSE (of indirect irradiance) and FLIP against each indirect component of the \
+             reference: one-bounce and multi-bounce; {} marks the run's own, the component its \
+             technique computes (column reference).",
+            super::table::OWN_MARK
+        ),
     ];
     Some(Table {
         title: "Error at equal time".to_string(),

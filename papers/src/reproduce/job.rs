@@ -83,7 +83,17 @@ impl Job {
         };
         match self {
             Job::Run(plans) => (plans.iter())
-                .map(|(a, p)| of(&p.spec(a)))
+                .map(|(a, p)| {
+                    let (frames, units) = of(&p.spec(a));
+                    // --equal-time's search: at most this many frames more per technique with
+                    // a knob (an upper bound; the manifest's rate absorbs the difference).
+                    let search = p.equal_time.map_or(0, |_| {
+                        let tuned = p.techniques.iter().filter(|t| t.knob.is_some()).count();
+                        tuned as u64 * crate::equal_time::search_frames()
+                    });
+                    let [w, h] = p.config.resolution;
+                    (frames + search, units + search * w as u64 * h as u64)
+                })
                 .fold((0, 0), |(f, u), (g, v)| (f + g, u + v)),
             Job::Sweep(a, p) => of(&p.spec(a)),
             Job::Reference(a, p) => {

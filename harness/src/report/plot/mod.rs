@@ -126,11 +126,15 @@ pub fn svg_to_pdf(svg: &str) -> std::result::Result<Vec<u8>, String> {
             db.faces()
                 .any(|f| f.families.iter().any(|(name, _)| name == family))
         };
-        if let Some(family) = ["DejaVu Sans", "Liberation Sans", "Arial"]
+        match ["DejaVu Sans", "Liberation Sans", "Arial"]
             .into_iter()
             .find(|f| installed(f))
         {
-            db.set_sans_serif_family(family);
+            Some(family) => db.set_sans_serif_family(family),
+            None => eprintln!(
+                "warning: no DejaVu Sans, Liberation Sans or Arial font is installed: the figures' \
+                 PDFs have no text (apt-get install fonts-dejavu-core); the SVGs are whole"
+            ),
         }
         Arc::new(db)
     });
