@@ -69,6 +69,7 @@ pub fn equal_time_table(results: &[RunResult]) -> Option<Table> {
         "scene",
         "technique",
         "setting",
+        "reference",
         "budget ms",
         "search ms",
         "frame ms",

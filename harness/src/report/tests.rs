@@ -762,3 +762,41 @@ fn errors_against_both_components_with_the_own_marked() {
         "{text}"
     );
 }
+
+/// The equal-time table: a header for every cell of a row (the steps column last, not cut),
+/// the setting with its range end, the own error marked. Catches a column missing from the
+/// header, which shifted every heading and dropped the steps (it happened).
+#[test]
+fn equal_time_table_heads_every_cell() {
+    let mut laine = scored_both("laine", 140.0, 0.2, 0.9, "one-bounce");
+    laine.settings.insert(
+        "equal_time".into(),
+        serde_json::json!({"budget_ms": 150.0, "knob": "vpls", "value": 300, "frame_ms": 135.0,
+            "end": null, "steps": [{"value": 64, "frame_ms": 40.0}, {"value": 300, "frame_ms": 135.0}]}),
+    );
+    let mut gaitatzes = scored_both("gaitatzes", 240.0, 2.0, 0.6, "multi-bounce");
+    gaitatzes.settings.insert(
+        "equal_time".into(),
+        serde_json::json!({"budget_ms": 150.0, "knob": "iterations", "value": 0, "frame_ms": 240.0,
+            "end": "min", "steps": [{"value": 0, "frame_ms": 240.0}]}),
+    );
+    let t = equal_time_table(&[laine, gaitatzes]).unwrap();
+    assert!(
+        t.rows.iter().all(|r| r.len() == t.columns.len()),
+        "{:?}",
+        t.columns
+    );
+    let cell = |row: usize, name: &str| {
+        t.rows[row][t.columns.iter().position(|c| c == name).unwrap()].display()
+    };
+    assert_eq!(cell(0, "reference"), "one-bounce");
+    assert_eq!(cell(0, "setting"), "vpls=300");
+    assert_eq!(cell(0, "search ms"), "135.00");
+    assert_eq!(cell(0, "relMSE one-bounce"), "0.2000*");
+    assert_eq!(cell(0, "search (value ms → …)"), "64 40.0 → 300 135.0");
+    assert_eq!(
+        cell(1, "setting"),
+        "iterations=0 (its smallest: over budget)"
+    );
+    assert_eq!(cell(1, "relMSE multi-bounce"), "0.6000*");
+}
