@@ -82,10 +82,10 @@ pub fn equal_time_table(results: &[RunResult]) -> Option<Table> {
     .collect();
     let notes = vec![
         "Equal time: each technique's quality knob (gibench list) set to the largest value whose \
-         frame fitted the budget (within 95 % of it, the rest left for the run's own \
+         frame fitted the budget (within 96 % of it, the rest left for the run's own \
          measurement) in a short timed search on this device: steps of a few frames after a \
          warm-up, each value's median frame (column search, value and ms per step), ending once \
-         a fitting value reached 85 % of the budget, where no untried value lay between one that \
+         a fitting value reached 89 % of the budget, where no untried value lay between one that \
          fitted and one that did not, or at the knob's range end (said in column setting: its \
          largest value fits, or its smallest, or every value tried, is over budget). frame ms: \
          the run's own measurement at that setting, which the machine's noise may put a little \
