@@ -145,10 +145,18 @@ pub fn search(
             // Neighbours: nothing lies between a value that fits and one over.
             (Some(f), Some(o)) if o.value - f.value <= 1 => break,
             (Some(f), Some(o)) => {
-                let x = along.unwrap_or_else(|| {
-                    let at = (aim - f.frame_ms) / (o.frame_ms - f.frame_ms);
-                    f.value as f64 + (o.value - f.value) as f64 * at.clamp(0.0, 1.0)
-                });
+                // The line's point inside the bracket; halfway where the line reaches the aim
+                // only beyond the over-budget value (the time jumps between them: stepping
+                // toward the jump crept one value at a time); else interpolation.
+                let gap = o.value - f.value;
+                let x = match along {
+                    Some(x) if x >= o.value as f64 => (f.value + gap / 2) as f64,
+                    Some(x) => x,
+                    None => {
+                        let at = (aim - f.frame_ms) / (o.frame_ms - f.frame_ms);
+                        f.value as f64 + gap as f64 * at.clamp(0.0, 1.0)
+                    }
+                };
                 within(x.round() as i64, f.value + 1, (o.value - 1).min(hi))
             }
             (Some(f), None) => {
@@ -367,6 +375,23 @@ mod tests {
         let found = search((1, 4096), 64, 150.0, &mut laine).unwrap();
         assert!(found.frame_ms >= LOW * 150.0, "{found:?}");
         assert!(found.steps.len() <= 4, "{found:?}");
+    }
+
+    /// A time that rises slowly, then jumps past the budget (keller-incremental on Sibenik as
+    /// measured here: 104 ms at 507 VPLs, 162 ms at 1582): the search halves the bracket
+    /// instead of stepping down from the over-budget end one value at a time. Catches that
+    /// creep (1581, 1580, ... until the steps ran out).
+    #[test]
+    fn a_jump_past_the_budget_is_bracketed_by_halves() {
+        let mut jump = |v: i64| {
+            Ok(if v <= 1000 {
+                86.0 + 0.035 * v as f64
+            } else {
+                160.0
+            })
+        };
+        let found = search((1, 4096), 64, 150.0, &mut jump).unwrap();
+        assert!(found.value >= 900, "{found:?}");
     }
 
     /// A technique that needs a minimum (Laine: `vpls` above `recalc-min` = 4) over a budget
