@@ -34,6 +34,21 @@ pub fn writable_dir(option: &str, dir: &Path) -> Result<()> {
     probe
 }
 
+/// The reference cache's folder `dir`, created where missing and kept, then checked as
+/// [`writable_dir`]: processes share it (a fleet's shards, parallel tests), and a check that
+/// removed a cache folder it had just made could pull it from under another process's probe
+/// (seen: "results/cache is not a writable folder" in the fleet test).
+pub fn cache_dir(option: &str, dir: &Path) -> Result<()> {
+    let dir = gibench_harness::output::without_cur_dirs(dir);
+    std::fs::create_dir_all(&dir).map_err(|e| {
+        Error::param(
+            option,
+            format!("{} is not a writable folder: {e}", dir.display()),
+        )
+    })?;
+    writable_dir(option, &dir)
+}
+
 /// Checks `path` can be written as a file: not a folder, in a folder that can be created and
 /// written ([`writable_dir`]); the error names `option` and suggests `example` inside a folder.
 pub fn writable_file(option: &str, path: &Path, example: &str) -> Result<()> {

@@ -10,7 +10,7 @@ use gibench_harness::scene::assets::AssetPaths;
 use gibench_harness::scene::{Scene, SceneDescriptor};
 use gibench_harness::{Error, Result};
 
-use crate::files::writable_dir;
+use crate::files::{cache_dir, writable_dir};
 use crate::options::ReferenceOpts;
 use crate::params::{check_frame_number, parse_resolution};
 use crate::progress::Bars;
@@ -67,7 +67,7 @@ pub fn reference_plan(args: &ReferenceArgs) -> Result<ReferencePlan> {
     let desc = SceneDescriptor::resolve(&args.scene)?;
     let scene = Scene::load(&desc, &AssetPaths::standard(args.assets.as_deref()))?;
     if !args.reference.no_cache {
-        writable_dir("cache", &args.reference.cache)?;
+        cache_dir("cache", &args.reference.cache)?;
     }
     writable_dir("out", &args.out)?;
     Ok(ReferencePlan {

@@ -17,7 +17,7 @@ use gibench_harness::scene::assets::AssetPaths;
 use gibench_harness::scene::{Scene, SceneDescriptor};
 use gibench_harness::{Error, Result};
 
-use crate::files::{file_name, writable_dir};
+use crate::files::{cache_dir, file_name, writable_dir};
 use crate::options::{GpuArgs, ReferenceOpts};
 use crate::page::{page_line, with_folder, write_page};
 use crate::params::{assign_params, parse_resolution};
@@ -232,7 +232,7 @@ pub fn plan(args: &RunArgs, extra_params: &[String]) -> Result<Plan> {
     // Where files will go must be usable before any GPU work.
     writable_dir("out", &args.out)?;
     if args.quality && !args.reference.no_cache {
-        writable_dir("cache", &args.reference.cache)?;
+        cache_dir("cache", &args.reference.cache)?;
     }
     let equal_time = (args.equal_time.as_deref())
         .map(crate::equal_time::parse_budget)
