@@ -12,6 +12,10 @@ use super::table::{Cell, Table};
 use crate::measure::metrics::ComponentErrors;
 use crate::measure::results::RunResult;
 
+/// The search steps a row shows, the last ones (a search of 8 steps and a few failed ones
+/// made a 145-character terminal line).
+const SHOWN_STEPS: usize = 4;
+
 /// A run's `settings.equal_time` record, if it has one.
 fn record(r: &RunResult) -> Option<&Value> {
     r.settings.get("equal_time")
@@ -57,10 +61,14 @@ pub fn equal_time_table(results: &[RunResult]) -> Option<Table> {
             .into_iter()
             .chain(NAMES.map(|c| error_cell(r, c, |e| e.rel_mse.mean, 4)))
             .chain(NAMES.map(|c| error_cell(r, c, |e| e.flip_mean.mean, 4)))
-            .chain([Cell::text(if steps.is_empty() {
-                "–".to_string()
-            } else {
-                steps.join(" → ")
+            .chain([Cell::text(match steps.len() {
+                0 => "–".to_string(),
+                // The last steps only: the cell must fit a terminal's width (every step is
+                // in the results file).
+                n if n > SHOWN_STEPS => {
+                    format!("… → {}", steps[n - SHOWN_STEPS..].join(" → "))
+                }
+                _ => steps.join(" → "),
             })])
             .collect()
         })
