@@ -494,7 +494,7 @@ fn the_terminal_table_fits_120_columns_in_every_timing_mode() {
 /// search, a kept value that did not fit, and a search left out of the results.
 #[test]
 fn equal_time_runs_each_technique_at_the_value_its_search_kept() {
-    use gibench_papers::equal_time::{FIT, MAX_STEPS};
+    use gibench_papers::equal_time::{FIT, MAX_STEPS, REPEATS};
     let tmp = tempfile::tempdir().unwrap();
     let cache = tmp.path().join("cache");
     #[rustfmt::skip]
@@ -516,7 +516,17 @@ fn equal_time_runs_each_technique_at_the_value_its_search_kept() {
         .map(|s| s["value"].as_i64().unwrap())
         .max();
     match fitted {
-        Some(v) => assert_eq!(kept, v, "{e}"),
+        Some(v) => {
+            assert_eq!(kept, v, "{e}");
+            // The kept value was timed again: its figure is its timings' median.
+            let step = (steps.iter()).find(|s| s["value"] == kept).unwrap();
+            let mut t: Vec<f64> = (step["timings"].as_array().unwrap().iter())
+                .map(|t| t.as_f64().unwrap())
+                .collect();
+            assert_eq!(t.len(), REPEATS, "{e}");
+            t.sort_by(f64::total_cmp);
+            assert_eq!(step["frame_ms"].as_f64(), Some(t[REPEATS / 2]), "{e}");
+        }
         // Nothing fitted this machine's 8 ms: the smallest value that ran, said.
         None => assert!(
             matches!(e["end"].as_str(), Some("min" | "over budget")),

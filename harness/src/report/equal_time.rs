@@ -89,16 +89,31 @@ pub fn equal_time_table(results: &[RunResult]) -> Option<Table> {
     .chain(["search (value ms → …)".to_string()])
     .collect();
     let notes = vec![
-        "Equal time: each technique's quality knob (gibench list) set to the largest value whose \
-         frame fitted the budget (within 96 % of it, the rest left for the run's own \
-         measurement) in a short timed search on this device: steps of a few frames after a \
-         warm-up, each value's median frame (column search, value and ms per step), ending once \
-         a fitting value reached 89 % of the budget, where no untried value lay between one that \
-         fitted and one that did not, or at the knob's range end (said in column setting: its \
-         largest value fits, or its smallest, or every value tried, is over budget). frame ms: \
-         the run's own measurement at that setting, which the machine's noise may put a little \
-         off the search's."
-            .to_string(),
+        {
+            // The search's thresholds as its records give them (the first run's).
+            let e = record(runs[0]).expect("filtered above");
+            let pc = |k: &str| {
+                e[k].as_f64().map_or("(not recorded)".to_string(), |f| {
+                    format!("{:.0} %", 100.0 * f)
+                })
+            };
+            let repeats = e["repeats"].as_u64().map_or(String::new(), |n| {
+                format!("; the value kept was timed {n} times and judged by the median")
+            });
+            format!(
+                "Equal time: each technique's quality knob (gibench list) set to the largest value \
+                 whose frame fitted the budget (within {} of it, the rest left for the run's own \
+                 measurement) in a short timed search on this device: steps of a few frames after \
+                 a warm-up, each value's median frame (column search, value and ms per step), \
+                 ending once a fitting value reached {} of the budget, where no untried value lay \
+                 between one that fitted and one that did not, or at the knob's range end (said \
+                 in column setting: its largest value fits, or its smallest, or every value \
+                 tried, is over budget){repeats}. frame ms: the run's own measurement at that \
+                 setting, which the machine's noise may put a little off the search's.",
+                pc("fit"),
+                pc("low"),
+            )
+        },
         format!(
             "relMSE (of indirect irradiance) and FLIP against each indirect component of the \
              reference: one-bounce and multi-bounce; {} marks the run's own, the component its \
@@ -106,6 +121,31 @@ pub fn equal_time_table(results: &[RunResult]) -> Option<Table> {
             super::table::OWN_MARK
         ),
     ];
+    // A run whose own measurement left the budget is said, not hidden in the column.
+    let off: Vec<String> =
+        (runs.iter())
+            .filter_map(|r| {
+                let e = record(r)?;
+                let (budget, ms) = (e["budget_ms"].as_f64()?, frame_time_ms(r)?);
+                (e["knob"].is_string() && e["end"].is_null() && ms > budget).then(|| {
+                    format!(
+                    "{} {}: the run measured {ms:.2} ms, over the {budget} ms budget (its search: \
+                     {})",
+                    r.scene,
+                    r.technique,
+                    e["frame_ms"].as_f64().map_or("–".into(), |s| format!("{s:.2} ms")),
+                )
+                })
+            })
+            .collect();
+    let mut notes = notes;
+    if !off.is_empty() {
+        notes.push(format!(
+            "Over the budget in the run's own measurement (the machine's noise between two \
+             timings of one setting): {}.",
+            off.join("; ")
+        ));
+    }
     Some(Table {
         title: "Error at equal time".to_string(),
         columns,

@@ -764,15 +764,24 @@ fn errors_against_both_components_with_the_own_marked() {
 }
 
 /// The equal-time table: a header for every cell of a row (the steps column last, not cut),
-/// the setting with its range end, the own error marked. Catches a column missing from the
-/// header, which shifted every heading and dropped the steps (it happened).
+/// the setting with its range end, the own error marked, the search's thresholds from its
+/// record, and a run over the budget in its own measurement said in a note (not the one at its
+/// range's end, nor one within). Catches a column missing from the header, which shifted every
+/// heading and dropped the steps (it happened).
 #[test]
 fn equal_time_table_heads_every_cell() {
     let mut laine = scored_both("laine", 140.0, 0.2, 0.9, "one-bounce");
     laine.settings.insert(
         "equal_time".into(),
         serde_json::json!({"budget_ms": 150.0, "knob": "vpls", "value": 300, "frame_ms": 135.0,
-            "end": null, "steps": [{"value": 64, "frame_ms": 40.0}, {"value": 300, "frame_ms": 135.0}]}),
+            "end": null, "fit": 0.95, "low": 0.89,
+            "steps": [{"value": 64, "frame_ms": 40.0}, {"value": 300, "frame_ms": 135.0}]}),
+    );
+    let mut ism = scored_both("ism", 152.5, 0.2, 0.9, "one-bounce");
+    ism.settings.insert(
+        "equal_time".into(),
+        serde_json::json!({"budget_ms": 150.0, "knob": "vpls", "value": 400, "frame_ms": 141.0,
+            "end": null, "steps": [{"value": 400, "frame_ms": 141.0}]}),
     );
     let mut gaitatzes = scored_both("gaitatzes", 240.0, 2.0, 0.6, "multi-bounce");
     gaitatzes.settings.insert(
@@ -780,7 +789,18 @@ fn equal_time_table_heads_every_cell() {
         serde_json::json!({"budget_ms": 150.0, "knob": "iterations", "value": 0, "frame_ms": 240.0,
             "end": "min", "steps": [{"value": 0, "frame_ms": 240.0}]}),
     );
-    let t = equal_time_table(&[laine, gaitatzes]).unwrap();
+    let t = equal_time_table(&[laine, gaitatzes, ism]).unwrap();
+    let notes = t.notes.join("\n");
+    assert!(
+        notes.contains("within 95 % of it") && notes.contains("reached 89 %"),
+        "{notes}"
+    );
+    assert!(
+        notes.contains("cornell ism: the run measured 152.50 ms, over the 150 ms budget (its search: 141.00 ms)")
+            && !notes.contains("cornell laine:")
+            && !notes.contains("cornell gaitatzes:"),
+        "{notes}"
+    );
     assert!(
         t.rows.iter().all(|r| r.len() == t.columns.len()),
         "{:?}",
