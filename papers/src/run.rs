@@ -573,6 +573,68 @@ pub fn run_planned(args: &RunArgs, plan: &Plan, gpu: &GpuContext, bars: &Bars) -
     run_planned_skipping(args, plan, gpu, bars).map(|(done, _)| done)
 }
 
+/// With `--equal-time`: a technique whose run measured its frame off the mark
+/// ([`crate::equal_time::off_the_mark`]: over the budget, or under 85 % of it) is tuned again
+/// with that measurement as one more timing of its value and run again, at most
+/// [`crate::equal_time::MAX_RETUNES`] times; `results` get the new runs (their files replace
+/// the earlier ones), and each record lists the measurements that sent it back (`runs`).
+#[allow(clippy::too_many_arguments)]
+fn retune_off_the_mark(
+    args: &RunArgs,
+    plan: &Plan,
+    gpu: &GpuContext,
+    bars: &Bars,
+    budget: f64,
+    params: &mut [Params],
+    recorded: &mut [BTreeMap<String, serde_json::Value>],
+    results: &mut [RunResult],
+) -> Result<()> {
+    for _ in 0..crate::equal_time::MAX_RETUNES {
+        let off: Vec<(usize, f64)> = (plan.techniques.iter().enumerate())
+            .filter_map(|(i, info)| {
+                let r = results.iter().find(|r| r.technique == info.name)?;
+                let ms = report::frame_time_ms(r)?;
+                crate::equal_time::off_the_mark(&recorded[i]["equal_time"], ms).then_some((i, ms))
+            })
+            .collect();
+        if off.is_empty() {
+            return Ok(());
+        }
+        let h = Harness::new(gpu, &plan.scene, &plan.config)?;
+        for &(i, ms) in &off {
+            let info = plan.techniques[i];
+            bars.note(&format!(
+                "equal time {budget} ms: {}'s run measured {ms:.2} ms a frame, off the mark (85-100 % of the budget): tuning it again",
+                info.name
+            ));
+            let (p, record) = crate::equal_time::retune(
+                info,
+                &params[i],
+                &plan.config,
+                &h,
+                &recorded[i]["equal_time"],
+                ms,
+                bars,
+            )?;
+            params[i] = p;
+            recorded[i].insert("equal_time".to_string(), record);
+        }
+        drop(h);
+        let mut spec = plan.spec_with(args, params, recorded);
+        spec.runs.retain(|r| {
+            off.iter()
+                .any(|&(i, _)| plan.techniques[i].name == r.info.name)
+        });
+        let (again, _) = execute_skipping_with_bar(bars, gpu, &spec, false)?;
+        for r in again {
+            if let Some(old) = results.iter_mut().find(|o| o.technique == r.technique) {
+                *old = r;
+            }
+        }
+    }
+    Ok(())
+}
+
 /// [`run_planned`], also returning the techniques a run over every technique left out.
 fn run_planned_skipping(
     args: &RunArgs,
@@ -600,8 +662,20 @@ fn run_planned_skipping(
     let spec = plan.spec_with(args, &params, &recorded);
     // A run over every technique leaves out one that cannot take the scene or the device; one
     // named with --technique is an error.
-    let (results, skipped) =
+    let (mut results, skipped) =
         execute_skipping_with_bar(bars, gpu, &spec, args.technique.is_empty())?;
+    if let Some(budget) = plan.equal_time {
+        retune_off_the_mark(
+            args,
+            plan,
+            gpu,
+            bars,
+            budget,
+            &mut params,
+            &mut recorded,
+            &mut results,
+        )?;
+    }
     let name = &plan.desc.name;
     if results.is_empty() {
         let reasons: Vec<String> = skipped

@@ -518,14 +518,21 @@ fn equal_time_runs_each_technique_at_the_value_its_search_kept() {
     match fitted {
         Some(v) => {
             assert_eq!(kept, v, "{e}");
-            // The kept value was timed again: its figure is its timings' median.
+            // The kept value was timed again (and a run off the mark adds its timing): its
+            // figure is its timings' median.
             let step = (steps.iter()).find(|s| s["value"] == kept).unwrap();
             let mut t: Vec<f64> = (step["timings"].as_array().unwrap().iter())
                 .map(|t| t.as_f64().unwrap())
                 .collect();
-            assert_eq!(t.len(), REPEATS, "{e}");
+            assert!(t.len() >= REPEATS, "{e}");
             t.sort_by(f64::total_cmp);
-            assert_eq!(step["frame_ms"].as_f64(), Some(t[REPEATS / 2]), "{e}");
+            let n = t.len();
+            let median = if n % 2 == 1 {
+                t[n / 2]
+            } else {
+                0.5 * (t[n / 2 - 1] + t[n / 2])
+            };
+            assert_eq!(step["frame_ms"].as_f64(), Some(median), "{e}");
         }
         // Nothing fitted this machine's 8 ms: the smallest value that ran, said.
         None => assert!(

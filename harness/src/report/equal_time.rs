@@ -38,6 +38,7 @@ pub fn equal_time_table(results: &[RunResult]) -> Option<Table> {
                 (Some(k), Some(v)) => match e["end"].as_str() {
                     Some("max") => format!("{k}={v} (its largest: fits)"),
                     Some("min") => format!("{k}={v} (its smallest: over budget)"),
+                    Some("jump") => format!("{k}={v} (the next value is over: a jump)"),
                     Some(_) => format!("{k}={v} (over budget)"),
                     None => format!("{k}={v}"),
                 },
@@ -88,16 +89,19 @@ pub fn equal_time_table(results: &[RunResult]) -> Option<Table> {
     .chain(error_columns("FLIP"))
     .chain(["search (value ms → …)".to_string()])
     .collect();
+    // The search's thresholds as its records give them (the first tuned run's).
+    let thresholds = (runs.iter())
+        .filter_map(|r| record(r))
+        .find(|e| e["knob"].is_string())
+        .unwrap_or(&Value::Null);
+    let pc = |k: &str| {
+        (thresholds[k].as_f64()).map_or("(not recorded)".to_string(), |f| {
+            format!("{:.0} %", 100.0 * f)
+        })
+    };
     let notes = vec![
         {
-            // The search's thresholds as its records give them (the first run's).
-            let e = record(runs[0]).expect("filtered above");
-            let pc = |k: &str| {
-                e[k].as_f64().map_or("(not recorded)".to_string(), |f| {
-                    format!("{:.0} %", 100.0 * f)
-                })
-            };
-            let repeats = e["repeats"].as_u64().map_or(String::new(), |n| {
+            let repeats = thresholds["repeats"].as_u64().map_or(String::new(), |n| {
                 format!("; the value kept was timed {n} times and judged by the median")
             });
             format!(
@@ -108,7 +112,8 @@ pub fn equal_time_table(results: &[RunResult]) -> Option<Table> {
                  ending once a fitting value reached {} of the budget, where no untried value lay \
                  between one that fitted and one that did not, or at the knob's range end (said \
                  in column setting: its largest value fits, or its smallest, or every value \
-                 tried, is over budget){repeats}. frame ms: the run's own measurement at that \
+                 tried, is over budget; or a jump: the frame time leaps between the value kept, \
+                 under the low end, and the next){repeats}. frame ms: the run's own measurement at that \
                  setting, which the machine's noise may put a little off the search's.",
                 pc("fit"),
                 pc("low"),
@@ -138,7 +143,32 @@ pub fn equal_time_table(results: &[RunResult]) -> Option<Table> {
                 })
             })
             .collect();
+    // Runs measured off the mark before (over the budget, or under its low end), which sent
+    // their technique back to the search and ran it again.
+    let again: Vec<String> = (runs.iter())
+        .filter_map(|r| {
+            let before = record(r)?["runs"].as_array().filter(|a| !a.is_empty())?;
+            let list: Vec<String> = (before.iter())
+                .map(|b| {
+                    let ms = b["frame_ms"]
+                        .as_f64()
+                        .map_or("–".into(), |m| format!("{m:.2} ms"));
+                    format!("{} at {ms}", b["value"])
+                })
+                .collect();
+            Some(format!("{} {}: {}", r.scene, r.technique, list.join(", ")))
+        })
+        .collect();
     let mut notes = notes;
+    if !again.is_empty() {
+        notes.push(format!(
+            "Run again after the run's own measurement left {}-100 % of the budget (that \
+             measurement then counted as one more timing of its value, and the search went on): \
+             {}.",
+            pc("run_low").trim_end_matches(" %"),
+            again.join("; ")
+        ));
+    }
     if !off.is_empty() {
         notes.push(format!(
             "Over the budget in the run's own measurement (the machine's noise between two \

@@ -781,7 +781,8 @@ fn equal_time_table_heads_every_cell() {
     ism.settings.insert(
         "equal_time".into(),
         serde_json::json!({"budget_ms": 150.0, "knob": "vpls", "value": 400, "frame_ms": 141.0,
-            "end": null, "steps": [{"value": 400, "frame_ms": 141.0}]}),
+            "end": null, "steps": [{"value": 400, "frame_ms": 141.0}],
+            "runs": [{"value": 420, "frame_ms": 161.5}]}),
     );
     let mut gaitatzes = scored_both("gaitatzes", 240.0, 2.0, 0.6, "multi-bounce");
     gaitatzes.settings.insert(
@@ -799,6 +800,10 @@ fn equal_time_table_heads_every_cell() {
         notes.contains("cornell ism: the run measured 152.50 ms, over the 150 ms budget (its search: 141.00 ms)")
             && !notes.contains("cornell laine:")
             && !notes.contains("cornell gaitatzes:"),
+        "{notes}"
+    );
+    assert!(
+        notes.contains("went on): cornell ism: 420 at 161.50 ms."),
         "{notes}"
     );
     assert!(
