@@ -160,28 +160,38 @@ pub fn search_on(
                 // The value about to be kept is timed [`REPEATS`] times in all and judged by
                 // the median: one timing on a shared machine is a few percent off, and the run
                 // at the kept value measures again. A median over the budget (or under its
-                // low end) sends the search on; each value is timed again once at most, so
-                // at most MAX_STEPS × REPEATS timings in all.
-                let kept = (steps.iter_mut())
-                    .filter(|s| s.frame_ms.is_finite() && s.frame_ms <= FIT * budget)
-                    .max_by_key(|s| s.value);
-                match kept {
-                    Some(s) if s.timings.len() < REPEATS => {
-                        while s.timings.len() < REPEATS {
-                            match measure(s.value) {
-                                Ok(ms) => s.timings.push(ms),
-                                Err(e) => {
-                                    s.note = Some(e.to_string());
-                                    s.timings.clear();
-                                    last_error = Some(e);
-                                    break;
-                                }
-                            }
+                // low end) sends the search on. Where the value kept lies under the low end,
+                // the next value, over the mark, is timed again too: a jump between them is
+                // said on both medians, not on one slow timing. Each value is timed again
+                // once at most, so at most MAX_STEPS × REPEATS timings in all.
+                let fitting = |s: &Step| s.frame_ms.is_finite() && s.frame_ms <= FIT * budget;
+                let kept = (steps.iter().enumerate())
+                    .filter(|(_, s)| fitting(s))
+                    .max_by_key(|(_, s)| s.value)
+                    .map(|(i, _)| i);
+                let again = match kept {
+                    Some(i) if steps[i].timings.len() < REPEATS => Some(i),
+                    Some(i) if steps[i].frame_ms < LOW * budget => (steps.iter()).position(|s| {
+                        s.value == steps[i].value + 1
+                            && s.frame_ms.is_finite()
+                            && s.timings.len() < REPEATS
+                    }),
+                    _ => None,
+                };
+                let Some(i) = again else { break };
+                let s = &mut steps[i];
+                while s.timings.len() < REPEATS {
+                    match measure(s.value) {
+                        Ok(ms) => s.timings.push(ms),
+                        Err(e) => {
+                            s.note = Some(e.to_string());
+                            s.timings.clear();
+                            last_error = Some(e);
+                            break;
                         }
-                        s.frame_ms = median(&s.timings);
                     }
-                    _ => break,
                 }
+                s.frame_ms = median(&s.timings);
             }
         }
     }
@@ -751,13 +761,28 @@ mod tests {
     /// shadow maps' atlas grows at each square number of maps: 196 maps at 100 ms, 197 at 148
     /// ms as measured here against 150 ms; here 130 ms below the leap): the search closes in on
     /// the neighbours and says "jump" (a run under the low end is then not off the
-    /// mark). Catches a search that calls the value kept an ordinary result (its run would go
-    /// back to the search for nothing).
+    /// mark), on the medians of both neighbours' repeats. Catches a search that calls the value
+    /// kept an ordinary result (its run would go back to the search for nothing), and one that
+    /// says "jump" on a single slow timing of the next value.
     #[test]
     fn a_jump_between_neighbours_is_found_and_said() {
         let mut squares = |v: i64| Ok(if v <= 196 { 130.0 } else { 148.0 });
         let found = search((1, 4096), 180, 150.0, &mut squares).unwrap();
         assert_eq!((found.value, found.end), (196, Some("jump")), "{found:?}");
+        // One slow timing of the next value is no jump: timed again, it fits and is kept
+        // (gaitatzes on Cornell: 42 iterations at 131.9 ms, 43 once at 150.9 ms). Here the
+        // leap is one value later.
+        let mut seen = std::collections::HashSet::new();
+        let mut once_slow = |v: i64| {
+            let first = seen.insert(v);
+            Ok(if v <= 196 || (v == 197 && !first) {
+                130.0
+            } else {
+                148.0
+            })
+        };
+        let found = search((1, 4096), 180, 150.0, &mut once_slow).unwrap();
+        assert_eq!((found.value, found.end), (197, Some("jump")), "{found:?}");
     }
 
     #[test]
