@@ -42,6 +42,10 @@ pub const MODULES: &[WgslModule] = &[
         source: include_str!("ir/shaders/vpl_store.wgsl"),
     },
     WgslModule {
+        name: "gibench::prepared_vpl",
+        source: include_str!("ir/shaders/prepared_vpl.wgsl"),
+    },
+    WgslModule {
         name: "gibench::atlas_lookup",
         source: include_str!("ir/shaders/atlas_lookup.wgsl"),
     },

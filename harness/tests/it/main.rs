@@ -6,6 +6,7 @@
 //! of every worker of rayon's global pool, which any other test's parallel work would add to)
 //! and `threads.rs` (it builds rayon's global pool, once per process).
 
+mod accumulate;
 mod bindings;
 mod direct_light;
 mod edges;

@@ -7,6 +7,13 @@
 //! tiles; Laine et al. 2007 §5.1), scaled by T; its contribution to a receiver is
 //! E = Φ/π · cos θ_v cos θ_r / r² · V.
 //!
+//! One compute pass of two dispatches: the first computes once per VPL what does not depend on
+//! the receiver (its map's eye point and tile origin in the atlas, Φ/π, the largest geometric
+//! term the clamp lets through) into a buffer of the store's capacity; the second, one
+//! invocation per split texel, loops over its tile's VPLs with only the receiver-dependent
+//! work (the geometric term, the map lookup). The images equal those of the direct per-pair
+//! formulation (`harness/tests/it/shaders/accumulate_per_pair.wgsl`, compared by a test).
+//!
 //! **Clamp** (Laine et al. 2007 §5.2, after Keller): the irradiance a single VPL may give a
 //! receiver is bounded — against the 1/r² singularity — by E_max = k · Ē, where Ē = ΣΦ / A
 //! is the mean irradiance all the store's VPLs together would give if their flux were spread
@@ -24,7 +31,7 @@ use super::atlas::ShadowAtlas;
 use super::interleave::{Interleave, INTERLEAVE_WGSL};
 use super::store::VplStore;
 use crate::gpu::GpuContext;
-use crate::kit::passes::{bind_buffer, compute_pipeline, params_buffer, params_entry};
+use crate::kit::passes::{compute_pipeline, params_buffer, Bindings};
 use crate::Result;
 
 /// GPU layout of `AccumulateParams` in `accumulate.wgsl`.
@@ -66,12 +73,22 @@ impl IrradianceClamp {
     }
 }
 
+/// Bytes of one `PreparedVpl` (`prepared_vpl.wgsl`).
+const PREPARED_BYTES: u64 = 80;
+/// Invocations per workgroup of the prepare dispatch (`accumulate_prepare.wgsl`).
+const PREPARE_WG: u32 = 64;
+
 /// The accumulate pass over one store and one atlas (see the module docs).
 pub struct Accumulation {
+    prepare: wgpu::ComputePipeline,
+    prepare_group: wgpu::BindGroup,
     pipeline: wgpu::ComputePipeline,
     group: wgpu::BindGroup,
-    /// Kept alive for the bind group.
-    _params: wgpu::Buffer,
+    /// Slots of the store (the prepare dispatch covers them all; those past the header's
+    /// count return at once).
+    capacity: u32,
+    /// Kept alive for the bind groups.
+    _buffers: [wgpu::Buffer; 2],
 }
 
 impl Accumulation {
@@ -92,21 +109,39 @@ impl Accumulation {
                 clamp: [clamp.per_flux(), 0.0, 0.0, 0.0],
             },
         );
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("accumulate"),
-            entries: &[
-                VplStore::layout_entry(0, false),
-                params_entry(1, wgpu::ShaderStages::COMPUTE),
-            ],
+        // Its size is that of the store's items (80 bytes each, as GpuVpl), which the store
+        // checked against the adapter's limits.
+        let prepared = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("accumulate prepared vpls"),
+            size: store.capacity() as u64 * PREPARED_BYTES,
+            usage: wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
         });
-        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("accumulate"),
-            layout: &layout,
-            entries: &[bind_buffer(0, store.buffer()), bind_buffer(1, &params)],
-        });
+        let prepare = Bindings::new("accumulate prepare", wgpu::ShaderStages::COMPUTE)
+            .read(store.buffer())
+            .params(&params)
+            .write(&prepared)
+            .build(device);
+        let source = format!(
+            "{}\n{}\n{}",
+            VplStore::wgsl(0, 0, false),
+            ShadowAtlas::wgsl(1),
+            include_str!("shaders/accumulate_prepare.wgsl")
+        );
+        let prepare_pipeline = compute_pipeline(
+            device,
+            "vpl accumulate prepare",
+            &source,
+            &[&prepare.layout, atlas.layout()],
+            "prepare",
+        );
+        let gather = Bindings::new("accumulate", wgpu::ShaderStages::COMPUTE)
+            .read(&prepared)
+            .read(store.buffer())
+            .build(device);
         let source = format!(
             "{INTERLEAVE_WGSL}\n{}\n{}\n{}",
-            VplStore::wgsl(1, 0, false),
+            VplStore::wgsl(1, 1, false),
             ShadowAtlas::wgsl(2),
             include_str!("shaders/accumulate.wgsl")
         );
@@ -114,14 +149,17 @@ impl Accumulation {
             device,
             "vpl accumulate",
             &source,
-            &[interleave.split_layout(), &layout, atlas.layout()],
+            &[interleave.split_layout(), &gather.layout, atlas.layout()],
             "accumulate",
         );
         gpu.check_errors()?;
         Ok(Accumulation {
+            prepare: prepare_pipeline,
+            prepare_group: prepare.group,
             pipeline,
-            group,
-            _params: params,
+            group: gather.group,
+            capacity: store.capacity(),
+            _buffers: [params, prepared],
         })
     }
 
@@ -136,6 +174,10 @@ impl Accumulation {
             label: Some("accumulate"),
             timestamp_writes: None,
         });
+        pass.set_pipeline(&self.prepare);
+        pass.set_bind_group(0, &self.prepare_group, &[]);
+        pass.set_bind_group(1, atlas.group(), &[]);
+        pass.dispatch_workgroups(self.capacity.div_ceil(PREPARE_WG), 1, 1);
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, interleave.split_group(), &[]);
         pass.set_bind_group(1, &self.group, &[]);

@@ -359,8 +359,9 @@ impl ShadowAtlas {
     }
 
     /// The lookup for a shader binding [`ShadowAtlas::group`] at `group`: the bindings
-    /// `atlas_params` and `vpl_atlas`, then `vpl_visibility(v: GpuVpl, p, n) -> f32`. Needs
-    /// `GpuVpl`, which the module imports.
+    /// `atlas_params` and `vpl_atlas`, then `vpl_visibility(v: GpuVpl, p, n) -> f32` and its
+    /// parts for a caller that computes them once per VPL (`vpl_eye`, `vpl_map_origin`,
+    /// `atlas_visibility`: the accumulation's). Needs `GpuVpl`, which the module imports.
     pub fn wgsl(group: u32) -> String {
         format!(
             "#import gibench::atlas_lookup\n@group({group}) @binding(0) var<storage, read> atlas_params: AtlasParams;\n@group({group}) @binding(1) var vpl_atlas: texture_2d<f32>;\n"

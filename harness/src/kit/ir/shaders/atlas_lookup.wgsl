@@ -43,20 +43,34 @@ fn octahedral_texel(local: vec3<f32>, size: u32) -> vec2<i32> {
     return clamp(st, vec2<i32>(0), vec2<i32>(i32(size) - 1));
 }
 
-// 1 if receiver `p` (unit normal `n`) is visible from VPL `v` according to its map, else 0.
-// The receiver is first moved off its surface by about two map texels (normal offset), so that
-// surfaces tilted away from the VPL do not shadow themselves.
-fn vpl_visibility(v: GpuVpl, p_surface: vec3<f32>, n: vec3<f32>) -> f32 {
+// The eye point of VPL `v`'s map: its position lifted off its surface along its normal.
+fn vpl_eye(v: GpuVpl) -> vec3<f32> {
+    return v.position.xyz + v.normal.xyz * atlas_params.distances.w;
+}
+
+// Top-left texel of the map of `slot` in the atlas (cube: of face 0 of its 3x2 block).
+fn vpl_map_origin(slot: u32) -> vec2<i32> {
     let size = atlas_params.counts.y;
-    let slot = u32(v.position.w);
-    let eye = v.position.xyz + v.normal.xyz * atlas_params.distances.w;
+    if (atlas_params.counts.z == 1u) {
+        return vpl_tile_origin(slot, 3u * size, 2u * size);
+    }
+    return vpl_tile_origin(slot, size, size);
+}
+
+// 1 if receiver `p_surface` (unit normal `n`) is visible from the map with eye point `eye`,
+// frame (`tangent`, `bitangent`, `normal`: z along the VPL's normal) and top-left texel
+// `origin` in the atlas (vpl_eye, vpl_map_origin), else 0. The receiver is first moved off its
+// surface by about two map texels (normal offset), so that surfaces tilted away from the VPL
+// do not shadow themselves.
+fn atlas_visibility(eye: vec3<f32>, tangent: vec3<f32>, bitangent: vec3<f32>, normal: vec3<f32>, origin: vec2<i32>, p_surface: vec3<f32>, n: vec3<f32>) -> f32 {
+    let size = atlas_params.counts.y;
     let p = p_surface + n * (4.0 * length(p_surface - eye) / f32(size));
     let d = p - eye;
     let len = length(d);
     let far = atlas_params.distances.x;
     let bias = atlas_params.distances.y;
     if (atlas_params.counts.z != 1u) {
-        let local = vec3<f32>(dot(d, v.tangent.xyz), dot(d, v.bitangent.xyz), dot(d, v.normal.xyz)) / max(len, 1e-20);
+        let local = vec3<f32>(dot(d, tangent), dot(d, bitangent), dot(d, normal)) / max(len, 1e-20);
         if (local.z <= 0.0) {
             return 0.0;
         }
@@ -66,7 +80,7 @@ fn vpl_visibility(v: GpuVpl, p_surface: vec3<f32>, n: vec3<f32>) -> f32 {
         } else {
             t = octahedral_texel(local, size);
         }
-        let stored = textureLoad(vpl_atlas, vpl_tile_origin(slot, size, size) + t, 0).r;
+        let stored = textureLoad(vpl_atlas, origin + t, 0).r;
         let receiver = 1.0 - len * (1.0 - bias) / far;
         return select(0.0, 1.0, receiver >= stored);
     }
@@ -75,7 +89,13 @@ fn vpl_visibility(v: GpuVpl, p_surface: vec3<f32>, n: vec3<f32>) -> f32 {
     let ndc = clip.xyz / clip.w;
     let st = vec2<i32>(floor(vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5) * f32(size)));
     let t = clamp(st, vec2<i32>(0), vec2<i32>(i32(size) - 1));
-    let origin = vpl_tile_origin(slot, 3u * size, 2u * size) + vec2<i32>(i32((face % 3u) * size), i32((face / 3u) * size));
-    let stored = textureLoad(vpl_atlas, origin + t, 0).r;
+    let face_origin = origin + vec2<i32>(i32((face % 3u) * size), i32((face / 3u) * size));
+    let stored = textureLoad(vpl_atlas, face_origin + t, 0).r;
     return select(0.0, 1.0, ndc.z >= stored);
+}
+
+// 1 if receiver `p_surface` (unit normal `n`) is visible from VPL `v` according to its map,
+// else 0 (atlas_visibility for v's own map).
+fn vpl_visibility(v: GpuVpl, p_surface: vec3<f32>, n: vec3<f32>) -> f32 {
+    return atlas_visibility(vpl_eye(v), v.tangent.xyz, v.bitangent.xyz, v.normal.xyz, vpl_map_origin(u32(v.position.w)), p_surface, n);
 }

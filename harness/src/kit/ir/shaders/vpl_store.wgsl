@@ -19,17 +19,23 @@ struct VplStoreData {
     items: array<GpuVpl>,
 };
 
-// The unoccluded geometric term between VPL `v` and a receiver at `p` (unit normal `n`): the
-// cosine at the VPL times the cosine at the receiver over their squared distance; 0 when either
-// lies behind the other's surface. A VPL's irradiance there is flux / pi * this * visibility.
-fn vpl_geometry(v: GpuVpl, p: vec3<f32>, n: vec3<f32>) -> f32 {
-    let d = p - v.position.xyz;
+// The unoccluded geometric term between a VPL at `position` (unit normal `normal`) and a
+// receiver at `p` (unit normal `n`): the cosine at the VPL times the cosine at the receiver
+// over their squared distance; 0 when either lies behind the other's surface. A VPL's
+// irradiance there is flux / pi * this * visibility.
+fn geometric_term(position: vec3<f32>, normal: vec3<f32>, p: vec3<f32>, n: vec3<f32>) -> f32 {
+    let d = p - position;
     let r2 = dot(d, d);
     let dir = d * inverseSqrt(max(r2, 1e-30));
-    let cos_v = dot(v.normal.xyz, dir);
+    let cos_v = dot(normal, dir);
     let cos_r = -dot(n, dir);
     if (cos_v <= 0.0 || cos_r <= 0.0) {
         return 0.0;
     }
     return cos_v * cos_r / max(r2, 1e-30);
+}
+
+// geometric_term between VPL `v` and a receiver at `p` (unit normal `n`).
+fn vpl_geometry(v: GpuVpl, p: vec3<f32>, n: vec3<f32>) -> f32 {
+    return geometric_term(v.position.xyz, v.normal.xyz, p, n);
 }
