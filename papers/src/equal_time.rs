@@ -40,8 +40,10 @@ pub const STEP_WARMUP: u32 = 3;
 /// The value a search keeps is timed this many times in all, and judged by the median.
 pub const REPEATS: usize = 3;
 
-/// The most frames a technique's search renders (its timed steps, warm-up included): what a
-/// work estimate adds for it.
+/// The most frames a technique's first search renders (its timed steps and their repeats,
+/// warm-up included): what a work estimate adds for it. A run off the mark can send it back
+/// to the search up to [`MAX_RETUNES`] times, each with as many steps again and a run; those
+/// are left out (the manifest's rate absorbs them).
 pub fn search_frames() -> u64 {
     (MAX_STEPS * REPEATS) as u64 * (STEP_FRAMES + STEP_WARMUP) as u64
 }
@@ -61,7 +63,8 @@ pub fn parse_budget(s: &str) -> Result<f64> {
 
 /// One timed step of a search: the value tried and its frame time (infinite where the run
 /// failed: `note` says why, e.g. the device cannot hold that many maps), the median of its
-/// `timings` (one, or [`REPEATS`] for a value the search was about to keep).
+/// `timings` (one, or [`REPEATS`] for a value the search was about to keep, and then one more
+/// for each run at it that measured off the mark).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Step {
     pub value: i64,
@@ -398,9 +401,9 @@ pub const RUN_LOW: f64 = 0.85;
 pub const MAX_RETUNES: usize = 2;
 
 /// Whether a run that measured `run_ms` a frame at the setting its equal-time `record` kept is
-/// off the mark: over the budget, unless no value fitted (the record's range end says so), or
-/// under [`RUN_LOW`] of it where neither the knob's largest value nor a jump in the frame time
-/// from a value the search itself timed under [`RUN_LOW`] ended the search.
+/// off the mark: over the budget, unless no value fitted (range end "min" or "over budget");
+/// or under [`RUN_LOW`] of it, only where the search ended on its own terms (no range end) or
+/// at a jump from a value the search itself timed within [`RUN_LOW`]–100 %.
 pub fn off_the_mark(record: &Value, run_ms: f64) -> bool {
     let (Some(_), Some(budget)) = (record["knob"].as_str(), record["budget_ms"].as_f64()) else {
         return false;

@@ -126,13 +126,29 @@ pub fn equal_time_table(results: &[RunResult]) -> Option<Table> {
             super::table::OWN_MARK
         ),
     ];
+    let mut notes = notes;
+    notes.extend(remeasured_notes(&runs, &pc("run_low")));
+    Some(Table {
+        title: "Error at equal time".to_string(),
+        columns,
+        rows,
+        notes,
+    })
+}
+
+/// The notes on runs measured again (their earlier runs' timings) and on runs still over the
+/// budget in their own measurement; `run_low` is the low end a run must reach ("85 %").
+fn remeasured_notes(runs: &[&RunResult], run_low: &str) -> Vec<String> {
     // A run whose own measurement left the budget is said, not hidden in the column.
     let off: Vec<String> =
         (runs.iter())
             .filter_map(|r| {
                 let e = record(r)?;
                 let (budget, ms) = (e["budget_ms"].as_f64()?, frame_time_ms(r)?);
-                (e["knob"].is_string() && e["end"].is_null() && ms > budget).then(|| {
+                // Over it though a value fitted (a range end of "min" or "over budget" says none
+                // did, and the setting column says so).
+                let fitted = !matches!(e["end"].as_str(), Some("min" | "over budget"));
+                (e["knob"].is_string() && fitted && ms > budget).then(|| {
                     format!(
                     "{} {}: the run measured {ms:.2} ms, over the {budget} ms budget (its search: \
                      {})",
@@ -159,13 +175,13 @@ pub fn equal_time_table(results: &[RunResult]) -> Option<Table> {
             Some(format!("{} {}: {}", r.scene, r.technique, list.join(", ")))
         })
         .collect();
-    let mut notes = notes;
+    let mut notes = Vec::new();
     if !again.is_empty() {
         notes.push(format!(
             "Run again after the run's own measurement left {}-100 % of the budget (that \
              measurement then counted as one more timing of its value, and the search went on): \
              {}.",
-            pc("run_low").trim_end_matches(" %"),
+            run_low.trim_end_matches(" %"),
             again.join("; ")
         ));
     }
@@ -176,10 +192,5 @@ pub fn equal_time_table(results: &[RunResult]) -> Option<Table> {
             off.join("; ")
         ));
     }
-    Some(Table {
-        title: "Error at equal time".to_string(),
-        columns,
-        rows,
-        notes,
-    })
+    notes
 }

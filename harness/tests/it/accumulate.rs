@@ -1,8 +1,9 @@
 //! The accumulation's lean form (each VPL's receiver-independent terms computed once, by a
 //! dispatch of their own) against the direct per-pair formulation it replaced
 //! (`shaders/accumulate_per_pair.wgsl`, the kit's shader before): on the Cornell box with 4x4
-//! tiles, every map kind, the clamp on and off, and empty slots between VPLs, the split
-//! irradiance of both agrees within 1e-5 relative at every texel. Runs on Vulkan and GL.
+//! tiles, every map kind, the clamp on and off (and biting), empty slots between VPLs, and an
+//! atlas of more than one row of maps, the split irradiance of both agrees within 1e-5
+//! relative at every texel. Runs on Vulkan and GL.
 
 use gibench_harness::cpu::vpl::{self, Vpl, VplSettings};
 use gibench_harness::gpu::GpuContext;
@@ -37,8 +38,10 @@ fn both(
         beta: 2.0,
     };
     let interleave = Interleave::new(gpu, &harness.gbuffer, (4, 4), filter, &output).unwrap();
-    // 48 first-bounce VPLs, every third slot left empty (as an incremental technique's ring).
-    let vpls: Vec<Vpl> = vpl::generate(scene, &harness.bvh, &frame.light, &VplSettings::new(48));
+    // First-bounce VPLs, every third slot left empty (as an incremental technique's ring):
+    // more slots than an atlas row of 128² maps holds under a 16384-texel limit, so that
+    // tile origins below the first row are looked up too (asserted below).
+    let vpls: Vec<Vpl> = vpl::generate(scene, &harness.bvh, &frame.light, &VplSettings::new(160));
     let stored: Vec<(u32, Vpl)> = (vpls.iter().enumerate())
         .map(|(i, v)| ((i + i / 2) as u32, *v))
         .collect();
@@ -49,12 +52,17 @@ fn both(
         AtlasSettings {
             kind,
             format: AtlasFormat::Depth16,
-            size: 32,
+            size: 128,
             capacity,
             bias: 0.01,
         },
     )
     .unwrap();
+    let ([_, last_row], _) = atlas.block(capacity - 1);
+    assert!(
+        last_row > 0,
+        "the atlas holds {capacity} maps in one row: widen the test"
+    );
     let store = VplStore::new(gpu, capacity).unwrap();
     store.write(&gpu.queue, &stored);
     let lean = Accumulation::new(gpu, &interleave, &store, &atlas, clamp).unwrap();
@@ -135,15 +143,21 @@ fn the_lean_accumulation_equals_the_per_pair_one() {
     for backend in backends_for("accumulate") {
         let gpu = backend_context(backend);
         for kind in [MapKind::Paraboloid, MapKind::Cube, MapKind::Octahedral] {
+            let mut references = Vec::new();
             for clamp in [IrradianceClamp::OFF, clamped] {
                 let (lean, per_pair) = both(&gpu, &scene, kind, clamp);
                 assert_eq!(lean.len(), per_pair.len());
                 let (mut lit, mut worst) = (0, 0f32);
                 for (a, b) in lean.iter().zip(&per_pair) {
                     for c in 0..4 {
-                        let rel = (a[c] - b[c]).abs() / b[c].abs().max(1e-30);
                         if a[c] != b[c] {
-                            worst = worst.max(rel);
+                            let rel = (a[c] - b[c]).abs() / b[c].abs().max(1e-30);
+                            // A NaN on either side is a difference, not a pass.
+                            worst = if rel.is_nan() {
+                                f32::INFINITY
+                            } else {
+                                worst.max(rel)
+                            };
                         }
                     }
                     lit += (b[0] > 0.0) as usize;
@@ -158,7 +172,13 @@ fn the_lean_accumulation_equals_the_per_pair_one() {
                     worst <= 1e-5,
                     "{backend} {kind:?} {clamp:?}: a texel differs by {worst:e} relative"
                 );
+                references.push(per_pair);
             }
+            // The clamp bites somewhere (else its branch went untested).
+            assert_ne!(
+                references[0], references[1],
+                "{backend} {kind:?}: the clamp changed nothing"
+            );
         }
     }
 }

@@ -33,11 +33,11 @@ fn accumulate(@builtin(global_invocation_id) id: vec3<u32>) {
         if (v.position.w < 0.0) {
             continue;
         }
-        let g = geometric_term(v.position.xyz, v.normal.xyz, p, n);
+        let g = geometric_term(v.position.xyz, v.normal, p, n);
         if (g <= 0.0) {
             continue;
         }
-        if (atlas_visibility(v.eye.xyz, v.tangent.xyz, v.bitangent.xyz, v.normal.xyz, prepared_origin(v), p, n) == 0.0) {
+        if (atlas_visibility(v.eye.xyz, v.tangent.xyz, v.bitangent.xyz, v.normal, prepared_origin(v), p, n) == 0.0) {
             continue;
         }
         e += vec3<f32>(v.eye.w, v.tangent.w, v.bitangent.w) * min(g, v.position.w);

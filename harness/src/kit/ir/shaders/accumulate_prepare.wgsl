@@ -43,7 +43,8 @@ fn prepare(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     prepared[k] = PreparedVpl(
         vec4<f32>(v.position.xyz, g_max),
-        vec4<f32>(v.normal.xyz, pack_origin(vpl_map_origin(u32(v.position.w)))),
+        v.normal.xyz,
+        pack_origin(vpl_map_origin(u32(v.position.w))),
         vec4<f32>(vpl_eye(v), base.r),
         vec4<f32>(v.tangent.xyz, base.g),
         vec4<f32>(v.bitangent.xyz, base.b),

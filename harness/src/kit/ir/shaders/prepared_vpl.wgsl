@@ -7,8 +7,11 @@ struct PreparedVpl {
     // xyz: position; w: the largest geometric term the clamp lets through (3.4e38 without a
     // clamp), below 0 for an empty slot
     position: vec4<f32>,
-    // xyz: unit normal; w: the bits of the map's tile origin in the atlas, x | y << 16
-    normal: vec4<f32>,
+    // unit normal
+    normal: vec3<f32>,
+    // the map's tile origin in the atlas, x | y << 16 (an integer: as a float's bits, small
+    // values would be subnormal, which a driver may flush to zero)
+    origin: u32,
     // xyz: the map's eye point; w: flux / pi, red
     eye: vec4<f32>,
     // xyz: the map's frame (tangent); w: flux / pi, green
@@ -17,15 +20,14 @@ struct PreparedVpl {
     bitangent: vec4<f32>,
 };
 
-// The tile origin packed in `normal.w`, unpacked.
+// The tile origin of `v`, unpacked.
 fn prepared_origin(v: PreparedVpl) -> vec2<i32> {
-    let packed = bitcast<u32>(v.normal.w);
-    return vec2<i32>(i32(packed & 0xffffu), i32(packed >> 16u));
+    return vec2<i32>(i32(v.origin & 0xffffu), i32(v.origin >> 16u));
 }
 
-// The tile origin `o` (each coordinate below 65536: an atlas is at most 16384 texels wide)
-// packed into the bits of an f32.
-fn pack_origin(o: vec2<i32>) -> f32 {
+// The tile origin `o` packed (each coordinate below 65536, the most texels an atlas side may
+// have under any adapter's 2D texture limit we have met: 32768).
+fn pack_origin(o: vec2<i32>) -> u32 {
     let u = vec2<u32>(o);
-    return bitcast<f32>(u.x | (u.y << 16u));
+    return u.x | (u.y << 16u);
 }
