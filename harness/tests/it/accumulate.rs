@@ -1,6 +1,6 @@
 //! The accumulation's lean form (each VPL's receiver-independent terms computed once, by a
 //! dispatch of their own) against the direct per-pair formulation it replaced
-//! (`shaders/accumulate_per_pair.wgsl`, the kit's shader before): on the Cornell box with 4x4
+//! (`accumulate_per_pair.wgsl`, the kit's shader before): on the Cornell box with 4x4
 //! tiles, every map kind, the clamp on and off (and biting), empty slots between VPLs, and an
 //! atlas of more than one row of maps, the split irradiance of both agrees within 1e-5
 //! relative at every texel. Runs on Vulkan and GL.
@@ -85,7 +85,7 @@ fn both(
         "{INTERLEAVE_WGSL}\n{}\n{}\n{}",
         VplStore::wgsl(1, 0, false),
         ShadowAtlas::wgsl(2),
-        include_str!("shaders/accumulate_per_pair.wgsl")
+        include_str!("accumulate_per_pair.wgsl")
     );
     let per_pair = compute_pipeline(
         &gpu.device,

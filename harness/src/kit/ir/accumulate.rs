@@ -12,7 +12,7 @@
 //! term the clamp lets through) into a buffer of the store's capacity; the second, one
 //! invocation per split texel, loops over its tile's VPLs with only the receiver-dependent
 //! work (the geometric term, the map lookup). The images equal those of the direct per-pair
-//! formulation (`harness/tests/it/shaders/accumulate_per_pair.wgsl`, compared by a test).
+//! formulation (`harness/tests/it/accumulate_per_pair.wgsl`, compared by a test).
 //!
 //! **Clamp** (Laine et al. 2007 §5.2, after Keller): the irradiance a single VPL may give a
 //! receiver is bounded — against the 1/r² singularity — by E_max = k · Ē, where Ē = ΣΦ / A
