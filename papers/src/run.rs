@@ -310,13 +310,12 @@ impl Plan {
 pub fn announcement(plan: &Plan, gpu: &GpuContext) -> String {
     let c = &plan.config;
     format!(
-        "gibench: scene '{}' ({} triangles) at {}x{} on {} ({}), {} measured + {} warm-up frames, timing '{}'",
+        "gibench: scene '{}' ({} triangles) at {}x{} on {}, {} measured + {} warm-up frames, timing '{}'",
         plan.desc.name,
         plan.scene.mesh.triangle_count(),
         c.resolution[0],
         c.resolution[1],
-        gpu.info.adapter,
-        gpu.info.backend,
+        gpu.info.label(),
         c.frames,
         c.warmup,
         c.timing.name()
@@ -635,6 +634,12 @@ fn retune_off_the_mark(
     Ok(())
 }
 
+/// Said before an equal-time search on a software rasteriser left to its default threads.
+/// Measured on a shared 2-core machine (lavapipe, `gaitatzes` on Cornell at one setting, 30
+/// frames a run): five runs' medians 79.1-126.3 ms with the default threads, in two modes a
+/// whole run long; with `LP_NUM_THREADS=0` 126.1-133.3 ms over four runs of 10 frames.
+const UNSTEADY_SOFTWARE: &str = "equal time: this device is a software rasteriser on its default threads, whose frame time can move by tens of percent from one run to the next (on a shared machine); a run may then land off the budget however the search went. LP_NUM_THREADS=0 (one thread: slower and steady) gives settings that hold";
+
 /// [`run_planned`], also returning the techniques a run over every technique left out.
 fn run_planned_skipping(
     args: &RunArgs,
@@ -646,6 +651,9 @@ fn run_planned_skipping(
     // With --equal-time, each technique's knob tuned to the budget first.
     let (mut params, mut recorded) = (plan.params.clone(), Vec::new());
     if let Some(budget) = plan.equal_time {
+        if gpu.info.is_software() && gpu.info.driver_env.is_empty() {
+            bars.note(UNSTEADY_SOFTWARE);
+        }
         let h = Harness::new(gpu, &plan.scene, &plan.config)?;
         let records = crate::equal_time::apply(
             &plan.techniques,

@@ -153,15 +153,19 @@ pub(crate) fn exec(args: &ExportResultsArgs) -> Result<()> {
 }
 
 /// The testbed the runs were made on, as a Bencher slug (lower case, digits and dashes, at
-/// most 64 characters): adapter, backend and driver. `None` without runs; an error when the
-/// runs come from more than one (their histories must not mix).
+/// most 64 characters): adapter, backend and driver, and a software rasteriser's recorded
+/// thread setting (`driver_env`). `None` without runs; an error when the runs come from more
+/// than one (their histories must not mix).
 fn testbed(runs: &[RunResult]) -> Result<Option<String>> {
     // Devices are told apart by their whole names, not by their slugs, which may be cut.
     let mut devices: Vec<String> = runs
         .iter()
         .map(|r| {
             let d = &r.device;
-            format!("{} {} {}", d.adapter, d.backend, d.driver)
+            let env: String = (d.driver_env.iter())
+                .map(|(k, v)| format!(" {k} {v}"))
+                .collect();
+            format!("{} {} {}{env}", d.adapter, d.backend, d.driver)
         })
         .collect();
     devices.sort();
@@ -579,6 +583,33 @@ mod tests {
         let u = testbed(std::slice::from_ref(&other)).unwrap().unwrap();
         assert!(u.len() <= 64 && u != t, "{t} / {u}");
         let e = testbed(&[r, other]).unwrap_err().to_string();
+        assert!(e.contains("2 devices"), "{e}");
+    }
+
+    /// A software rasteriser run with its thread count set (`LP_NUM_THREADS=0`: steadier, and
+    /// slower) is another testbed than one left to the driver's default, and the two are not
+    /// exported together. Catches a history that mixes the two settings' timings.
+    #[test]
+    fn a_software_thread_setting_is_its_own_testbed() {
+        let r: RunResult = serde_json::from_slice(
+            &std::fs::read(
+                std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                    .join("results/baseline/r1/cornell-direct.json"),
+            )
+            .unwrap(),
+        )
+        .unwrap();
+        assert!(r.device.driver_env.is_empty(), "{:?}", r.device);
+        let mut one = r.clone();
+        one.device.driver_env = r
+            .device
+            .software_env(|k| (k == "LP_NUM_THREADS").then(|| "0".into()));
+        let (t, u) = (
+            testbed(std::slice::from_ref(&r)).unwrap().unwrap(),
+            testbed(std::slice::from_ref(&one)).unwrap().unwrap(),
+        );
+        assert!(u.ends_with("lp-num-threads-0") && t != u, "{t} / {u}");
+        let e = testbed(&[r, one]).unwrap_err().to_string();
         assert!(e.contains("2 devices"), "{e}");
     }
 }

@@ -223,7 +223,7 @@ impl GpuContext {
         } else {
             0.0
         };
-        let info = DeviceInfo {
+        let mut info = DeviceInfo {
             adapter: ai.name.clone(),
             backend: format!("{:?}", ai.backend).to_lowercase(),
             device_type: format!("{:?}", ai.device_type),
@@ -231,7 +231,9 @@ impl GpuContext {
             driver_info: ai.driver_info.clone(),
             timestamp_queries: timestamps,
             timestamp_period_ns: period,
+            driver_env: Default::default(),
         };
+        info.driver_env = info.software_env(|k| std::env::var(k).ok());
         Ok(GpuContext {
             instance,
             adapter,

@@ -110,7 +110,16 @@ pub struct DeviceInfo {
     pub timestamp_queries: bool,
     /// Nanoseconds per timestamp tick.
     pub timestamp_period_ns: f32,
+    /// The environment variables that set how a software rasteriser runs, as they were set
+    /// ([`SOFTWARE_ENV`]; empty on a GPU, or where none was set): a CPU device's thread count
+    /// changes its speed, so runs made with other settings are another device's.
+    #[serde(default, skip_serializing_if = "std::collections::BTreeMap::is_empty")]
+    pub driver_env: std::collections::BTreeMap<String, String>,
 }
+
+/// Environment variables read by software rasterisers that change their speed: Mesa llvmpipe's
+/// and lavapipe's thread count (`LP_NUM_THREADS`; 0 runs everything on the submitting thread).
+pub const SOFTWARE_ENV: [&str; 1] = ["LP_NUM_THREADS"];
 
 impl DeviceInfo {
     /// Whether the adapter is a CPU rasteriser rather than a GPU: wgpu's CPU device type, or a
@@ -129,6 +138,30 @@ impl DeviceInfo {
             ]
             .iter()
             .any(|s| name.contains(s))
+    }
+
+    /// [`SOFTWARE_ENV`]'s variables as `get` reads them, where the adapter is a software
+    /// rasteriser (a GPU's runs record none).
+    pub fn software_env(
+        &self,
+        get: impl Fn(&str) -> Option<String>,
+    ) -> std::collections::BTreeMap<String, String> {
+        if !self.is_software() {
+            return Default::default();
+        }
+        (SOFTWARE_ENV.iter())
+            .filter_map(|k| Some((k.to_string(), get(k)?)))
+            .collect()
+    }
+
+    /// "adapter (backend)", with any [`SOFTWARE_ENV`] setting after the backend
+    /// ("llvmpipe (LLVM 15.0.6, 256 bits) (vulkan, LP_NUM_THREADS=0)"): what a run ran on.
+    pub fn label(&self) -> String {
+        let mut s = self.backend.clone();
+        for (k, v) in &self.driver_env {
+            s.push_str(&format!(", {k}={v}"));
+        }
+        format!("{} ({s})", self.adapter)
     }
 }
 
@@ -425,5 +458,38 @@ mod span_tests {
         let gaps = GpuFrameSpan::of([(100, 200), (500, 600)], 1e6);
         assert_eq!((gaps.span_ms, gaps.stage_sum_ms), (500.0, 200.0));
         assert_eq!(GpuFrameSpan::of(std::iter::empty(), 1.0).span_ms, 0.0);
+    }
+}
+
+#[cfg(test)]
+mod device_tests {
+    use super::DeviceInfo;
+
+    /// A software rasteriser records its thread setting where one is set, and shows it in its
+    /// label; a GPU records none whatever the environment holds. Catches a GPU run labelled
+    /// with llvmpipe's variable and a CPU run whose setting is lost.
+    #[test]
+    fn a_software_rasterisers_thread_setting_is_recorded_and_labelled() {
+        let set = |k: &str| (k == "LP_NUM_THREADS").then(|| "0".to_string());
+        let mut cpu = DeviceInfo {
+            adapter: "llvmpipe (LLVM 15.0.6, 256 bits)".into(),
+            backend: "vulkan".into(),
+            device_type: "Cpu".into(),
+            ..Default::default()
+        };
+        assert!(cpu.software_env(|_| None).is_empty());
+        cpu.driver_env = cpu.software_env(set);
+        assert_eq!(
+            cpu.label(),
+            "llvmpipe (LLVM 15.0.6, 256 bits) (vulkan, LP_NUM_THREADS=0)"
+        );
+        let gpu = DeviceInfo {
+            adapter: "NVIDIA H100".into(),
+            backend: "vulkan".into(),
+            device_type: "DiscreteGpu".into(),
+            ..Default::default()
+        };
+        assert!(gpu.software_env(set).is_empty());
+        assert_eq!(gpu.label(), "NVIDIA H100 (vulkan)");
     }
 }

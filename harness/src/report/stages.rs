@@ -119,9 +119,10 @@ pub fn vpl_count_cell(r: &RunResult) -> Cell {
     }
 }
 
-/// "adapter (backend)": what a run ran on, for tables that pool several devices.
+/// "adapter (backend)" ([`crate::measure::results::DeviceInfo::label`]: with a software
+/// rasteriser's thread setting): what a run ran on, for tables that pool several devices.
 pub fn device_label(r: &RunResult) -> String {
-    format!("{} ({})", r.device.adapter, r.device.backend)
+    r.device.label()
 }
 
 /// "fewest / most" VPLs any interleaving tile got in any measured frame (the `tile-vpls-min`

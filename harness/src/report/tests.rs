@@ -75,6 +75,7 @@ fn run(scene: &str, technique: &str, stages: Vec<StageResult>, frame_median: f64
             driver_info: "1.2.3".into(),
             timestamp_queries: true,
             timestamp_period_ns: 1.0,
+            driver_env: Default::default(),
         },
         stages,
         frame: Some(FrameResult {

@@ -80,7 +80,7 @@ pub fn reproduce(args: &ReproduceArgs) -> Result<()> {
     };
     let adapter = gpu
         .as_ref()
-        .map(|g| format!("{} ({})", g.info.adapter, g.info.backend))
+        .map(|g| g.info.label())
         .unwrap_or_else(|| "CPU only".into());
     let previous = Manifest::previous(&root);
     let (measured, sources) = estimates(&planned, previous.as_ref());
