@@ -637,8 +637,12 @@ fn retune_off_the_mark(
 /// Said before an equal-time search on a software rasteriser left to its default threads.
 /// Measured on a shared 2-core machine (lavapipe, `gaitatzes` on Cornell at one setting, 30
 /// frames a run): five runs' medians 79.1-126.3 ms with the default threads, in two modes a
-/// whole run long; with `LP_NUM_THREADS=0` 126.1-133.3 ms over four runs of 10 frames.
-const UNSTEADY_SOFTWARE: &str = "equal time: this device is a software rasteriser on its default threads, whose frame time can move by tens of percent from one run to the next (on a shared machine); a run may then land off the budget however the search went. LP_NUM_THREADS=0 (one thread: slower and steady) gives settings that hold";
+/// whole run long; with `LP_NUM_THREADS=0` 126.1-133.3 ms over four runs of 10 frames. One
+/// thread is steadier, not steady: `barczak` at 126 VPLs (10 frames) measured 88.6-129.6 ms in
+/// 22 of 28 processes on one thread and 141-169 ms in the other 6, each steady within its
+/// process (neither glibc's malloc thresholds fixed nor address randomisation off changed
+/// that; not explained).
+const UNSTEADY_SOFTWARE: &str = "equal time: this device is a software rasteriser on its default threads, whose frame time can move by tens of percent from one run to the next (on a shared machine); a run may then land off the budget however the search went. LP_NUM_THREADS=0 (one thread: slower, and steadier) gives settings that hold more often";
 
 /// [`run_planned`], also returning the techniques a run over every technique left out.
 fn run_planned_skipping(
