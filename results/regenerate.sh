@@ -37,19 +37,23 @@ run() { # run OUTPUT_DIR command... (OUTPUT_DIR is emptied first: no stale files
 # equal-time search can aim within (docs/running.md, --equal-time); its results record the
 # setting (device.driver_env) and count as another device's.
 reproduce() { # reproduce TARGET,TARGET,... (equal-time, where listed, in a process of its own)
+  # equal-time first: the manifest (results/reproduce-all.*) then names the other targets' run
+  # as the last one, with equal-time's entry carried over.
   local rest
+  [ -n "$1" ] || { echo "regenerate.sh: no targets to reproduce" >&2; exit 1; }
+  if echo "$1" | tr , '\n' | grep -qx equal-time; then
+    echo "== LP_NUM_THREADS=0 gibench reproduce all --quick --html --only equal-time"
+    LP_NUM_THREADS=0 "$g" reproduce all --quick --html --only equal-time --out results
+  fi
   rest=$(echo "$1" | tr , '\n' | grep -vx equal-time | paste -sd, - || true)
   if [ -n "$rest" ]; then
     echo "== gibench reproduce all --quick --html --only $rest"
     "$g" reproduce all --quick --html --only "$rest" --out results
   fi
-  if echo "$1" | tr , '\n' | grep -qx equal-time; then
-    echo "== LP_NUM_THREADS=0 gibench reproduce all --quick --html --only equal-time"
-    LP_NUM_THREADS=0 "$g" reproduce all --quick --html --only equal-time --out results
-  fi
 }
 if [ -z "$only" ]; then
-  reproduce "$("$g" reproduce all --quick --list 2>&1 | awk '/^  [a-z]/ { print $1 }' | paste -sd, -)"
+  all=$("$g" reproduce all --quick --list 2>&1 | awk '/^  [a-z]/ && NF >= 3 { print $1 }' | paste -sd, -)
+  reproduce "$all"
 elif [ "$only" != baseline ]; then
   targets=$("$g" reproduce all --quick --list 2>&1 | awk -v d="$only" '/^  [a-z]/ && ($3 == d || index($3, d "/") == 1) { print $1 }' | paste -sd, -)
   case "results/gaitatzes/transfer" in "results/$only"*) transfer_only=1 ;; *) transfer_only=0 ;; esac

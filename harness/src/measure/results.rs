@@ -157,11 +157,15 @@ impl DeviceInfo {
     /// "adapter (backend)", with any [`SOFTWARE_ENV`] setting after the backend
     /// ("llvmpipe (LLVM 15.0.6, 256 bits) (vulkan, LP_NUM_THREADS=0)"): what a run ran on.
     pub fn label(&self) -> String {
-        let mut s = self.backend.clone();
-        for (k, v) in &self.driver_env {
-            s.push_str(&format!(", {k}={v}"));
-        }
-        format!("{} ({s})", self.adapter)
+        format!("{} ({}{})", self.adapter, self.backend, self.env_text())
+    }
+
+    /// The recorded [`SOFTWARE_ENV`] settings as ", LP_NUM_THREADS=0" (empty where none): for
+    /// every description of the device.
+    pub fn env_text(&self) -> String {
+        (self.driver_env.iter())
+            .map(|(k, v)| format!(", {k}={v}"))
+            .collect()
     }
 }
 

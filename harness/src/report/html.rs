@@ -227,10 +227,11 @@ impl Page {
                     .filter(|s| !s.is_empty())
                     .collect::<Vec<_>>()
                     .join(" ");
+                let env = d.env_text();
                 if driver.is_empty() {
-                    format!("{} ({})", d.adapter, d.backend)
+                    format!("{} ({}{env})", d.adapter, d.backend)
                 } else {
-                    format!("{} ({}, driver {driver})", d.adapter, d.backend)
+                    format!("{} ({}, driver {driver}{env})", d.adapter, d.backend)
                 }
             })
             .collect();

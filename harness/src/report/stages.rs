@@ -28,10 +28,11 @@ fn device_text(r: &RunResult) -> String {
     };
     let mut kind: Vec<&str> = vec![d.backend.trim(), d.device_type.trim()];
     kind.retain(|s| !s.is_empty());
+    let env = d.env_text();
     if kind.is_empty() {
-        format!("{adapter} (driver {driver})")
+        format!("{adapter} (driver {driver}{env})")
     } else {
-        format!("{adapter} ({}; driver {driver})", kind.join(", "))
+        format!("{adapter} ({}; driver {driver}{env})", kind.join(", "))
     }
 }
 

@@ -142,6 +142,22 @@ fn pooled_devices_get_a_device_column() {
     assert!(cell(1).starts_with("NVIDIA H200") && !cell(0).starts_with("NVIDIA"));
 }
 
+/// A software rasteriser's thread setting tells runs apart like another device: the second
+/// run made with `LP_NUM_THREADS=0` gets the device column and the notes name the setting.
+/// Catches a table that pools the two settings' timings as one device's.
+#[test]
+fn a_thread_setting_is_named_as_another_device() {
+    let mut runs = two_runs();
+    runs[1].device.driver_env = [("LP_NUM_THREADS".to_string(), "0".to_string())].into();
+    let t = stage_table(&runs);
+    assert_eq!(t.columns[0], "device");
+    assert!(
+        t.notes.iter().any(|n| n.contains("LP_NUM_THREADS=0")),
+        "{:?}",
+        t.notes
+    );
+}
+
 #[test]
 fn stage_union_keeps_execution_order() {
     let t = stage_table(&two_runs());

@@ -255,12 +255,12 @@ pub fn device_note(runs: &[&RunResult]) -> String {
     let mut devices: Vec<String> = runs
         .iter()
         .map(|r| {
-            let env: String = (r.device.driver_env.iter())
-                .map(|(k, v)| format!(", {k}={v}"))
-                .collect();
             format!(
-                "{} ({}, driver {}{env})",
-                r.device.adapter, r.device.backend, r.device.driver
+                "{} ({}, driver {}{})",
+                r.device.adapter,
+                r.device.backend,
+                r.device.driver,
+                r.device.env_text()
             )
         })
         .collect();
