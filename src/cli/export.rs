@@ -162,10 +162,7 @@ fn testbed(runs: &[RunResult]) -> Result<Option<String>> {
         .iter()
         .map(|r| {
             let d = &r.device;
-            let env: String = (d.driver_env.iter())
-                .map(|(k, v)| format!(" {k} {v}"))
-                .collect();
-            format!("{} {} {}{env}", d.adapter, d.backend, d.driver)
+            format!("{} {} {}{}", d.adapter, d.backend, d.driver, d.env_text())
         })
         .collect();
     devices.sort();
