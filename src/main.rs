@@ -28,7 +28,7 @@ use gibench_papers::sweep::SweepArgs;
 #[derive(Parser)]
 #[command(
     name = "gibench",
-    version,
+    version = concat!(env!("CARGO_PKG_VERSION"), " (", env!("GIBENCH_GIT_COMMIT"), ")"),
     about = "Benchmark suite for real-time indirect illumination"
 )]
 struct Cli {
@@ -78,6 +78,8 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    // Results record the commit this binary was built from (build.rs), not the checkout's.
+    gibench_harness::run::runner::set_build_commit(env!("GIBENCH_GIT_COMMIT"));
     gibench_harness::cpu::threads::join_global_pool();
     let cli = Cli::parse();
     let outcome = match cli.command {

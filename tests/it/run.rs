@@ -49,6 +49,18 @@ fn cornell_run_writes_results_images_and_tables() {
         }
     }
     assert_eq!(r.frame.as_ref().expect("frame timing").frame_ms.count, 4);
+    // The run records the commit the binary was built from (stamped by build.rs), and that
+    // stamp is the checkout's current one: a stale stamp (the build script not rerun after a
+    // commit or an edit) would name another.
+    let version = support::GIBENCH.command().arg("--version").output().unwrap();
+    let version = String::from_utf8_lossy(&version.stdout).into_owned();
+    assert!(
+        version.contains(&format!("({})", r.git_commit)),
+        "results name {} but the binary says {version}",
+        r.git_commit
+    );
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    assert_eq!(r.git_commit, gibench_harness::run::commit::describe(root));
     for f in [
         "cornell-direct.png",
         "cornell-direct-indirect.exr",

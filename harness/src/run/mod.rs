@@ -5,6 +5,7 @@
 //! Depends on [`crate::kit`] and everything below it.
 
 pub mod bounds;
+pub mod commit;
 pub mod config;
 pub mod quality;
 pub mod runner;

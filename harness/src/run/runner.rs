@@ -702,40 +702,29 @@ impl<'a> Harness<'a> {
     }
 }
 
-/// `git describe --always` of the source checkout gibench was built from, with `-dirty` when
-/// tracked files outside `results/` differ from that commit (rewriting committed results, as
-/// `results/regenerate.sh` does, changes no code); "unknown" without git.
+/// The commit the `gibench` binary was built from, when it said so at start
+/// ([`set_build_commit`]); a copied binary (a before/after comparison, a GPU slot's bundle)
+/// then records its own build, not the checkout it runs beside.
+static BUILD_COMMIT: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+
+/// Records the commit this process's binary was built from (the root crate's build script
+/// stamps it; see [`super::commit`]). "unknown" is ignored: the run-time look-up may do better.
+pub fn set_build_commit(commit: &str) {
+    if commit != "unknown" {
+        let _ = BUILD_COMMIT.set(commit.to_string());
+    }
+}
+
+/// The commit results record: the binary's own ([`set_build_commit`]), else the source
+/// checkout's at run time ([`super::commit::describe`]: tests, benches and examples).
 pub fn git_commit() -> String {
+    if let Some(commit) = BUILD_COMMIT.get() {
+        return commit.clone();
+    }
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .parent()
         .unwrap_or(std::path::Path::new("."));
-    let git = |args: &[&str]| {
-        std::process::Command::new("git")
-            .arg("-C")
-            .arg(dir)
-            .args(args)
-            .output()
-            .ok()
-            .filter(|o| o.status.success())
-            .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
-    };
-    let Some(commit) = git(&["describe", "--always"]).filter(|s| !s.is_empty()) else {
-        return "unknown".into();
-    };
-    let code_changed = git(&[
-        "status",
-        "--porcelain",
-        "--untracked-files=no",
-        "--",
-        ".",
-        ":(exclude)results",
-    ])
-    .is_some_and(|s| !s.is_empty());
-    if code_changed {
-        format!("{commit}-dirty")
-    } else {
-        commit
-    }
+    super::commit::describe(dir)
 }
 
 #[cfg(test)]
