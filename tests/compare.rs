@@ -351,6 +351,7 @@ fn markdown_lists_regressions_first_and_fail_on_sets_the_status() {
 /// command fails naming it, before writing anything. Catches the comparison passing over such
 /// runs silently (how the committed baseline once lacked `ism`, `ism-classic` and `gaitatzes`
 /// without anyone seeing it) and a `--require-all` that lets an incomplete baseline through.
+/// `--ignore-param` matches them again.
 #[test]
 fn a_run_on_one_side_only_is_listed_and_fails_require_all() {
     let tmp = tempfile::tempdir().unwrap();
@@ -394,6 +395,27 @@ fn a_run_on_one_side_only_is_listed_and_fails_require_all() {
         "{stderr}"
     );
     assert!(!out.exists(), "nothing is written when --require-all fails");
+
+    // `--ignore-param gained`: the gained runs match BASE's (CURRENT then holds ten repeats of
+    // the one run), nothing is left unmatched, and the notes say which parameter was ignored;
+    // a name no run has is refused, naming it. Catches the option changing nothing (the
+    // require-all failure above again) and a misspelt name passing silently.
+    let (ok, rows, stderr) = compare_with(
+        dir,
+        "base",
+        "current",
+        &["--require-all", "--ignore-param", "gained"],
+    );
+    assert!(ok, "{stderr}");
+    assert_eq!(rows.len(), STAGES.len(), "{rows:?}");
+    assert!(!stderr.contains("only in CURRENT"), "{stderr}");
+    let md = std::fs::read_to_string(dir.join("cmp-base-current/compare.md")).unwrap();
+    assert!(md.contains("as if they did not set gained"), "{md}");
+    let (ok, _, stderr) = compare_with(dir, "base", "current", &["--ignore-param", "gainde"]);
+    assert!(
+        !ok && stderr.contains("ignore-param") && stderr.contains("'gainde'"),
+        "{stderr}"
+    );
 }
 
 /// Catches: runs from two devices compared as if from one (their difference read as a

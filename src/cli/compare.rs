@@ -69,6 +69,12 @@ pub(crate) struct CompareArgs {
     /// refused. Both sides' devices are named either way.
     #[arg(long)]
     cross_device: bool,
+    /// Match runs as if these parameters were not set (comma-separated): a parameter a
+    /// technique gained since the BASE runs were made, so that CURRENT's runs (which record it)
+    /// still match BASE's. Only for a parameter whose value CURRENT ran at does what BASE's
+    /// code did or is the change being measured; named in the outputs' notes.
+    #[arg(long, value_delimiter = ',', value_name = "NAME")]
+    ignore_param: Vec<String>,
 }
 
 /// The exit status of `gibench compare --fail-on` when a verdict it names is found (1 is an
@@ -97,6 +103,33 @@ enum StatisticArg {
     Median,
 }
 
+/// Drops the parameters `names` from every run of both sides before matching; a name no run
+/// on either side has is refused (a misspelt name would otherwise change nothing). Returns the
+/// note that says which were ignored.
+fn ignore_params(names: &[String], sides: [&mut Vec<RunResult>; 2]) -> Result<Option<String>> {
+    if names.is_empty() {
+        return Ok(None);
+    }
+    let mut found = vec![false; names.len()];
+    for runs in sides {
+        for r in runs.iter_mut() {
+            for (name, found) in names.iter().zip(&mut found) {
+                *found |= r.parameters.remove(name).is_some();
+            }
+        }
+    }
+    if let Some((name, _)) = names.iter().zip(&found).find(|(_, f)| !**f) {
+        return Err(Error::param(
+            "ignore-param",
+            format!("no run on either side has a parameter '{name}' (expected a parameter one side's runs record)"),
+        ));
+    }
+    Ok(Some(format!(
+        "Runs matched as if they did not set {} (--ignore-param).",
+        names.join(", ")
+    )))
+}
+
 /// `gibench compare`: reads both sides, compares, prints and writes the table and JSON; the
 /// exit status is [`CHANGE_STATUS`] when `--fail-on` names a verdict found.
 pub(crate) fn exec(args: &CompareArgs) -> Result<ExitCode> {
@@ -113,10 +146,11 @@ pub(crate) fn exec(args: &CompareArgs) -> Result<ExitCode> {
     let base = results_under("base", &args.base)?;
     let current = results_under("current", &args.current)?;
     check_distinct_runs(args, &base, &current)?;
-    let (base, current): (Vec<RunResult>, Vec<RunResult>) = (
+    let (mut base, mut current): (Vec<RunResult>, Vec<RunResult>) = (
         base.into_iter().map(|(_, r)| r).collect(),
         current.into_iter().map(|(_, r)| r).collect(),
     );
+    let ignored_note = ignore_params(&args.ignore_param, [&mut base, &mut current])?;
     let devices = [devices(&base), devices(&current)];
     let same_devices = devices[0] == devices[1];
     if !same_devices && !args.cross_device {
@@ -161,6 +195,11 @@ pub(crate) fn exec(args: &CompareArgs) -> Result<ExitCode> {
     let mut table = gibench_harness::report::compare::compare_table(&rows, &settings);
     table.notes.push(device_note.clone());
     let mut notes = vec![device_note];
+    if let Some(note) = ignored_note {
+        eprintln!("{note}");
+        table.notes.push(note.clone());
+        notes.push(note);
+    }
     if !listing.is_empty() {
         let note = format!("Not compared (on one side only): {}.", listing.join("; "));
         eprintln!("warning: {note}");

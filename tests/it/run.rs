@@ -52,7 +52,11 @@ fn cornell_run_writes_results_images_and_tables() {
     // The run records the commit the binary was built from (stamped by build.rs), and that
     // stamp is the checkout's current one: a stale stamp (the build script not rerun after a
     // commit or an edit) would name another.
-    let version = support::GIBENCH.command().arg("--version").output().unwrap();
+    let version = support::GIBENCH
+        .command()
+        .arg("--version")
+        .output()
+        .unwrap();
     let version = String::from_utf8_lossy(&version.stdout).into_owned();
     assert!(
         version.contains(&format!("({})", r.git_commit)),

@@ -12,12 +12,15 @@
 //!   a lookup and its partial lights with one; blocked lights and lights behind are skipped;
 //! * [`Level::Naive`] — adds every light with a lookup on every leaf (brute force).
 //!
-//! Draws: elements, each a set of leaves with the lights they share (one per leaf, merged by
+//! Passes: elements, each a set of leaves with the lights they share (one per leaf, merged by
 //! Figure 4-10's optimiser when `optimise` is on; lights needing lookups and lights not needing
-//! them are separate elements); each element is drawn ⌈lights / K⌉ times, a draw handling up to
-//! K lights (the thesis' X800 had room for 7 per pass; K ≤ 16 here). The per-draw light list is
-//! a read-only storage buffer at a dynamic offset (not a uniform: lavapipe compiles a shader variant per
-//! draw for uniforms that control flow reads; see `passes::params_entry`), portable to GL.
+//! them are separate elements); each element is drawn ⌈lights / K⌉ times, a pass handling up to
+//! K lights (the thesis' X800 had room for 7 per pass; K ≤ 16 here). Every vertex a pass emits
+//! names its leaf vertex and the pass's light record (read-only storage, portable to GL; the
+//! vertex shader pulls the leaf's vertex), so [`Submission::Merged`] submits all the passes of a
+//! render pass as one draw, in the passes' order (blending keeps it): the same triangles, the
+//! same lights per fragment, without the thesis' per-pass draw cost, which on a CPU rasteriser
+//! is most of the stage (docs/roofline.md); [`Submission::Passes`] issues one draw per pass.
 //! Buffers are sized once for the worst case (Naive without merging), so no frame allocates.
 
 use std::ops::Range;
@@ -28,8 +31,7 @@ use gibench_harness::gpu::GpuContext;
 use gibench_harness::kit::ir::atlas::ShadowAtlas;
 use gibench_harness::kit::ir::store::VplStore;
 use gibench_harness::kit::passes::{
-    bind_buffer, dynamic_storage_entry, read_storage_entry, shader_module, FrameUniforms, GBuffer,
-    CAMERA_SLOT,
+    dynamic_storage_entry, shader_module, Bindings, Bound, FrameUniforms, GBuffer, CAMERA_SLOT,
 };
 use gibench_harness::{wgpu, Error, Result};
 
@@ -38,6 +40,32 @@ use crate::lightmap_pass::{color_pass, target_pass, Leaves};
 use crate::lowres::{accumulate, mask_depth, LowRes};
 use crate::passes::{one_per_object, optimise, total_passes, Element, LightSet};
 use crate::visibility::LightState;
+
+/// How the passes reach the device.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Submission {
+    /// One draw per render pass holding every planned pass.
+    Merged,
+    /// One draw per pass, as the thesis submits them.
+    Passes,
+}
+
+impl Submission {
+    /// Parameter values, in [`Submission`]'s order.
+    pub const NAMES: [&'static str; 2] = ["merged", "passes"];
+
+    /// The submission named `name` (one of [`Self::NAMES`]).
+    pub fn parse(name: &str) -> Result<Submission> {
+        match name {
+            "merged" => Ok(Submission::Merged),
+            "passes" => Ok(Submission::Passes),
+            other => Err(Error::param(
+                "submission",
+                format!("expected merged or passes (got {other})"),
+            )),
+        }
+    }
+}
 
 /// Lights one draw handles at most.
 pub const MAX_LIGHTS_PER_DRAW: u32 = 16;
@@ -55,7 +83,10 @@ pub enum Level {
     /// Every light with a lookup.
     Naive,
 }
+/// The raster entries' stride (a dynamic offset's alignment).
 const RECORD_STRIDE: u64 = 256;
+/// Bytes of one pass's light record.
+const LIGHTS_STRIDE: u64 = std::mem::size_of::<DrawLights>() as u64;
 
 /// Where and how a set of draws rasterises.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -85,8 +116,10 @@ struct DrawLights {
 /// See the module docs.
 pub struct LightDraws {
     k: u32,
+    submission: Submission,
     leaves: Arc<Leaves>,
-    indices: wgpu::Buffer,
+    /// Per emitted vertex: its leaf vertex and its pass's record.
+    emitted: wgpu::Buffer,
     records: wgpu::Buffer,
     /// Draws the buffers hold at most.
     max_draws: u32,
@@ -98,11 +131,11 @@ pub struct LightDraws {
     _raster: wgpu::Buffer,
     /// The last plan's level.
     level: Level,
-    /// The CPU copies of the index and record uploads, reused frame to frame.
-    scratch_indices: Vec<u32>,
-    scratch_records: Vec<u8>,
-    /// This frame's draws: index range and record.
-    draws: Vec<(Range<u32>, u32)>,
+    /// The CPU copies of the emitted-vertex and record uploads, reused frame to frame.
+    scratch_emitted: Vec<[u32; 2]>,
+    scratch_records: Vec<DrawLights>,
+    /// This frame's passes: each one's emitted vertices.
+    draws: Vec<Range<u32>>,
     /// Elements of the last plan (for the results: passes made).
     elements: usize,
     /// The draws the last plan's elements would have needed unmerged.
@@ -110,7 +143,8 @@ pub struct LightDraws {
 }
 
 impl LightDraws {
-    /// The pass over `leaves` for `lights` lights in `store` and `atlas`, `k` lights per draw.
+    /// The pass over `leaves` for `lights` lights in `store` and `atlas`, `k` lights per pass,
+    /// submitted as `submission` says.
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         gpu: &GpuContext,
@@ -119,6 +153,7 @@ impl LightDraws {
         leaves: Arc<Leaves>,
         lights: u32,
         k: u32,
+        submission: Submission,
         store: &VplStore,
         atlas: &ShadowAtlas,
         lowres: Option<&LowRes>,
@@ -129,15 +164,20 @@ impl LightDraws {
                 format!("expected 1..={MAX_LIGHTS_PER_DRAW} (got {k})"),
             ));
         }
-        let (indices, records, max_draws) = draw_buffers(gpu, &leaves, lights, k)?;
+        let (emitted, records, max_draws) = draw_buffers(gpu, &leaves, lights, k)?;
         let raster = raster_buffer(gpu, lowres);
-        let (store_layout, store_group) = store_bind_group(&gpu.device, store, &records, &raster);
+        let buffers = [store.buffer(), &records, &raster, &emitted, leaves.buffer()];
+        let Bound {
+            layout: store_layout,
+            group: store_group,
+        } = store_bind_group(&gpu.device, buffers);
         let pipelines = pipelines(&gpu.device, uniforms, gbuffer, &store_layout, atlas);
         gpu.check_errors()?;
         Ok(LightDraws {
             k,
+            submission,
             leaves,
-            indices,
+            emitted,
             records,
             max_draws,
             store_group,
@@ -145,7 +185,7 @@ impl LightDraws {
             pipelines,
             _raster: raster,
             level: Level::Full,
-            scratch_indices: Vec::new(),
+            scratch_emitted: Vec::new(),
             scratch_records: Vec::new(),
             draws: Vec::new(),
             elements: 0,
@@ -193,9 +233,9 @@ impl LightDraws {
             Level::Naive => vec![(one_per_object(&per_leaf(&|_| true)), true)],
         };
         // Scratch kept between frames.
-        let mut indices = std::mem::take(&mut self.scratch_indices);
+        let mut emitted = std::mem::take(&mut self.scratch_emitted);
         let mut records = std::mem::take(&mut self.scratch_records);
-        indices.clear();
+        emitted.clear();
         records.clear();
         self.draws.clear();
         self.elements = 0;
@@ -209,11 +249,6 @@ impl LightDraws {
             };
             self.elements += elements.len();
             for e in &elements {
-                let start = indices.len() as u32;
-                for &tile in &e.objects {
-                    indices.extend(self.leaves.ranges[tile as usize].clone());
-                }
-                let range = start..indices.len() as u32;
                 let flag = if lookup { LOOKUP } else { 0 };
                 let lights: Vec<u32> = e.lights.iter().map(|l| l | flag).collect();
                 for chunk in lights.chunks(self.k as usize) {
@@ -223,29 +258,37 @@ impl LightDraws {
                     };
                     rec.lights[..chunk.len()].copy_from_slice(chunk);
                     let record = self.draws.len() as u32;
-                    if record >= self.max_draws || indices.len() as u64 * 4 > self.indices.size() {
+                    let start = emitted.len() as u32;
+                    for &tile in &e.objects {
+                        let vertices = self.leaves.ranges[tile as usize].clone();
+                        emitted.extend(vertices.map(|v| [v, record]));
+                    }
+                    if record >= self.max_draws || emitted.len() as u64 * 8 > self.emitted.size() {
                         return Err(Error::Invalid(format!(
-                            "barczak's light draws need more than the {} draws they were sized for",
+                            "barczak's light draws need more than the {} passes they were sized for",
                             self.max_draws
                         )));
                     }
-                    let mut bytes = [0u8; RECORD_STRIDE as usize];
-                    bytes[..std::mem::size_of::<DrawLights>()]
-                        .copy_from_slice(bytemuck::bytes_of(&rec));
-                    records.extend_from_slice(&bytes);
-                    self.draws.push((range.clone(), record));
+                    records.push(rec);
+                    self.draws.push(start..emitted.len() as u32);
                 }
             }
         }
-        if !indices.is_empty() {
+        if !emitted.is_empty() {
             gpu.queue
-                .write_buffer(&self.indices, 0, bytemuck::cast_slice(&indices));
-            gpu.queue.write_buffer(&self.records, 0, &records);
+                .write_buffer(&self.emitted, 0, bytemuck::cast_slice(&emitted));
+            gpu.queue
+                .write_buffer(&self.records, 0, bytemuck::cast_slice(&records));
         }
-        self.scratch_indices = indices;
+        self.scratch_emitted = emitted;
         self.scratch_records = records;
         self.level = level;
         Ok(self.draws.len() as u32)
+    }
+
+    /// Submits the passes as `submission` says from now on.
+    pub fn set_submission(&mut self, submission: Submission) {
+        self.submission = submission;
     }
 
     /// The patch leaves' vertices (what a draw over every leaf reads).
@@ -340,25 +383,29 @@ impl LightDraws {
         );
         pass.set_bind_group(1, &self.gbuffer_group, &[]);
         pass.set_bind_group(3, atlas.group(), &[]);
-        pass.set_vertex_buffer(0, self.leaves.buffer().slice(..));
-        pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
         let raster_offset = if raster == Raster::Low {
             RECORD_STRIDE as u32
         } else {
             0
         };
-        for (range, record) in &self.draws {
-            let offset = (*record as u64 * RECORD_STRIDE) as u32;
-            pass.set_bind_group(2, &self.store_group, &[offset, raster_offset]);
-            pass.draw_indexed(range.clone(), 0, 0..1);
+        pass.set_bind_group(2, &self.store_group, &[raster_offset]);
+        match (self.submission, self.draws.last()) {
+            (_, None) => {}
+            (Submission::Merged, Some(last)) => pass.draw(0..last.end, 0..1),
+            (Submission::Passes, _) => {
+                for range in &self.draws {
+                    pass.draw(range.clone(), 0..1);
+                }
+            }
         }
         self.draws.len() as u32
     }
 }
 
-/// The element index buffer and the per-draw light records, sized once for the most any level
-/// plans for `lights` lights over `leaves`, `k` per draw; and that many draws. Refused when
-/// the larger would not fit the device's largest buffer.
+/// The emitted vertices and the per-pass light records, sized once for the most any level
+/// plans for `lights` lights over `leaves`, `k` per pass; and that many passes. Refused when
+/// the larger would not fit the device's largest storage binding. (Every (leaf, light) pair is
+/// in one pass, so the passes emit at most each leaf's vertices once per light.)
 fn draw_buffers(
     gpu: &GpuContext,
     leaves: &Leaves,
@@ -370,9 +417,12 @@ fn draw_buffers(
     // The most any level plans without merging: every leaf, every light, split in two groups
     // (VD: one more partial draw per leaf at most).
     let max_draws = (tiles * (lights.div_ceil(k) as u64 + 1)).max(1);
-    let max_indices = (leaves.vertex_count() as u64 * lights as u64).max(1);
-    let limit = gpu.device.limits().max_buffer_size;
-    let need = (max_indices * 4).max(max_draws * RECORD_STRIDE);
+    let max_emitted = (leaves.vertex_count() as u64 * lights as u64).max(1);
+    let limits = gpu.device.limits();
+    let limit = limits
+        .max_buffer_size
+        .min(limits.max_storage_buffer_binding_size);
+    let need = (max_emitted * 8).max(max_draws * LIGHTS_STRIDE);
     if need > limit {
         return Err(Error::Invalid(format!(
             "barczak's light draws would need a {} MB buffer ({} leaves, {} of their vertices, {lights} light samples), more than this device's largest ({} MB); use fewer samples (vpls) or a scene with fewer patches (max-charts)",
@@ -382,19 +432,17 @@ fn draw_buffers(
             limit >> 20
         )));
     }
-    let indices = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("barczak element indices"),
-        size: max_indices * 4,
-        usage: wgpu::BufferUsages::INDEX | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    let records = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("barczak draw lights"),
-        size: max_draws * RECORD_STRIDE,
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    Ok((indices, records, max_draws as u32))
+    let storage = |label, size| {
+        device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        })
+    };
+    let emitted = storage("barczak emitted vertices", max_emitted * 8);
+    let records = storage("barczak pass lights", max_draws * LIGHTS_STRIDE);
+    Ok((emitted, records, max_draws as u32))
 }
 
 /// The two raster entries, a record apart: full resolution, then the low-resolution pass's
@@ -424,51 +472,25 @@ fn raster_buffer(gpu: &GpuContext, lowres: Option<&LowRes>) -> wgpu::Buffer {
     raster
 }
 
-/// Group 2 of the light draws: the store's lights, the draw's light record and its raster
-/// entry (the last two at dynamic offsets).
+/// Group 2 of the light draws: 0 the store's lights, 1 the passes' light records, 2 the raster
+/// entry (at a dynamic offset), 3 the emitted vertices, 4 the leaves' vertices.
 fn store_bind_group(
     device: &wgpu::Device,
-    store: &VplStore,
-    records: &wgpu::Buffer,
-    raster: &wgpu::Buffer,
-) -> (wgpu::BindGroupLayout, wgpu::BindGroup) {
-    let frag = wgpu::ShaderStages::FRAGMENT;
-    let store_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("barczak lights"),
-        entries: &[
-            read_storage_entry(0, frag),
-            dynamic_storage_entry(1, frag, std::mem::size_of::<DrawLights>() as u64),
-            dynamic_storage_entry(
-                2,
-                wgpu::ShaderStages::VERTEX_FRAGMENT,
-                std::mem::size_of::<RasterData>() as u64,
-            ),
-        ],
+    [lights, records, raster, emitted, leaves]: [&wgpu::Buffer; 5],
+) -> Bound {
+    let raster_size = std::mem::size_of::<RasterData>() as u64;
+    let raster_slot = wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+        buffer: raster,
+        offset: 0,
+        size: wgpu::BufferSize::new(raster_size),
     });
-    let store_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("barczak lights"),
-        layout: &store_layout,
-        entries: &[
-            bind_buffer(0, store.buffer()),
-            wgpu::BindGroupEntry {
-                binding: 1,
-                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                    buffer: records,
-                    offset: 0,
-                    size: wgpu::BufferSize::new(std::mem::size_of::<DrawLights>() as u64),
-                }),
-            },
-            wgpu::BindGroupEntry {
-                binding: 2,
-                resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
-                    buffer: raster,
-                    offset: 0,
-                    size: wgpu::BufferSize::new(std::mem::size_of::<RasterData>() as u64),
-                }),
-            },
-        ],
-    });
-    (store_layout, store_group)
+    Bindings::new("barczak lights", wgpu::ShaderStages::VERTEX_FRAGMENT)
+        .read(lights)
+        .read(records)
+        .with(|b, v| dynamic_storage_entry(b, v, raster_size), raster_slot)
+        .read(emitted)
+        .read(leaves)
+        .build(device)
 }
 
 /// The light draws' pipelines per [`Raster`] (full resolution, low resolution, edges), each
@@ -505,7 +527,7 @@ fn pipelines(
                 module: &module,
                 entry_point: Some("vs_leaf"),
                 compilation_options: Default::default(),
-                buffers: &[Some(Leaves::layout())],
+                buffers: &[],
             },
             primitive: wgpu::PrimitiveState::default(),
             depth_stencil: depth,

@@ -31,6 +31,9 @@ struct LeafVertex {
     st: [f32; 2],
 }
 
+// The light draws pull these from storage as nine words each (shaders/light_draws.wgsl).
+const _: () = assert!(std::mem::size_of::<LeafVertex>() == 9 * 4);
+
 /// The patch leaves as GPU geometry, shared by the light-map and subtraction passes: leaf `t`
 /// (its tile) is the vertices [`Leaves::ranges`]`[t]`, a triangle list, each vertex with its
 /// position, tile, the patch normal and its (s, t) in the leaf. A patch whose rectangle is its
@@ -133,7 +136,10 @@ impl Leaves {
         let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("barczak leaves"),
             size: (std::mem::size_of_val(vertices.as_slice()) as u64).max(4),
-            usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
+            // Drawn from by the light-map pass, pulled from by the light draws.
+            usage: wgpu::BufferUsages::VERTEX
+                | wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
         gpu.queue

@@ -4,6 +4,7 @@
 use gibench_harness::kit::technique::{ParamKind, ParamSpec, Params};
 use gibench_harness::{Error, Result};
 
+use crate::light_draws::Submission;
 use crate::renderer::{Optimisation, RendererSettings};
 use crate::samples::SampleSettings;
 
@@ -37,7 +38,13 @@ pub(crate) const PARAMS: &[ParamSpec] = &[
         name: "lights-per-draw",
         kind: ParamKind::Int { min: 1, max: 16 },
         default: "7",
-        doc: "lights one draw handles (the thesis' X800: 7 per pass)",
+        doc: "lights one pass handles (the thesis' X800: 7 per pass)",
+    },
+    ParamSpec {
+        name: "submission",
+        kind: ParamKind::Choice(&Submission::NAMES),
+        default: "merged",
+        doc: "merged: each render pass's light passes in one draw, every vertex naming its pass's lights (same fragments and lights); passes: one draw per pass, as the thesis submits them (its per-pass cost)",
     },
     ParamSpec {
         name: "lowres",
@@ -138,6 +145,7 @@ impl BarczakParams {
                 samples,
                 light_map_res: params.int("light-map-res") as u32,
                 lights_per_draw: params.int("lights-per-draw") as u32,
+                submission: Submission::parse(params.choice("submission"))?,
                 level,
                 lowres,
                 edge_step,

@@ -35,7 +35,7 @@ use gibench_harness::scene::Scene;
 use gibench_harness::{wgpu, Error, Result};
 use glam::{Mat3, Mat4};
 
-use crate::light_draws::{Level, LightDraws};
+use crate::light_draws::{Level, LightDraws, Submission};
 use crate::lightmap_pass::{Leaves, LightMapPass};
 use crate::lowres::LowRes;
 use crate::prt::{self, COEFFS};
@@ -52,6 +52,8 @@ pub struct RendererSettings {
     pub light_map_res: u32,
     /// Lights per subtraction draw (K).
     pub lights_per_draw: u32,
+    /// How the light passes reach the device.
+    pub submission: Submission,
     /// Figure 5-3's optimisation level.
     pub level: Optimisation,
     /// The low-resolution pass's factor (at [`Optimisation::Full`] and
@@ -298,6 +300,7 @@ impl Renderer {
             leaves,
             n,
             settings.lights_per_draw,
+            settings.submission,
             &store,
             &atlas,
             lowres.as_ref(),

@@ -1,9 +1,12 @@
-// Barczak 2006 §4.3.2–4.3.5: lights drawn over patch leaves, up to K per draw. Each draw covers
-// the leaves of one element and up to K lights. `fs_subtract` (after the light-map pass, blended
-// with ReverseSubtract) sums the contributions of the lights its shadow maps find occluded;
-// `fs_add` (blended with Add) sums every light's contribution, times its shadow-map visibility
-// where the light's entry asks for a lookup (high bit set). Needs GpuVpl / vpl_store (group 2,
-// binding 0) and the atlas lookup (group 3) declared before it.
+// Barczak 2006 §4.3.2–4.3.5: lights drawn over patch leaves, up to K per pass. Each pass covers
+// the leaves of one element and up to K lights; every vertex the draws emit names its leaf
+// vertex and its pass's light record (`emitted`), so that one draw can hold many passes (each
+// triangle shaded with its own pass's lights, blended in the order of the passes).
+// `fs_subtract` (after the light-map pass, blended with ReverseSubtract) sums the contributions
+// of the lights its shadow maps find occluded; `fs_add` (blended with Add) sums every light's
+// contribution, times its shadow-map visibility where the light's entry asks for a lookup (high
+// bit set). Needs GpuVpl / vpl_store (group 2, binding 0) and the atlas lookup (group 3)
+// declared before it.
 
 @group(0) @binding(0) var<uniform> camera: View;
 @group(1) @binding(0) var<uniform> view: View;
@@ -17,7 +20,7 @@ struct DrawLights {
     // The lights' store slots, four per vector; the high bit asks for a shadow-map lookup.
     lights: array<vec4<u32>, 4>,
 };
-@group(2) @binding(1) var<storage, read> draw_lights: DrawLights;
+@group(2) @binding(1) var<storage, read> records: array<DrawLights>;
 
 // Where the draw rasterises: full resolution (factor 1) or the low-resolution pass's (its
 // pixel p shows the G-buffer's pixel factor * p + sample, the projection shifted by ndc so that
@@ -30,19 +33,35 @@ struct Raster {
 };
 @group(2) @binding(2) var<storage, read> raster: Raster;
 
+// Per emitted vertex: x the leaf vertex, y its pass's record.
+@group(2) @binding(3) var<storage, read> emitted: array<vec2<u32>>;
+// The leaves' vertices (lightmap_pass.rs `LeafVertex`, nine words each): position, tile,
+// normal, (s, t).
+@group(2) @binding(4) var<storage, read> leaf_words: array<u32>;
+const LEAF_WORDS: u32 = 9u;
+
 struct LeafOut {
     @builtin(position) clip: vec4<f32>,
     @location(0) world: vec3<f32>,
     @location(1) normal: vec3<f32>,
+    @location(2) @interpolate(flat) record: u32,
 };
 
+fn leaf_vec3(vertex: u32, word: u32) -> vec3<f32> {
+    let i = vertex * LEAF_WORDS + word;
+    return bitcast<vec3<f32>>(vec3<u32>(leaf_words[i], leaf_words[i + 1u], leaf_words[i + 2u]));
+}
+
 @vertex
-fn vs_leaf(@location(0) position: vec3<f32>, @location(2) normal: vec3<f32>) -> LeafOut {
+fn vs_leaf(@builtin(vertex_index) index: u32) -> LeafOut {
+    let e = emitted[index];
+    let position = leaf_vec3(e.x, 0u);
     var out: LeafOut;
     out.clip = camera.view_proj * vec4<f32>(position, 1.0);
     out.clip = vec4<f32>(out.clip.xy + raster.ndc.xy * out.clip.w, out.clip.zw);
     out.world = position;
-    out.normal = normal;
+    out.normal = leaf_vec3(e.x, 4u);
+    out.record = e.y;
     return out;
 }
 
@@ -69,10 +88,11 @@ fn fs_subtract(in: LeafOut) -> @location(0) vec4<f32> {
         discard;
     }
     let n = normalize(in.normal);
+    let record = in.record;
     var occluded = vec3<f32>(0.0);
-    let count = min(draw_lights.count.x, 16u);
+    let count = min(records[record].count.x, 16u);
     for (var k = 0u; k < count; k++) {
-        let slot = draw_lights.lights[k / 4u][k % 4u] & ~LOOKUP;
+        let slot = records[record].lights[k / 4u][k % 4u] & ~LOOKUP;
         let v = vpl_store.items[slot];
         let c = contribution(v, in.world, n);
         if (any(c > vec3<f32>(0.0))) {
@@ -88,10 +108,11 @@ fn fs_add(in: LeafOut) -> @location(0) vec4<f32> {
         discard;
     }
     let n = normalize(in.normal);
+    let record = in.record;
     var sum = vec3<f32>(0.0);
-    let count = min(draw_lights.count.x, 16u);
+    let count = min(records[record].count.x, 16u);
     for (var k = 0u; k < count; k++) {
-        let entry = draw_lights.lights[k / 4u][k % 4u];
+        let entry = records[record].lights[k / 4u][k % 4u];
         let v = vpl_store.items[entry & ~LOOKUP];
         let c = contribution(v, in.world, n);
         if (any(c > vec3<f32>(0.0))) {

@@ -3,11 +3,12 @@
 //! light with the same shadow maps (Barczak's "Naive") on the patches' pixels, once the light
 //! maps' interpolation error (computed on the CPU) is accounted for; merging elements by the
 //! optimiser changes the image by rounding only and never adds draws; the Naive level equals
-//! the gather, and VD equals Naive but where a shadow map contradicts the classification.
+//! the gather, and VD equals Naive but where a shadow map contradicts the classification. At
+//! every level the passes submitted as one draw give the very image of one draw per pass.
 
 use std::sync::Arc;
 
-use gibench_barczak::light_draws::{Level, LightDraws};
+use gibench_barczak::light_draws::{Level, LightDraws, Submission};
 use gibench_barczak::lightmap::contribution;
 use gibench_barczak::lightmap_pass::{Leaves, LightMapPass};
 use gibench_barczak::samples::SampleSettings;
@@ -72,23 +73,14 @@ fn light_maps_minus_occluded_partials_equal_the_brute_force_gather() {
             leaves,
             n,
             7,
+            Submission::Merged,
             &store,
             &atlas,
             None,
         )
         .unwrap();
-        // Barczak Full with and without the pass optimiser, then VD and Naive (which, as the
-        // thesis' levels, draw each leaf on its own).
-        let mut images = Vec::new();
-        let mut draws = Vec::new();
-        let runs = [
-            (Level::Full, true),
-            (Level::Full, false),
-            (Level::VisibilityDetermination, false),
-            (Level::Naive, false),
-        ];
-        for (level, optimise) in runs {
-            draws.push(subtract.plan(gpu, &bz.db, level, optimise).unwrap());
+        // Draws the planned passes (after the light maps, at Full) into a new target.
+        let draw = |subtract: &LightDraws, level: Level| {
             let t = render_target(&gpu.device, "test irradiance", [W, H], HDR_FORMAT);
             let view = t.create_view(&Default::default());
             let mut enc = gpu.device.create_command_encoder(&Default::default());
@@ -109,7 +101,26 @@ fn light_maps_minus_occluded_partials_equal_the_brute_force_gather() {
             }
             subtract.encode(&mut enc, &harness.uniforms, &atlas, &view);
             gpu.queue.submit([enc.finish()]);
-            images.push(gibench_harness::gpu::image_io::read_rgb_f32(gpu, &t).unwrap());
+            gibench_harness::gpu::image_io::read_rgb_f32(gpu, &t).unwrap()
+        };
+        // Barczak Full with and without the pass optimiser, then VD and Naive (which, as the
+        // thesis' levels, draw each leaf on its own).
+        let mut images = Vec::new();
+        let mut draws = Vec::new();
+        let runs = [
+            (Level::Full, true),
+            (Level::Full, false),
+            (Level::VisibilityDetermination, false),
+            (Level::Naive, false),
+        ];
+        for (level, optimise) in runs {
+            draws.push(subtract.plan(gpu, &bz.db, level, optimise).unwrap());
+            let [passes, merged] = [Submission::Passes, Submission::Merged].map(|submission| {
+                subtract.set_submission(submission);
+                draw(&subtract, level)
+            });
+            let what = format!("{backend}: {level:?} (optimiser {optimise})");
+            images.push(assert_bit_identical(&what, passes, merged));
         }
         let naive = brute_force_gather(gpu, harness, &store, &atlas);
 
@@ -178,6 +189,21 @@ fn light_maps_minus_occluded_partials_equal_the_brute_force_gather() {
             "{backend}: VD matches Naive on {same_vd} of {patch} pixels"
         );
     });
+}
+
+/// One draw and one draw per pass give the very same image: the passes' order and lights kept.
+/// Returns the image.
+fn assert_bit_identical(what: &str, passes: Vec<[f32; 3]>, merged: Vec<[f32; 3]>) -> Vec<[f32; 3]> {
+    let differ = passes
+        .iter()
+        .zip(&merged)
+        .filter(|(a, b)| a.map(f32::to_bits) != b.map(f32::to_bits))
+        .count();
+    assert_eq!(
+        differ, 0,
+        "{what}: one draw and one draw per pass differ on {differ} pixels"
+    );
+    merged
 }
 
 /// The kit's gather of every light with the same maps (1x1 tiles, no filtering, no clamp):

@@ -12,6 +12,7 @@
 //! 5. and Full, with its low-resolution subtraction, agrees with VD+LP within 10 % on 95 % of
 //!    the pixels (they differ by the light maps' interpolation).
 
+use gibench_barczak::light_draws::Submission;
 use gibench_barczak::renderer::{FrameCounts, Optimisation, Renderer, RendererSettings};
 use gibench_barczak::samples::SampleSettings;
 
@@ -29,6 +30,7 @@ fn settings(level: Optimisation) -> RendererSettings {
         },
         light_map_res: 4,
         lights_per_draw: 7,
+        submission: Submission::Merged,
         level,
         lowres: 2,
         edge_step: 3,

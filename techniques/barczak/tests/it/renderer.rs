@@ -3,6 +3,7 @@
 //! of a renderer prepared from scratch at that frame — the database, light-map, shadow-map and
 //! PRT updates together. And face culling (§4.2.2) changes no pixel while skipping faces.
 
+use gibench_barczak::light_draws::Submission;
 use gibench_barczak::renderer::{Optimisation, Renderer, RendererSettings};
 use gibench_barczak::samples::SampleSettings;
 
@@ -16,6 +17,7 @@ const SETTINGS: RendererSettings = RendererSettings {
     },
     light_map_res: 4,
     lights_per_draw: 7,
+    submission: Submission::Merged,
     level: Optimisation::Full,
     lowres: 2,
     edge_step: 3,
