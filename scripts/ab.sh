@@ -3,8 +3,10 @@
 #
 #   bash scripts/ab.sh BEFORE AFTER OUT [COMPARE-OPTION...] -- RUN-ARGUMENT...
 #
-# builds the gibench binary of each commit (a git worktree of each under target/ab/, one shared
-# target directory, so only our crates build twice), then runs `gibench run RUN-ARGUMENT...`
+# builds the gibench binary of each commit (a git worktree and a target directory of each under
+# target/ab/, kept for the next comparison: a first build of a commit is a cold one, minutes;
+# one target directory for both would let cargo take one commit's crates for the other's, as
+# their sources' times can say they are fresh), then runs `gibench run RUN-ARGUMENT...`
 # five times with each binary, BEFORE and AFTER alternating (REPEATS=N for another count), into
 # OUT/before/rI and OUT/after/rI, and compares them with `gibench compare --statistic median`
 # (and COMPARE-OPTIONs, e.g. --ignore-param NAME) into OUT/compare.{md,csv,tex,json}. Each run
@@ -58,10 +60,8 @@ for side in before after; do
     git -C "$root" worktree add --detach --quiet "$tree" "$c"
   fi
   echo "== building $side (${c:0:12})" >&2
-  (cd "$tree" && CARGO_TARGET_DIR="$ab/target" cargo build --release --quiet --bin gibench)
-  mkdir -p "$ab/bin-${c:0:12}"
-  cp "$ab/target/release/gibench" "$ab/bin-${c:0:12}/gibench"
-  bin[$side]="$ab/bin-${c:0:12}/gibench"
+  (cd "$tree" && CARGO_TARGET_DIR="$ab/target-${c:0:12}" cargo build --release --quiet --bin gibench)
+  bin[$side]="$ab/target-${c:0:12}/release/gibench"
 done
 
 mkdir -p "$out"

@@ -533,6 +533,56 @@ fn filter_matches_cpu_reference() {
     }
 }
 
+/// The filter's taps addressed from the box origin's quotient and remainder give the very
+/// output of the form it replaced (`interleave_passes_by_division.wgsl`: a division and a
+/// modulo per tap), bit for bit, for tile grids that wrap at every column and row, clip at the
+/// borders, and span most of the image (64x64 on 97x70). Catches a remainder that wraps one
+/// tap late or a quotient not carried (tried: the wrap test `>` instead of `>=` differs).
+#[test]
+fn the_filter_equals_its_division_form() {
+    for backend in backends_for("interleave") {
+        let gpu = backend_context(backend);
+        let size = [97, 70];
+        with_cornell(&gpu, size, |h, _| {
+            let input: Vec<[f32; 3]> = (0..size[0] * size[1])
+                .map(|i| {
+                    [
+                        (i % 13) as f32 * 0.1,
+                        (i % 7) as f32 * 0.3,
+                        (i % 29) as f32 * 0.05,
+                    ]
+                })
+                .collect();
+            for tiles in [(4, 4), (3, 2), (1, 1), (8, 8), (5, 3), (64, 64)] {
+                let [a, b] = [output_texture(&gpu, size), output_texture(&gpu, size)];
+                let lean = Interleave::new(&gpu, &h.gbuffer, tiles, CORNELL, &a).unwrap();
+                let division = Interleave::with_passes_source(
+                    &gpu,
+                    &h.gbuffer,
+                    tiles,
+                    CORNELL,
+                    &b,
+                    include_str!("interleave_passes_by_division.wgsl"),
+                )
+                .unwrap();
+                let x = filter(&gpu, &lean, &a, &input);
+                let y = filter(&gpu, &division, &b, &input);
+                let differ = (x.iter().zip(&y))
+                    .filter(|(p, q)| p.map(f32::to_bits) != q.map(f32::to_bits))
+                    .count();
+                assert_eq!(
+                    differ, 0,
+                    "{backend} tiles {tiles:?}: {differ} pixels differ"
+                );
+                assert!(
+                    x.iter().filter(|p| p.iter().any(|v| *v > 0.0)).count() > x.len() / 2,
+                    "{backend} tiles {tiles:?}: the filter wrote little"
+                );
+            }
+        });
+    }
+}
+
 fn expect_param_error(result: Result<Interleave, Error>, name: &str, what: &str) {
     match result {
         Err(Error::Param { name: n, message }) => {

@@ -288,16 +288,16 @@ fn pass_bind_group(
 
 /// The split, combine and filter pipelines, in that order, over the pass group and the
 /// G-buffer's read group.
+/// The passes' shader (split, combine, filter).
+const PASSES_WGSL: &str = include_str!("shaders/interleave_passes.wgsl");
+
 fn pipelines(
     device: &wgpu::Device,
     pass_layout: &wgpu::BindGroupLayout,
     gbuffer: &GBuffer,
+    source: &str,
 ) -> [wgpu::ComputePipeline; 3] {
-    let module = shader_module(
-        device,
-        "interleave",
-        include_str!("shaders/interleave_passes.wgsl"),
-    );
+    let module = shader_module(device, "interleave", source);
     let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: Some("interleave"),
         bind_group_layouts: &[Some(pass_layout), Some(&gbuffer.read_layout)],
@@ -336,6 +336,20 @@ impl Interleave {
         filter: FilterSettings,
         output: &wgpu::Texture,
     ) -> Result<Interleave> {
+        Self::with_passes_source(gpu, gbuffer, tiles, filter, output, PASSES_WGSL)
+    }
+
+    /// [`Interleave::new`] with the split, combine and filter passes compiled from `source`
+    /// (entry points and bindings as `shaders/interleave_passes.wgsl`'s) instead of the kit's:
+    /// how a test runs an earlier implementation of a pass beside the current one.
+    pub fn with_passes_source(
+        gpu: &GpuContext,
+        gbuffer: &GBuffer,
+        tiles: (u32, u32),
+        filter: FilterSettings,
+        output: &wgpu::Texture,
+        source: &str,
+    ) -> Result<Interleave> {
         let device = &gpu.device;
         let tiles = [tiles.0, tiles.1];
         let full = gbuffer.size;
@@ -356,7 +370,7 @@ impl Interleave {
         let (split_layout, split_group) = split_bind_group(device, &buffers);
         let (pass_layout, pass_group) = pass_bind_group(device, &buffers, output);
         let [split_pipeline, combine_pipeline, filter_pipeline] =
-            pipelines(device, &pass_layout, gbuffer);
+            pipelines(device, &pass_layout, gbuffer, source);
 
         let Buffers {
             params,

@@ -38,7 +38,11 @@ fn surface_at(pix: vec2<u32>) -> Surface {
 // The same surface read back from the split buffers (written by split_main this frame): the
 // filter's taps, without rebuilding each tap's position from depth.
 fn split_surface_at(pix: vec2<u32>) -> Surface {
-    let s = split_texel_of_pixel(pix.x, pix.y);
+    return split_surface_at_texel(split_texel_of_pixel(pix.x, pix.y));
+}
+
+// The surface at split texel `s`.
+fn split_surface_at_texel(s: vec2<u32>) -> Surface {
     let i = split_index(s.x, s.y);
     let p = split_position[i];
     var out: Surface;
@@ -95,17 +99,36 @@ fn filter_main(@builtin(global_invocation_id) id: vec3<u32>) {
         let origin = vec2<u32>(clamp(vec2<i32>(pix) - tiles / 2, vec2<i32>(0), max(size - tiles, vec2<i32>(0))));
         let alpha = interleave.thresholds.x;
         let beta = interleave.thresholds.y;
+        // The box spans n×m consecutive pixels, so the taps' split texels
+        // (split_texel_of_pixel: (t % n) · tile_size + t / n) follow from the origin's quotient
+        // and remainder without a division per tap: the remainder steps by one and wraps once.
+        let n = interleave.tiles;
+        let quotient = origin / n;
+        let remainder = origin % n;
         var accum = vec3<f32>(0.0);
         var count = 0.0;
-        for (var y = 0u; y < interleave.tiles.y; y += 1u) {
-            for (var x = 0u; x < interleave.tiles.x; x += 1u) {
+        for (var y = 0u; y < n.y; y += 1u) {
+            var ry = remainder.y + y;
+            var qy = quotient.y;
+            if (ry >= n.y) {
+                ry -= n.y;
+                qy += 1u;
+            }
+            for (var x = 0u; x < n.x; x += 1u) {
+                var rx = remainder.x + x;
+                var qx = quotient.x;
+                if (rx >= n.x) {
+                    rx -= n.x;
+                    qx += 1u;
+                }
                 let t = origin + vec2<u32>(x, y);
                 if (any(t >= full)) {
                     continue;
                 }
                 var take = all(t == pix);
                 if (!take) {
-                    let s = split_surface_at(t);
+                    let split = vec2<u32>(rx, ry) * interleave.tile_size + vec2<u32>(qx, qy);
+                    let s = split_surface_at_texel(split);
                     take = s.hit && length(s.position - centre.position) < alpha
                         && dot(s.normal, centre.normal) > beta;
                 }
