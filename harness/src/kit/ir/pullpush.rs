@@ -117,12 +117,14 @@ impl PullPushSettings {
     }
 }
 
-/// One dispatch: its pipeline, bind group and the texels of a map at its level.
+/// One dispatch: its pipeline, bind group and the edge of a map at its level.
 struct Pass {
     pipeline: usize,
     group: wgpu::BindGroup,
     _params: wgpu::Buffer,
-    texels: u32,
+    /// The edge of the level it writes: one invocation per texel of every map (8x8 groups,
+    /// the map's slot in z).
+    edge: u32,
 }
 
 /// The pull-push passes (see the module docs).
@@ -238,7 +240,7 @@ impl PullPush {
                 pipeline: kind,
                 group,
                 _params: params,
-                texels: s * s,
+                edge: s,
             }
         };
         let mut passes = Vec::new();
@@ -293,7 +295,8 @@ impl PullPush {
         for p in &self.passes {
             pass.set_pipeline(&self.pipelines[p.pipeline]);
             pass.set_bind_group(0, &p.group, &[]);
-            pass.dispatch_workgroups(p.texels.div_ceil(64), self.slots, 1);
+            let groups = p.edge.div_ceil(8);
+            pass.dispatch_workgroups(groups, groups, self.slots);
         }
     }
 }

@@ -41,15 +41,15 @@ fn texel(offset: u32, slot: u32, x: u32, y: u32, size: u32) -> vec2<f32> {
 }
 
 // Level `counts.x` (>= 1) from level `counts.x - 1`.
-@compute @workgroup_size(64)
+@compute @workgroup_size(8, 8)
 fn pull(@builtin(global_invocation_id) id: vec3<u32>) {
     let size = pp.counts.y;
-    let slot = id.y;
-    if (id.x >= size * size || slot >= pp.counts.z) {
+    let x = id.x;
+    let y = id.y;
+    let slot = id.z;
+    if (x >= size || y >= size || slot >= pp.counts.z) {
         return;
     }
-    let x = id.x % size;
-    let y = id.x / size;
     var children: array<vec2<f32>, 4>;
     var front = 0.0;
     for (var k = 0u; k < 4u; k = k + 1u) {
@@ -83,15 +83,15 @@ fn pull(@builtin(global_invocation_id) id: vec3<u32>) {
 }
 
 // Level `counts.x` (>= 1, below the top) completed from its parent level (already pushed).
-@compute @workgroup_size(64)
+@compute @workgroup_size(8, 8)
 fn push(@builtin(global_invocation_id) id: vec3<u32>) {
     let size = pp.counts.y;
-    let slot = id.y;
-    if (id.x >= size * size || slot >= pp.counts.z) {
+    let x = id.x;
+    let y = id.y;
+    let slot = id.z;
+    if (x >= size || y >= size || slot >= pp.counts.z) {
         return;
     }
-    let x = id.x % size;
-    let y = id.x / size;
     let i = pp.offsets.x + (slot * size + y) * size + x;
     let t = pyramid[i];
     let parent = texel(pp.offsets.y, slot, x / 2u, y / 2u, size / 2u);

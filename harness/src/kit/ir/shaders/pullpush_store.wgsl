@@ -7,15 +7,15 @@
 
 @group(0) @binding(3) var atlas_out: texture_storage_2d<r32float, write>;
 
-@compute @workgroup_size(64)
+@compute @workgroup_size(8, 8)
 fn store(@builtin(global_invocation_id) id: vec3<u32>) {
     let size = pp.counts.y;
-    let slot = id.y;
-    if (id.x >= size * size || slot >= pp.counts.z) {
+    let x = id.x;
+    let y = id.y;
+    let slot = id.z;
+    if (x >= size || y >= size || slot >= pp.counts.z) {
         return;
     }
-    let x = id.x % size;
-    let y = id.x / size;
     var v = level0(slot, x, y, size);
     if (pp.offsets.y != 0xffffffffu) {
         let parent = texel(pp.offsets.y, slot, x / 2u, y / 2u, size / 2u);
