@@ -8,6 +8,7 @@
 #   bash results/regenerate.sh baseline   # only CI's baseline (instruction counts, timing)
 #   bash results/regenerate.sh barczak-scenes  # only barczak on Sibenik, Sponza, Maze and the conference room
 #   bash results/regenerate.sh roofline        # only the stage-efficiency runs (docs/roofline.md)
+#   bash results/regenerate.sh lean            # only the lean stages' before/after (results/lean)
 #
 # Paper-size runs (`gibench reproduce all` without --quick) are for a GPU and are not part of
 # this script.
@@ -60,6 +61,7 @@ elif [ "$only" != baseline ]; then
   case "results/barczak-scenes/" in "results/$only"*) scenes_only=1 ;; *) scenes_only=0 ;; esac
   case "results/roofline/" in "results/$only"*) scenes_only=1 ;; esac
   case "results/ism/vpl-counts" in "results/$only"*) scenes_only=1 ;; esac
+  case "results/lean/" in "results/$only"*) scenes_only=1 ;; esac
   if [ -n "$targets" ]; then
     reproduce "$targets"
   elif [ "$transfer_only" = 0 ] && [ "$scenes_only" = 0 ]; then
@@ -99,4 +101,16 @@ run results/ism/vpl-counts-flat sweep --technique ism --sweep vpls=128,192,256,3
 # prints their roofline tables.
 run results/roofline/cornell run --frames 20 --warmup 3 --timing stages --no-images --quiet --out results/roofline/cornell
 run results/roofline/sibenik run --scene sibenik --technique gaitatzes --frames 5 --warmup 1 --timing stages --no-images --quiet --out results/roofline/sibenik
+# The lean stages (docs/roofline.md): the commit before that work (264d5f0) against this one,
+# five alternating repeats of the VPL techniques at 256x192 and 512x384, each commit built in a
+# worktree of its own (scripts/ab.sh). `submission` is barczak's parameter that work added.
+if [ -z "$only" ] || case "results/lean/" in "results/$only"*) true ;; *) false ;; esac; then
+  for res in 256x192 512x384; do
+    echo "== bash scripts/ab.sh 264d5f0 HEAD results/lean/$res"
+    rm -rf "results/lean/$res"
+    bash scripts/ab.sh 264d5f0 HEAD "results/lean/$res" --ignore-param submission -- \
+      --technique keller-full,keller-incremental,laine,ism,ism-classic,barczak --backend vulkan \
+      --resolution "$res" --frames 10 --warmup 3 --no-images
+  done
+fi
 echo "regenerate.sh: done"

@@ -10,8 +10,8 @@
 # five times with each binary, BEFORE and AFTER alternating (REPEATS=N for another count), into
 # OUT/before/rI and OUT/after/rI, and compares them with `gibench compare --statistic median`
 # (and COMPARE-OPTIONs, e.g. --ignore-param NAME) into OUT/compare.{md,csv,tex,json}. Each run
-# records the commit its binary was built from. OUT must not exist (nothing is overwritten);
-# OUT/command.txt holds the command line.
+# records the commit its binary was built from; of each repeat only its results files are kept.
+# OUT must not exist (nothing is overwritten); OUT/command.txt holds the command line.
 set -euo pipefail
 
 usage() {
@@ -72,6 +72,9 @@ for i in $(seq 1 "$repeats"); do
   for side in before after; do
     echo "== repeat $i of $repeats: $side" >&2
     "${bin[$side]}" run "$@" --out "$out/$side/r$i" --quiet >/dev/null
+    # The results files are what the comparison reads; each repeat's own tables and figures
+    # would only make the folder large.
+    find "$out/$side/r$i" -maxdepth 1 -type f ! -name '*.json' -delete
   done
 done
 "${bin[after]}" compare "$out/before" "$out/after" --statistic median "${compare_options[@]}" --out "$out"
