@@ -15,9 +15,10 @@
 //! Passes: elements, each a set of leaves with the lights they share (one per leaf, merged by
 //! Figure 4-10's optimiser when `optimise` is on; lights needing lookups and lights not needing
 //! them are separate elements); each element is drawn ⌈lights / K⌉ times, a pass handling up to
-//! K lights (the thesis' X800 had room for 7 per pass; K ≤ 16 here). Every vertex a pass emits
-//! names its leaf vertex and the pass's light record (read-only storage, portable to GL; the
-//! vertex shader pulls the leaf's vertex), so [`Submission::Merged`] submits all the passes of a
+//! K lights (the thesis' X800 had room for 7 per pass; K ≤ 16 here). Every triangle a pass emits
+//! names its leaf triangle's first vertex and the pass's light record (read-only storage,
+//! portable to GL; the vertex shader pulls the leaf's vertices), so [`Submission::Merged`]
+//! submits all the passes of a
 //! render pass as one draw, in the passes' order (blending keeps it): the same triangles, the
 //! same lights per fragment, without the thesis' per-pass draw cost, which on a CPU rasteriser
 //! is most of the stage (docs/roofline.md); [`Submission::Passes`] issues one draw per pass.
@@ -31,7 +32,8 @@ use gibench_harness::gpu::GpuContext;
 use gibench_harness::kit::ir::atlas::ShadowAtlas;
 use gibench_harness::kit::ir::store::VplStore;
 use gibench_harness::kit::passes::{
-    dynamic_storage_entry, shader_module, Bindings, Bound, FrameUniforms, GBuffer, CAMERA_SLOT,
+    dynamic_storage_entry, read_storage_entry, shader_module, Bindings, Bound, FrameUniforms,
+    GBuffer, CAMERA_SLOT,
 };
 use gibench_harness::{wgpu, Error, Result};
 
@@ -118,7 +120,7 @@ pub struct LightDraws {
     k: u32,
     submission: Submission,
     leaves: Arc<Leaves>,
-    /// Per emitted vertex: its leaf vertex and its pass's record.
+    /// Per emitted triangle: its leaf triangle's first vertex and its pass's record.
     emitted: wgpu::Buffer,
     records: wgpu::Buffer,
     /// Draws the buffers hold at most.
@@ -134,7 +136,7 @@ pub struct LightDraws {
     /// The CPU copies of the emitted-vertex and record uploads, reused frame to frame.
     scratch_emitted: Vec<[u32; 2]>,
     scratch_records: Vec<DrawLights>,
-    /// This frame's passes: each one's emitted vertices.
+    /// This frame's passes: each one's emitted vertices (three per emitted triangle).
     draws: Vec<Range<u32>>,
     /// Elements of the last plan (for the results: passes made).
     elements: usize,
@@ -258,10 +260,10 @@ impl LightDraws {
                     };
                     rec.lights[..chunk.len()].copy_from_slice(chunk);
                     let record = self.draws.len() as u32;
-                    let start = emitted.len() as u32;
+                    let start = 3 * emitted.len() as u32;
                     for &tile in &e.objects {
                         let vertices = self.leaves.ranges[tile as usize].clone();
-                        emitted.extend(vertices.map(|v| [v, record]));
+                        emitted.extend(vertices.step_by(3).map(|v| [v, record]));
                     }
                     if record >= self.max_draws || emitted.len() as u64 * 8 > self.emitted.size() {
                         return Err(Error::Invalid(format!(
@@ -270,7 +272,7 @@ impl LightDraws {
                         )));
                     }
                     records.push(rec);
-                    self.draws.push(start..emitted.len() as u32);
+                    self.draws.push(start..3 * emitted.len() as u32);
                 }
             }
         }
@@ -405,7 +407,7 @@ impl LightDraws {
 /// The emitted vertices and the per-pass light records, sized once for the most any level
 /// plans for `lights` lights over `leaves`, `k` per pass; and that many passes. Refused when
 /// the larger would not fit the device's largest storage binding. (Every (leaf, light) pair is
-/// in one pass, so the passes emit at most each leaf's vertices once per light.)
+/// in one pass, so the passes emit at most each leaf's triangles once per light.)
 fn draw_buffers(
     gpu: &GpuContext,
     leaves: &Leaves,
@@ -414,10 +416,7 @@ fn draw_buffers(
 ) -> Result<(wgpu::Buffer, wgpu::Buffer, u32)> {
     let device = &gpu.device;
     let tiles = leaves.tiles.len() as u64;
-    // The most any level plans without merging: every leaf, every light, split in two groups
-    // (VD: one more partial draw per leaf at most).
-    let max_draws = (tiles * (lights.div_ceil(k) as u64 + 1)).max(1);
-    let max_emitted = (leaves.vertex_count() as u64 * lights as u64).max(1);
+    let (max_draws, max_emitted) = draw_capacity(tiles, leaves.vertex_count() as u64, lights, k);
     let limits = gpu.device.limits();
     let limit = limits
         .max_buffer_size
@@ -425,7 +424,7 @@ fn draw_buffers(
     let need = (max_emitted * 8).max(max_draws * LIGHTS_STRIDE);
     if need > limit {
         return Err(Error::Invalid(format!(
-            "barczak's light draws would need a {} MB buffer ({} leaves, {} of their vertices, {lights} light samples), more than this device's largest ({} MB); use fewer samples (vpls) or a scene with fewer patches (max-charts)",
+            "barczak's light draws would need a {} MB buffer ({} leaves, {} of their vertices, {lights} light samples), more than this device binds ({} MB); use fewer samples (vpls) or a scene with fewer patches (max-charts)",
             need >> 20,
             tiles,
             leaves.vertex_count(),
@@ -443,6 +442,16 @@ fn draw_buffers(
     let emitted = storage("barczak emitted vertices", max_emitted * 8);
     let records = storage("barczak pass lights", max_draws * LIGHTS_STRIDE);
     Ok((emitted, records, max_draws as u32))
+}
+
+/// The passes and the emitted triangles the draws are sized for over `tiles` leaves of
+/// `vertices` vertices (triangle lists), `lights` lights, `k` per pass: the most any level
+/// plans without merging, every leaf and every light, split in two groups (VD: one more pass
+/// per leaf at most); and each leaf's triangles once per light.
+fn draw_capacity(tiles: u64, vertices: u64, lights: u32, k: u32) -> (u64, u64) {
+    let max_draws = (tiles * (lights.div_ceil(k) as u64 + 1)).max(1);
+    let max_emitted = (vertices / 3 * lights as u64).max(1);
+    (max_draws, max_emitted)
 }
 
 /// The two raster entries, a record apart: full resolution, then the low-resolution pass's
@@ -484,12 +493,16 @@ fn store_bind_group(
         offset: 0,
         size: wgpu::BufferSize::new(raster_size),
     });
-    Bindings::new("barczak lights", wgpu::ShaderStages::VERTEX_FRAGMENT)
-        .read(lights)
-        .read(records)
+    // Each binding visible to the stage that reads it: three storage buffers a stage, within
+    // the downlevel limit of four.
+    use wgpu::ShaderStages as S;
+    let read_in = |stage: S| move |b, _| read_storage_entry(b, stage);
+    Bindings::new("barczak lights", S::VERTEX_FRAGMENT)
+        .with(read_in(S::FRAGMENT), lights.as_entire_binding())
+        .with(read_in(S::FRAGMENT), records.as_entire_binding())
         .with(|b, v| dynamic_storage_entry(b, v, raster_size), raster_slot)
-        .read(emitted)
-        .read(leaves)
+        .with(read_in(S::VERTEX), emitted.as_entire_binding())
+        .with(read_in(S::VERTEX), leaves.as_entire_binding())
         .build(device)
 }
 
@@ -559,4 +572,21 @@ fn pipelines(
             pipeline("fs_add", Add, edges()),
         ],
     ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Sibenik's charts (29,927 leaves, 373,068 of their vertices at the defaults) with 64
+    /// lights fit the 128 MB a device binds by default (wgpu's default
+    /// `max_storage_buffer_binding_size`). Catches an emitted record per vertex (8 bytes a
+    /// vertex: 191 MB, refused) where one per triangle suffices (64 MB).
+    #[test]
+    fn sibenik_at_64_lights_fits_a_default_storage_binding() {
+        let (draws, emitted) = draw_capacity(29_927, 373_068, 64, 7);
+        let need = (emitted * 8).max(draws * LIGHTS_STRIDE);
+        let limit = wgpu::Limits::default().max_storage_buffer_binding_size;
+        assert!(need <= limit, "{need} bytes over {limit}");
+    }
 }

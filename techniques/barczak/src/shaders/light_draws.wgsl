@@ -1,7 +1,8 @@
 // Barczak 2006 §4.3.2–4.3.5: lights drawn over patch leaves, up to K per pass. Each pass covers
-// the leaves of one element and up to K lights; every vertex the draws emit names its leaf
-// vertex and its pass's light record (`emitted`), so that one draw can hold many passes (each
-// triangle shaded with its own pass's lights, blended in the order of the passes).
+// the leaves of one element and up to K lights; every triangle the draws emit names its leaf
+// triangle's first vertex and its pass's light record (`emitted`), so that one draw can hold
+// many passes (each triangle shaded with its own pass's lights, blended in the order of the
+// passes).
 // `fs_subtract` (after the light-map pass, blended with ReverseSubtract) sums the contributions
 // of the lights its shadow maps find occluded; `fs_add` (blended with Add) sums every light's
 // contribution, times its shadow-map visibility where the light's entry asks for a lookup (high
@@ -33,7 +34,7 @@ struct Raster {
 };
 @group(2) @binding(2) var<storage, read> raster: Raster;
 
-// Per emitted vertex: x the leaf vertex, y its pass's record.
+// Per emitted triangle: x its leaf triangle's first vertex, y its pass's record.
 @group(2) @binding(3) var<storage, read> emitted: array<vec2<u32>>;
 // The leaves' vertices (lightmap_pass.rs `LeafVertex`, nine words each): position, tile,
 // normal, (s, t).
@@ -54,13 +55,14 @@ fn leaf_vec3(vertex: u32, word: u32) -> vec3<f32> {
 
 @vertex
 fn vs_leaf(@builtin(vertex_index) index: u32) -> LeafOut {
-    let e = emitted[index];
-    let position = leaf_vec3(e.x, 0u);
+    let e = emitted[index / 3u];
+    let vertex = e.x + index % 3u;
+    let position = leaf_vec3(vertex, 0u);
     var out: LeafOut;
     out.clip = camera.view_proj * vec4<f32>(position, 1.0);
     out.clip = vec4<f32>(out.clip.xy + raster.ndc.xy * out.clip.w, out.clip.zw);
     out.world = position;
-    out.normal = leaf_vec3(e.x, 4u);
+    out.normal = leaf_vec3(vertex, 4u);
     out.record = e.y;
     return out;
 }
