@@ -6,7 +6,9 @@
 #[path = "harness/src/run/commit.rs"]
 mod commit;
 
+use std::collections::BTreeSet;
 use std::path::Path;
+use std::process::Command;
 
 fn main() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
@@ -14,20 +16,40 @@ fn main() {
         "cargo:rustc-env=GIBENCH_GIT_COMMIT={}",
         commit::describe(root)
     );
-    // Stamp again when the commit or any tracked source could change the answer: a commit or a
-    // checkout (git's HEAD and index), and an edit anywhere but the build and results folders
-    // (which `describe` does not count as a code change).
-    let git = root.join(".git");
-    if git.is_dir() {
-        for file in ["HEAD", "index"] {
-            println!("cargo:rerun-if-changed=.git/{file}");
+    let git = |args: &[&str]| {
+        Command::new("git")
+            .arg("-C")
+            .arg(root)
+            .args(args)
+            .output()
+            .ok()
+            .filter(|o| o.status.success())
+            .map(|o| String::from_utf8_lossy(&o.stdout).into_owned())
+    };
+    // Stamp again when the commit could change: HEAD's log records every move of HEAD (a
+    // commit, an amend, a reset, a checkout), the index every staging; found through git so
+    // that a worktree (where `.git` is a file) watches its own. A path that does not exist is
+    // left out (cargo would rerun the script on every build).
+    for file in ["logs/HEAD", "HEAD", "index"] {
+        if let Some(path) = git(&["rev-parse", "--git-path", file]) {
+            // Relative to `root` (git's answer for `-C root`), or absolute (a worktree's).
+            let path = root.join(path.trim());
+            if path.exists() {
+                println!("cargo:rerun-if-changed={}", path.display());
+            }
         }
     }
-    let entries = std::fs::read_dir(root).expect("the package's folder is readable");
-    for entry in entries.flatten() {
-        let name = entry.file_name().to_string_lossy().into_owned();
-        if !matches!(name.as_str(), ".git" | "target" | "results") {
-            println!("cargo:rerun-if-changed={name}");
-        }
+    // And when a tracked file changes outside the build and results folders (which `describe`
+    // does not count as a code change): the top-level entries git tracks.
+    let Some(tracked) = git(&["ls-files"]) else {
+        return;
+    };
+    let top: BTreeSet<&str> = tracked
+        .lines()
+        .filter_map(|path| path.split('/').next())
+        .filter(|name| !matches!(*name, "results" | "target"))
+        .collect();
+    for name in top {
+        println!("cargo:rerun-if-changed={name}");
     }
 }

@@ -38,6 +38,7 @@ repeats=${REPEATS:-5}
 for arg in "$@"; do
   case $arg in
     --out | --out=*) usage "the run arguments name --out; scripts/ab.sh chooses each run's folder" ;;
+    --quiet) usage "the run arguments name --quiet; scripts/ab.sh passes it to every run" ;;
   esac
 done
 
@@ -52,10 +53,18 @@ done
 # Both binaries first: a build failing after half the runs would leave half a measurement.
 ab="$root/target/ab"
 mkdir -p "$ab"
+# Forget worktrees whose folders are gone (`cargo clean` removes target/ab).
+git -C "$root" worktree prune
 declare -A bin
 for side in before after; do
   c=${commit[$side]}
   tree="$ab/tree-${c:0:12}"
+  # A kept tree is used only while it is still that commit, unchanged; else made again.
+  if [ -d "$tree" ] && { [ "$(git -C "$tree" rev-parse HEAD 2>/dev/null)" != "$c" ] ||
+    [ -n "$(git -C "$tree" status --porcelain --untracked-files=no 2>/dev/null)" ]; }; then
+    git -C "$root" worktree remove --force "$tree" 2>/dev/null || rm -rf "$tree"
+    git -C "$root" worktree prune
+  fi
   if [ ! -d "$tree" ]; then
     git -C "$root" worktree add --detach --quiet "$tree" "$c"
   fi
@@ -66,7 +75,7 @@ done
 
 mkdir -p "$out"
 printf 'bash scripts/ab.sh %s %s %s' "$before" "$after" "$out" >"$out/command.txt"
-printf ' %q' "${compare_options[@]}" -- "$@" >>"$out/command.txt"
+printf ' %q' ${compare_options[@]+"${compare_options[@]}"} -- "$@" >>"$out/command.txt"
 printf '\n# before = %s, after = %s, %s repeats\n' "${commit[before]}" "${commit[after]}" "$repeats" >>"$out/command.txt"
 for i in $(seq 1 "$repeats"); do
   for side in before after; do
@@ -77,4 +86,5 @@ for i in $(seq 1 "$repeats"); do
     find "$out/$side/r$i" -maxdepth 1 -type f ! -name '*.json' -delete
   done
 done
-"${bin[after]}" compare "$out/before" "$out/after" --statistic median "${compare_options[@]}" --out "$out"
+"${bin[after]}" compare "$out/before" "$out/after" --statistic median \
+  ${compare_options[@]+"${compare_options[@]}"} --out "$out"

@@ -396,22 +396,31 @@ fn a_run_on_one_side_only_is_listed_and_fails_require_all() {
     );
     assert!(!out.exists(), "nothing is written when --require-all fails");
 
-    // `--ignore-param gained`: the gained runs match BASE's (CURRENT then holds ten repeats of
-    // the one run), nothing is left unmatched, and the notes say which parameter was ignored;
-    // a name no run has is refused, naming it. Catches the option changing nothing (the
-    // require-all failure above again) and a misspelt name passing silently.
-    let (ok, rows, stderr) = compare_with(
-        dir,
-        "base",
-        "current",
-        &["--require-all", "--ignore-param", "gained"],
-    );
+    // `--ignore-param gained`: a side whose runs all set it (`gained`, the gained runs alone)
+    // matches BASE's, nothing left unmatched, and the notes say which parameter was ignored;
+    // a side holding the run with and without it (`current`) is refused rather than mixed
+    // into one run; a name no run has is refused, naming it. Catches the option changing
+    // nothing (the require-all failure above again), two settings pooled as repeats of one,
+    // and a misspelt name passing silently.
+    for i in 0..current.len() {
+        let d = dir.join(format!("gained/r{i}"));
+        std::fs::create_dir_all(&d).unwrap();
+        std::fs::copy(
+            dir.join(format!("current/r{i}/cornell-direct-gained.json")),
+            d.join("cornell-direct.json"),
+        )
+        .unwrap();
+    }
+    let ignore = ["--require-all", "--ignore-param", "gained"];
+    let (ok, rows, stderr) = compare_with(dir, "base", "gained", &ignore);
     assert!(ok, "{stderr}");
     assert_eq!(rows.len(), STAGES.len(), "{rows:?}");
     assert!(!stderr.contains("only in CURRENT"), "{stderr}");
-    let md = std::fs::read_to_string(dir.join("cmp-base-current/compare.md")).unwrap();
+    let md = std::fs::read_to_string(dir.join("cmp-base-gained/compare.md")).unwrap();
     assert!(md.contains("as if they did not set gained"), "{md}");
-    let (ok, _, stderr) = compare_with(dir, "base", "current", &["--ignore-param", "gainde"]);
+    let (ok, _, stderr) = compare_with(dir, "base", "current", &ignore);
+    assert!(!ok && stderr.contains("would be one run"), "{stderr}");
+    let (ok, _, stderr) = compare_with(dir, "base", "gained", &["--ignore-param", "gainde"]);
     assert!(
         !ok && stderr.contains("ignore-param") && stderr.contains("'gainde'"),
         "{stderr}"

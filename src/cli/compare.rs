@@ -5,6 +5,7 @@
 //! summary instead of the terminal table; `--fail-on slower` makes a regression exit with
 //! [`CHANGE_STATUS`] (3), for runners whose timings can be trusted to gate a change.
 
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -12,7 +13,7 @@ use clap::Args;
 use gibench_harness::measure::results::RunResult;
 use gibench_harness::output::OutputSet;
 use gibench_harness::report;
-use gibench_harness::report::compare::{Statistic, Verdict};
+use gibench_harness::report::compare::{run_key, Statistic, Verdict};
 use gibench_harness::{Error, Result};
 
 use super::results_io::results_under;
@@ -111,10 +112,26 @@ fn ignore_params(names: &[String], sides: [&mut Vec<RunResult>; 2]) -> Result<Op
         return Ok(None);
     }
     let mut found = vec![false; names.len()];
-    for runs in sides {
+    for (side, runs) in ["BASE", "CURRENT"].into_iter().zip(sides) {
+        // Two runs of one side that differ only in an ignored parameter would become repeats
+        // of one run, their settings mixed: refused, naming both.
+        let mut before: BTreeMap<String, String> = BTreeMap::new();
         for r in runs.iter_mut() {
+            let key = run_key(r);
             for (name, found) in names.iter().zip(&mut found) {
                 *found |= r.parameters.remove(name).is_some();
+            }
+            let merged = run_key(r);
+            match before.get(&merged) {
+                Some(other) if *other != key => {
+                    return Err(Error::param(
+                        "ignore-param",
+                        format!("{side} holds {other} and {key}: with {} ignored they would be one run, their settings mixed; compare each setting apart", names.join(", ")),
+                    ));
+                }
+                _ => {
+                    before.insert(merged, key);
+                }
             }
         }
     }

@@ -421,7 +421,10 @@ fn draw_buffers(
     let limit = limits
         .max_buffer_size
         .min(limits.max_storage_buffer_binding_size);
-    let need = (max_emitted * 8).max(max_draws * LIGHTS_STRIDE);
+    // The leaves' vertices are bound too (pulled by the vertex shader).
+    let need = (max_emitted * 8)
+        .max(max_draws * LIGHTS_STRIDE)
+        .max(leaves.buffer().size());
     if need > limit {
         return Err(Error::Invalid(format!(
             "barczak's light draws would need a {} MB buffer ({} leaves, {} of their vertices, {lights} light samples), more than this device binds ({} MB); use fewer samples (vpls) or a scene with fewer patches (max-charts)",
