@@ -267,8 +267,9 @@ impl LightDraws {
                     }
                     if record >= self.max_draws || emitted.len() as u64 * 8 > self.emitted.size() {
                         return Err(Error::Invalid(format!(
-                            "barczak's light draws need more than the {} passes they were sized for",
-                            self.max_draws
+                            "barczak's light draws: this frame's plan needs more than the {} passes and {} triangles the device's bindings hold (the pass optimiser drew leaves in more passes than without it); use fewer samples (vpls) or level vd",
+                            self.max_draws,
+                            self.emitted.size() / 8
                         )));
                     }
                     records.push(rec);
@@ -416,21 +417,25 @@ fn draw_buffers(
 ) -> Result<(wgpu::Buffer, wgpu::Buffer, u32)> {
     let device = &gpu.device;
     let tiles = leaves.tiles.len() as u64;
-    let (max_draws, max_emitted) = draw_capacity(tiles, leaves.vertex_count() as u64, lights, k);
     let limits = gpu.device.limits();
     let limit = limits
         .max_buffer_size
         .min(limits.max_storage_buffer_binding_size);
-    // The leaves' vertices are bound too (pulled by the vertex shader).
-    let need = (max_emitted * 8)
-        .max(max_draws * LIGHTS_STRIDE)
-        .max(leaves.buffer().size());
-    if need > limit {
+    let capacity = draw_capacity(tiles, leaves.vertex_count() as u64, lights, k, limit);
+    let Some((max_draws, max_emitted)) = capacity else {
         return Err(Error::Invalid(format!(
-            "barczak's light draws would need a {} MB buffer ({} leaves, {} of their vertices, {lights} light samples), more than this device binds ({} MB); use fewer samples (vpls) or a scene with fewer patches (max-charts)",
-            need >> 20,
+            "barczak's light draws would need more than this device binds ({} MB) for {} leaves ({} of their vertices) and {lights} light samples; use fewer samples (vpls) or a scene with fewer patches (max-charts)",
+            limit >> 20,
             tiles,
             leaves.vertex_count(),
+        )));
+    };
+    // The leaves' vertices are bound too (pulled by the vertex shader).
+    if leaves.buffer().size() > limit {
+        return Err(Error::Invalid(format!(
+            "barczak's {} leaf vertices take {} MB, more than this device binds ({} MB); use a scene with fewer patches (max-charts)",
+            leaves.vertex_count(),
+            leaves.buffer().size() >> 20,
             limit >> 20
         )));
     }
@@ -448,13 +453,24 @@ fn draw_buffers(
 }
 
 /// The passes and the emitted triangles the draws are sized for over `tiles` leaves of
-/// `vertices` vertices (triangle lists), `lights` lights, `k` per pass: the most any level
-/// plans without merging, every leaf and every light, split in two groups (VD: one more pass
-/// per leaf at most); and each leaf's triangles once per light.
-fn draw_capacity(tiles: u64, vertices: u64, lights: u32, k: u32) -> (u64, u64) {
-    let max_draws = (tiles * (lights.div_ceil(k) as u64 + 1)).max(1);
-    let max_emitted = (vertices / 3 * lights as u64).max(1);
-    (max_draws, max_emitted)
+/// `vertices` vertices (triangle lists), `lights` lights, `k` per pass, within `limit` bytes a
+/// binding; `None` when even a plan without merging might not fit.
+///
+/// Passes: the most any level plans without merging, every leaf with every light, split in two
+/// groups (VD: one more pass per leaf at most); merging only ever removes passes. Emitted
+/// triangles: each leaf's triangles once per pass of it, so without merging at most those
+/// passes per leaf; a merged plan can draw a leaf in more passes (up to one per light: every
+/// (leaf, light) pair is in one pass), so the buffer holds up to that many where the device
+/// binds them, and a plan beyond what it holds is refused at plan time, naming the sizes.
+fn draw_capacity(tiles: u64, vertices: u64, lights: u32, k: u32, limit: u64) -> Option<(u64, u64)> {
+    let passes_per_leaf = lights.div_ceil(k) as u64 + 1;
+    let max_draws = (tiles * passes_per_leaf).max(1);
+    let triangles = vertices / 3;
+    let unmerged = (triangles * passes_per_leaf.min(lights as u64)).max(1);
+    let most = (triangles * lights as u64).max(1);
+    let max_emitted = most.min(limit / 8);
+    (max_draws * LIGHTS_STRIDE <= limit && unmerged <= max_emitted)
+        .then_some((max_draws, max_emitted))
 }
 
 /// The two raster entries, a record apart: full resolution, then the low-resolution pass's
@@ -581,15 +597,19 @@ fn pipelines(
 mod tests {
     use super::*;
 
-    /// Sibenik's charts (29,927 leaves, 373,068 of their vertices at the defaults) with 64
-    /// lights fit the 128 MB a device binds by default (wgpu's default
-    /// `max_storage_buffer_binding_size`). Catches an emitted record per vertex (8 bytes a
-    /// vertex: 191 MB, refused) where one per triangle suffices (64 MB).
+    /// Sibenik's charts (29,927 leaves, 373,068 of their vertices at the defaults) and the
+    /// conference room's with 64 lights fit the 128 MB a device binds by default (wgpu's
+    /// default `max_storage_buffer_binding_size`). Catches an emitted record per vertex (8
+    /// bytes a vertex: 191 MB on Sibenik, refused) where one per triangle suffices, and a
+    /// capacity that insists on the worst merged plan (236 MB on the conference room).
     #[test]
-    fn sibenik_at_64_lights_fits_a_default_storage_binding() {
-        let (draws, emitted) = draw_capacity(29_927, 373_068, 64, 7);
-        let need = (emitted * 8).max(draws * LIGHTS_STRIDE);
+    fn the_large_scenes_at_64_lights_fit_a_default_storage_binding() {
         let limit = wgpu::Limits::default().max_storage_buffer_binding_size;
-        assert!(need <= limit, "{need} bytes over {limit}");
+        assert!(draw_capacity(29_927, 373_068, 64, 7, limit).is_some());
+        // The conference room's 136,185 leaves (1,452,696 vertices): the worst merged plan
+        // would not fit, a plan without merging does.
+        let (draws, emitted) = draw_capacity(136_185, 1_452_696, 64, 7, limit).unwrap();
+        assert!(emitted * 8 <= limit && draws * LIGHTS_STRIDE <= limit);
+        assert!(emitted >= 1_452_696 / 3 * 11, "{emitted}");
     }
 }
