@@ -18,10 +18,9 @@
 //! K lights (the thesis' X800 had room for 7 per pass; K ≤ 16 here). Every triangle a pass emits
 //! names its leaf triangle's first vertex and the pass's light record (read-only storage,
 //! portable to GL; the vertex shader pulls the leaf's vertices), so [`Submission::Merged`]
-//! submits all the passes of a
-//! render pass as one draw, in the passes' order (blending keeps it): the same triangles, the
-//! same lights per fragment, without the thesis' per-pass draw cost, which on a CPU rasteriser
-//! is most of the stage (docs/roofline.md); [`Submission::Passes`] issues one draw per pass.
+//! submits all the passes of a render pass as one draw, in the passes' order (blending keeps
+//! it): the same triangles, the same lights per fragment, without the thesis' per-pass draw
+//! cost (docs/roofline.md); [`Submission::Passes`] issues one draw per pass.
 //! Buffers are sized once for the worst case (Naive without merging), so no frame allocates.
 
 use std::ops::Range;
@@ -133,7 +132,7 @@ pub struct LightDraws {
     _raster: wgpu::Buffer,
     /// The last plan's level.
     level: Level,
-    /// The CPU copies of the emitted-vertex and record uploads, reused frame to frame.
+    /// The CPU copies of the emitted-triangle and record uploads, reused frame to frame.
     scratch_emitted: Vec<[u32; 2]>,
     scratch_records: Vec<DrawLights>,
     /// This frame's passes: each one's emitted vertices (three per emitted triangle).
@@ -405,10 +404,9 @@ impl LightDraws {
     }
 }
 
-/// The emitted vertices and the per-pass light records, sized once for the most any level
-/// plans for `lights` lights over `leaves`, `k` per pass; and that many passes. Refused when
-/// the larger would not fit the device's largest storage binding. (Every (leaf, light) pair is
-/// in one pass, so the passes emit at most each leaf's triangles once per light.)
+/// The emitted triangles and the per-pass light records for `lights` lights over `leaves`, `k`
+/// per pass, sized once by [`draw_capacity`]; and the passes they hold. Refused when a plan
+/// without merging might not fit the device's storage binding, or the leaves' vertices do not.
 fn draw_buffers(
     gpu: &GpuContext,
     leaves: &Leaves,
@@ -447,7 +445,7 @@ fn draw_buffers(
             mapped_at_creation: false,
         })
     };
-    let emitted = storage("barczak emitted vertices", max_emitted * 8);
+    let emitted = storage("barczak emitted triangles", max_emitted * 8);
     let records = storage("barczak pass lights", max_draws * LIGHTS_STRIDE);
     Ok((emitted, records, max_draws as u32))
 }
