@@ -6,11 +6,29 @@
 #SBATCH --job-name=gibench
 #SBATCH --gres=gpu:1
 #SBATCH --time=02:00:00
+# Preempted, the task is requeued; SIGTERM (preemption, or 2 minutes before the time limit)
+# stops gibench politely with status 75, and the task requeues itself: the next start on the
+# same --out resumes from the targets complete (docs/fleet.md, "Preemption and resume").
+#SBATCH --requeue
+#SBATCH --signal=B:TERM@120
 set -euo pipefail
 cd "${SLURM_SUBMIT_DIR:-.}"
 OUT=${GIBENCH_FLEET_OUT:-results/fleet}
 if [ "${1:-}" = merge ]; then
     exec cargo run --release -- merge "$OUT"/shard-* --out "$OUT/merged"
 fi
-exec cargo run --release -- reproduce all ${GIBENCH_QUICK:+--quick} --quiet \
-    --out "$OUT/shard-${SLURM_ARRAY_TASK_ID}"
+cargo build --release --quiet
+target/release/gibench reproduce all ${GIBENCH_QUICK:+--quick} --quiet \
+    --out "$OUT/shard-${SLURM_ARRAY_TASK_ID}" &
+pid=$!
+# --signal=B: signals this shell only: pass SIGTERM on to gibench and wait for its status.
+stopping=
+trap 'stopping=1; kill -TERM "$pid" 2>/dev/null' TERM INT
+rc=0
+wait "$pid" || rc=$?
+# A trapped signal ends the first wait early: wait again for gibench's own status.
+if [ -n "$stopping" ]; then rc=0; wait "$pid" || rc=$?; fi
+if [ "$rc" = 75 ]; then
+    scontrol requeue "$SLURM_JOB_ID"
+fi
+exit "$rc"

@@ -82,6 +82,14 @@ fn main() -> ExitCode {
     gibench_harness::run::runner::set_build_commit(env!("GIBENCH_GIT_COMMIT"));
     gibench_harness::cpu::threads::join_global_pool();
     let cli = Cli::parse();
+    // The commands whose frame loops stop politely on SIGTERM / SIGINT (the others keep the
+    // signals' default action: they have no point to stop at).
+    if matches!(
+        cli.command,
+        None | Some(Command::Run(_) | Command::Sweep(_) | Command::Reproduce(_))
+    ) {
+        gibench_harness::interrupt::install();
+    }
     let outcome = match cli.command {
         None => gibench_papers::run::exec(&RunArgs::parse_default()),
         Some(Command::Run(args)) => gibench_papers::run::exec(&args),
@@ -106,7 +114,13 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e}");
-            ExitCode::FAILURE
+            match e {
+                // Stopped by SIGTERM or SIGINT: what completed is kept; run again to go on.
+                gibench_harness::Error::Interrupted { .. } => {
+                    ExitCode::from(gibench_harness::interrupt::EXIT_STATUS)
+                }
+                _ => ExitCode::FAILURE,
+            }
         }
     }
 }

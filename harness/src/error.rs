@@ -29,6 +29,9 @@ pub enum Error {
         #[source]
         source: std::io::Error,
     },
+    /// SIGTERM or SIGINT arrived ([`crate::interrupt`]): the command stopped at `at`.
+    #[error("stopped by {signal} at {at}")]
+    Interrupted { signal: &'static str, at: String },
 }
 
 /// Result with the harness [`Error`].

@@ -3,7 +3,8 @@
 //! Everything the techniques share, written once, in folders by concern. Each folder uses only
 //! the ones above it in this list (`harness/tests/it/layers.rs` checks it):
 //!
-//! * [`error`], [`output`] and [`rng`]: errors; atomic files and output sets; random numbers;
+//! * [`error`], [`interrupt`], [`output`] and [`rng`]: errors; polite stops (SIGTERM, SIGINT);
+//!   atomic files and output sets; random numbers;
 //! * [`measure`]: statistics, image metrics, the timer calibration, the results file model,
 //!   the roofline's costs and bounds;
 //! * [`scene`]: the scene model and its loaders, the asset search path, the animation clock;
@@ -36,6 +37,7 @@
 pub mod cpu;
 pub mod error;
 pub mod gpu;
+pub mod interrupt;
 pub mod kit;
 pub mod measure;
 pub mod output;

@@ -23,7 +23,7 @@ const SHARD_VARS: &[&str] = &[
 
 /// `gibench reproduce all --quick --quiet --only ONLY --out OUT` at the tiny test size, with
 /// `vars` as its job system's environment, started (not waited for).
-fn start(only: &str, out: &Path, vars: &[(&str, String)]) -> Child {
+pub(crate) fn start(only: &str, out: &Path, vars: &[(&str, String)]) -> Child {
     let mut c: Command = support::GIBENCH.command();
     for v in SHARD_VARS {
         c.env_remove(v);
@@ -53,7 +53,7 @@ fn finish(child: Child, what: &str) -> String {
     stderr
 }
 
-fn manifest(dir: &Path) -> serde_json::Value {
+pub(crate) fn manifest(dir: &Path) -> serde_json::Value {
     serde_json::from_slice(&std::fs::read(dir.join("reproduce-all.json")).unwrap()).unwrap()
 }
 
@@ -141,7 +141,7 @@ fn files_by_target(m: &serde_json::Value) -> BTreeMap<String, Vec<String>> {
 
 /// `merged` holds what `single` holds: the same targets with the same files, every results
 /// JSON equal but for timings, every Markdown table equal but for its numbers.
-fn assert_same_tables(single: &Path, merged: &Path) {
+pub(crate) fn assert_same_tables(single: &Path, merged: &Path) {
     let (a, b) = (manifest(single), manifest(merged));
     assert_eq!(a["mode"], b["mode"]);
     assert_eq!(

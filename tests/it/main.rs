@@ -28,6 +28,7 @@ mod raycast;
 mod readme_examples;
 mod report;
 mod reproduce;
+mod resume;
 mod roofline;
 mod run;
 mod src_layers;

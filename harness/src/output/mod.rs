@@ -68,6 +68,9 @@ pub struct Mark {
     patterns: usize,
 }
 
+/// What [`OutputSet::resume`] asks: given the files staged there, which to take over.
+pub type Keep<'a> = dyn FnMut(&[PathBuf]) -> Vec<PathBuf> + 'a;
+
 /// An open output set (see the module docs). Publish it on success; dropping it unpublished
 /// discards what was staged.
 pub struct OutputSet {
@@ -75,6 +78,8 @@ pub struct OutputSet {
     dir: PathBuf,
     option: String,
     published: bool,
+    /// Closed by [`OutputSet::suspend`]: the staging folder stays for [`OutputSet::resume`].
+    suspended: bool,
     /// The folders `begin` created, deepest first (an unpublished set removes them if empty).
     created: Vec<PathBuf>,
     /// Held until the set is closed.
@@ -238,6 +243,19 @@ impl OutputSet {
     /// Opens the set on `dir` (created if needed); `option` names the command-line option in
     /// errors (`out`).
     pub fn begin(option: &str, dir: &Path) -> Result<OutputSet> {
+        Self::open(option, dir, None)
+    }
+
+    /// [`OutputSet::begin`], resuming a set that was killed or [suspended](OutputSet::suspend)
+    /// before publishing: once the folder's lock is held, `keep` is given the files that set
+    /// staged (relative to the folder) and says which to take over, as if this set had written
+    /// them; the other staged files are removed. `keep` is not called when nothing is staged
+    /// there.
+    pub fn resume(option: &str, dir: &Path, keep: &mut Keep) -> Result<OutputSet> {
+        Self::open(option, dir, Some(keep))
+    }
+
+    fn open(option: &str, dir: &Path, keep: Option<&mut Keep>) -> Result<OutputSet> {
         let fail = |what: String| Error::param(option, what);
         if ACTIVE.lock().map(|a| a.is_some()).unwrap_or(true) {
             return Err(fail("another output set is open in this process".into()));
@@ -267,10 +285,11 @@ impl OutputSet {
             dir: dir.to_path_buf(),
             option: option.to_string(),
             published: false,
+            suspended: false,
             created,
             lock: Some(lock),
         };
-        recover(dir)?;
+        let kept = recover(dir, keep)?;
         let staging = dir.join(STAGING);
         std::fs::create_dir_all(&staging).map_err(|e| Error::io(&staging, e))?;
         let mut active = ACTIVE
@@ -279,7 +298,7 @@ impl OutputSet {
         *active = Some(Active {
             dir: dir.to_path_buf(),
             given: absolute(&given),
-            staged: Vec::new(),
+            staged: kept,
             replaced: Vec::new(),
             patterns: Vec::new(),
         });
@@ -411,10 +430,23 @@ impl OutputSet {
         Ok(())
     }
 
-    /// Removes the staging folder, the journal and the lock (and, unpublished, the folder
-    /// itself if this set created it and it is empty).
+    /// Closes the set unpublished but keeps what it staged, for a later
+    /// [`OutputSet::resume`] (a command stopped by a signal). Until then the folder shows what
+    /// it showed before; a later [`OutputSet::begin`] discards the staged files.
+    pub fn suspend(mut self) {
+        if let Ok(mut active) = ACTIVE.lock() {
+            *active = None;
+        }
+        self.suspended = true;
+        self.close();
+    }
+
+    /// Removes the staging folder (unless suspended), the journal and the lock (and,
+    /// unpublished, the folder itself if this set created it and it is empty).
     fn close(&mut self) {
-        let _ = std::fs::remove_dir_all(self.dir.join(STAGING));
+        if !self.suspended {
+            let _ = std::fs::remove_dir_all(self.dir.join(STAGING));
+        }
         let _ = std::fs::remove_file(self.dir.join(JOURNAL));
         if let Some(lock) = self.lock.take() {
             lock.release();
@@ -429,7 +461,7 @@ impl OutputSet {
 
 impl Drop for OutputSet {
     fn drop(&mut self) {
-        if !self.published {
+        if !self.published && !self.suspended {
             if let Ok(mut active) = ACTIVE.lock() {
                 *active = None;
             }
@@ -589,22 +621,58 @@ fn remove_unlisted_matching(
 }
 
 /// Finishes a publication a killed run left half done, then removes its staging folder and
-/// journal.
-fn recover(dir: &Path) -> Result<()> {
-    if dir.join(JOURNAL).exists() {
+/// journal — or, with `keep` and no publication to finish, keeps the staged files `keep`
+/// names (those that are there) and removes the rest. Returns the files kept.
+fn recover(dir: &Path, keep: Option<&mut Keep>) -> Result<Vec<PathBuf>> {
+    let journal = dir.join(JOURNAL);
+    let finishing = journal.exists();
+    if finishing {
         move_staged(dir)?;
     }
     let staging = dir.join(STAGING);
-    if staging.is_dir() {
-        std::fs::remove_dir_all(&staging).map_err(|e| Error::io(&staging, e))?;
-    } else if staging.exists() {
-        std::fs::remove_file(&staging).map_err(|e| Error::io(&staging, e))?;
+    let mut kept = Vec::new();
+    match keep {
+        Some(keep) if !finishing && staging.is_dir() => {
+            let mut present = Vec::new();
+            files_below(&staging, Path::new(""), &mut present);
+            let wanted = keep(&present);
+            for rel in &present {
+                if !wanted.contains(rel) {
+                    let f = staging.join(rel);
+                    std::fs::remove_file(&f).map_err(|e| Error::io(&f, e))?;
+                }
+            }
+            kept = (wanted.into_iter())
+                .filter(|w| present.contains(w))
+                .collect();
+        }
+        _ if staging.is_dir() => {
+            std::fs::remove_dir_all(&staging).map_err(|e| Error::io(&staging, e))?
+        }
+        _ if staging.exists() => {
+            std::fs::remove_file(&staging).map_err(|e| Error::io(&staging, e))?
+        }
+        _ => {}
     }
-    let journal = dir.join(JOURNAL);
     if journal.exists() {
         std::fs::remove_file(&journal).map_err(|e| Error::io(&journal, e))?;
     }
-    Ok(())
+    Ok(kept)
+}
+
+/// Every file below `root.join(rel)` (relative to `root`), links not followed.
+fn files_below(root: &Path, rel: &Path, out: &mut Vec<PathBuf>) {
+    let Ok(entries) = std::fs::read_dir(root.join(rel)) else {
+        return;
+    };
+    for e in entries.flatten() {
+        let r = rel.join(e.file_name());
+        match e.file_type() {
+            Ok(t) if t.is_dir() => files_below(root, &r, out),
+            Ok(_) => out.push(r),
+            Err(_) => {}
+        }
+    }
 }
 
 /// Where a write to `path` must go while a set is open: its staged path, recorded for
@@ -705,125 +773,4 @@ pub fn write_atomic_direct(path: &Path, bytes: &[u8]) -> Result<()> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// Threads started together on a folder with a stale lock file (a dead run's process id):
-    /// exactly one holds the lock at a time. The process-id lock this replaced let two take over
-    /// the stale lock together (each removed the other's), or failed on the removed file.
-    #[test]
-    fn one_lock_owner_among_racing_takers() {
-        let tmp = tempfile::tempdir().unwrap();
-        let dir = tmp.path();
-        for round in 0..40 {
-            std::fs::write(dir.join(LOCK), b"999999999").unwrap();
-            let threads = 6;
-            let barrier = std::sync::Barrier::new(threads);
-            let held = std::sync::atomic::AtomicUsize::new(0);
-            let most = std::sync::atomic::AtomicUsize::new(0);
-            let errors = Mutex::new(Vec::new());
-            std::thread::scope(|s| {
-                for _ in 0..threads {
-                    s.spawn(|| {
-                        use std::sync::atomic::Ordering::SeqCst;
-                        barrier.wait();
-                        match FolderLock::take(dir) {
-                            Ok(lock) => {
-                                let now = held.fetch_add(1, SeqCst) + 1;
-                                most.fetch_max(now, SeqCst);
-                                std::thread::sleep(std::time::Duration::from_millis(2));
-                                held.fetch_sub(1, SeqCst);
-                                lock.release();
-                            }
-                            Err(LockError::InUse(_)) => {}
-                            Err(e) => errors.lock().unwrap().push(format!("{e:?}")),
-                        }
-                    });
-                }
-            });
-            let errors = errors.into_inner().unwrap();
-            assert!(errors.is_empty(), "round {round}: {errors:?}");
-            assert_eq!(
-                most.load(std::sync::atomic::Ordering::SeqCst),
-                1,
-                "round {round}: two held the lock at once"
-            );
-        }
-    }
-
-    /// Threads taking and releasing the lock over and over: a release removes the lock file,
-    /// so a taker that opened the file just before may lock the removed file while another
-    /// creates and locks a new one. Exactly one may hold it at any time (the check that the
-    /// locked file is still the one at the path; without it two held it at once here).
-    #[test]
-    fn a_released_lock_file_is_never_held_twice() {
-        use std::sync::atomic::{AtomicUsize, Ordering::SeqCst};
-        let tmp = tempfile::tempdir().unwrap();
-        let dir = tmp.path();
-        let (held, most, taken) = (
-            AtomicUsize::new(0),
-            AtomicUsize::new(0),
-            AtomicUsize::new(0),
-        );
-        let errors = Mutex::new(Vec::new());
-        let deadline = std::time::Instant::now() + std::time::Duration::from_millis(1500);
-        std::thread::scope(|s| {
-            for _ in 0..6 {
-                s.spawn(|| {
-                    while std::time::Instant::now() < deadline {
-                        match FolderLock::take(dir) {
-                            Ok(lock) => {
-                                let now = held.fetch_add(1, SeqCst) + 1;
-                                most.fetch_max(now, SeqCst);
-                                taken.fetch_add(1, SeqCst);
-                                std::thread::yield_now();
-                                held.fetch_sub(1, SeqCst);
-                                lock.release();
-                            }
-                            Err(LockError::InUse(_)) => std::thread::yield_now(),
-                            Err(e) => errors.lock().unwrap().push(format!("{e:?}")),
-                        }
-                    }
-                });
-            }
-        });
-        let errors = errors.into_inner().unwrap();
-        assert!(errors.is_empty(), "{:?}", &errors[..errors.len().min(3)]);
-        assert!(taken.load(SeqCst) > 0);
-        assert_eq!(most.load(SeqCst), 1, "two held the lock at once");
-    }
-
-    /// A replaced subfolder that is a symbolic link to a folder outside: publication removes
-    /// nothing there (before, every file in the link's target was deleted).
-    #[cfg(unix)]
-    #[test]
-    fn nothing_is_removed_through_a_link() {
-        let tmp = tempfile::tempdir().unwrap();
-        let (out, outside) = (tmp.path().join("out"), tmp.path().join("outside"));
-        std::fs::create_dir_all(&out).unwrap();
-        std::fs::create_dir_all(&outside).unwrap();
-        std::fs::write(outside.join("precious.txt"), b"mine").unwrap();
-        // Declared while the link is absent, made a link before publication (another process
-        // could do this mid-run): the declaration check cannot see it, publication must.
-        let set = OutputSet::begin("out", &out).unwrap();
-        set.replace(Path::new("tiles")).unwrap();
-        std::os::unix::fs::symlink(&outside, out.join("tiles")).unwrap();
-        let e = set.publish().unwrap_err().to_string();
-        assert!(e.contains("symbolic link"), "{e}");
-        assert!(outside.join("precious.txt").exists());
-        // With the link present before the command: refused when the set opens, naming it.
-        let e = OutputSet::begin("out", &out).err().unwrap().to_string();
-        assert!(e.contains("'out'") && e.contains("tiles"), "{e}");
-        // And a write below the link is refused rather than made outside.
-        std::fs::remove_file(out.join("tiles")).unwrap();
-        let set = OutputSet::begin("out", &out).unwrap();
-        std::os::unix::fs::symlink(&outside, out.join("tiles")).unwrap();
-        let e = write_atomic(&out.join("tiles/new.txt"), b"x")
-            .unwrap_err()
-            .to_string();
-        assert!(e.contains("symbolic link"), "{e}");
-        assert!(!outside.join("new.txt").exists());
-        drop(set);
-        assert!(outside.join("precious.txt").exists());
-    }
-}
+mod tests;

@@ -478,6 +478,9 @@ impl<'a> Harness<'a> {
             let mut profiler = self.profiler(info, mode);
             let total = config.warmup + config.frames;
             for i in 0..total {
+                crate::interrupt::check(|| {
+                    format!("{}'s frame {}", info.name, config.first_frame + i)
+                })?;
                 let frame = self.clock.frame(config.first_frame + i);
                 self.render_frame(
                     technique.as_mut(),
@@ -606,6 +609,7 @@ impl<'a> Harness<'a> {
         let to_vec3 = |v: Vec<[f32; 3]>| v.into_iter().map(glam::Vec3::from).collect::<Vec<_>>();
         let mut captured = Vec::new();
         for f in config.first_frame..=last {
+            crate::interrupt::check(|| format!("{}'s quality frame {f}", info.name))?;
             let frame = self.clock.frame(f);
             self.render_frame(technique.as_mut(), &compose, &mut profiler, &frame, false)?;
             if let Some(&(_, pair_end)) = targets.iter().find(|(g, _)| *g == f) {
@@ -627,6 +631,7 @@ impl<'a> Harness<'a> {
         let mut work = ReferenceWork::default();
         // A frame's reference with `settings`, from the cache or rendered, counted in `work`.
         let mut fetch = |f: u32, settings: &crate::cpu::reference::ReferenceSettings| {
+            crate::interrupt::check(|| format!("the reference of frame {f}"))?;
             let frame = self.clock.frame(f);
             let (r, setup) = cache.get_with(&self.trees, &frame, config.resolution, settings)?;
             *(if setup.is_some() {

@@ -8,9 +8,9 @@ use std::path::Path;
 
 use gibench_test_support::source::{paths_under, rust_files, without_comments};
 
-/// The folders from the bottom up; `error`, `output` and `rng` are the files every layer may use.
+/// The folders from the bottom up; `error`, `interrupt`, `output` and `rng` are the files every layer may use.
 const LAYERS: &[&[&str]] = &[
-    &["error", "output", "rng"],
+    &["error", "interrupt", "output", "rng"],
     &["measure"],
     &["scene"],
     &["cpu"],

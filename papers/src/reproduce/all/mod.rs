@@ -23,6 +23,7 @@
 mod manifest;
 mod merge;
 mod planned;
+mod resume;
 mod targets;
 
 use std::path::{Path, PathBuf};
@@ -38,6 +39,7 @@ use crate::progress::{Bars, Overall};
 use manifest::{duration, Manifest, Record, MANIFEST};
 pub use merge::merge;
 use planned::Planned;
+use resume::Checkpoint;
 pub use targets::{find, Kind, Target, TARGETS};
 
 /// `gibench reproduce TARGET` (one target) or `gibench reproduce all`.
@@ -105,22 +107,47 @@ pub fn reproduce(args: &ReproduceArgs) -> Result<()> {
         return Ok(());
     }
     writable_dir("out", &root)?;
-    let set = OutputSet::begin("out", &root)?;
+    let checkpoint = Checkpoint::new(
+        &root,
+        &planned,
+        &mode,
+        &adapter,
+        shard.as_ref().map(ToString::to_string),
+        std::env::args().collect::<Vec<_>>().join(" "),
+    );
+    let mut resumed: Vec<Option<Record>> = planned.iter().map(|_| None).collect();
+    let set = OutputSet::resume("out", &root, &mut |present| {
+        let (keep, taken) = checkpoint.take_over(present);
+        resumed = taken;
+        keep
+    })?;
+    for (p, r) in planned.iter().zip(&resumed) {
+        if r.is_some() {
+            claim_folders(&set, p.target)?;
+        }
+    }
     let budget = args.budget.map(|b| Budget {
         ends: began + b,
         total: b.as_secs_f64(),
         adapter: adapter.clone(),
         measured,
     });
-    let (records, seconds) = run_targets(
+    let (records, seconds) = match run_targets(
         &planned,
         &estimates,
         budget.as_ref(),
         gpu.as_ref(),
         &adapter,
-        &set,
+        (&set, &checkpoint, resumed),
         args.quiet,
-    )?;
+    ) {
+        // Stopped by a signal: the completed targets stay staged for a resume.
+        Err(e @ Error::Interrupted { .. }) => {
+            set.suspend();
+            return Err(e);
+        }
+        other => other?,
+    };
     let estimate: Option<f64> = estimates.iter().copied().sum();
     let mut manifest = Manifest::new(
         &mode,
@@ -146,6 +173,7 @@ pub fn reproduce(args: &ReproduceArgs) -> Result<()> {
     manifest.write(&root)?;
     manifest.write_index(&root)?;
     set.publish()?;
+    checkpoint.finish();
     println!("{}", manifest.listing(&root));
     let failed: Vec<&str> = manifest
         .targets
@@ -328,16 +356,18 @@ pub(super) fn claim_folders(set: &OutputSet, target: &Target) -> Result<()> {
 }
 
 /// Runs the planned targets one after another under one bar (with a budget: in priority
-/// order, each the first not yet run whose estimate fits what is left); returns each one's
-/// record (its files: what it staged in `set`; a target left out says why) and the seconds
-/// they took together.
+/// order, each the first not yet run whose estimate fits what is left), except those an
+/// interrupted run completed (`resumed`: their entries); returns each one's record (its files:
+/// what it staged in `set`; a target left out says why) and the seconds they took together.
+/// After each target `checkpoint` records the progress; a signal stops the run before the
+/// next target or frame (the target it stopped is dropped, the completed ones stay staged).
 fn run_targets(
     planned: &[Planned],
     estimates: &[Option<f64>],
     budget: Option<&Budget>,
     gpu: Option<&GpuContext>,
     adapter: &str,
-    set: &OutputSet,
+    (set, checkpoint, resumed): (&OutputSet, &Checkpoint, Vec<Option<Record>>),
     quiet: bool,
 ) -> Result<(Vec<Record>, f64)> {
     // The bar advances in estimated milliseconds (work units where there is no estimate).
@@ -349,11 +379,20 @@ fn run_targets(
     } else {
         planned.iter().map(|p| p.work.units.max(1)).collect()
     };
-    let overall = Overall::new(quiet, spans.iter().sum());
+    let overall = Overall::new(
+        quiet,
+        (spans.iter().zip(&resumed))
+            .filter(|(_, r)| r.is_none())
+            .map(|(s, _)| s)
+            .sum(),
+    );
     let started = Instant::now();
-    let mut records: Vec<Option<Record>> = planned.iter().map(|_| None).collect();
+    let mut order: Vec<usize> = (0..planned.len())
+        .filter(|&i| resumed[i].is_none())
+        .collect();
+    let to_run = order.len();
+    let mut records = resumed;
     let mut before = set.staged().len();
-    let mut order: Vec<usize> = (0..planned.len()).collect();
     if budget.is_some() {
         order.sort_by_key(|&i| targets::priority(planned[i].target.name));
     }
@@ -375,9 +414,14 @@ fn run_targets(
     } {
         let i = order.remove(pos);
         let p = &planned[i];
+        if let Err(e) =
+            gibench_harness::interrupt::check(|| format!("the start of {}", p.target.name))
+        {
+            return Err(stopped(e, checkpoint, &records));
+        }
         n += 1;
         overall.start(
-            &format!("{}/{} {}", n, planned.len(), p.target.name),
+            &format!("{}/{} {}", n, to_run, p.target.name),
             spans[i],
             p.work.frames,
         );
@@ -386,6 +430,11 @@ fn run_targets(
         let t = Instant::now();
         let done = match p.run(gpu, &Bars::Shared(&overall)) {
             Ok(done) => done,
+            Err(e @ Error::Interrupted { .. }) => {
+                overall.finish();
+                set.rollback(mark)?;
+                return Err(stopped(e, checkpoint, &records));
+            }
             // Within a budget (a short GPU slot) one target's failure does not cost the
             // others: it is left out with its error, nothing of it is published, the rest go on,
             // and the command fails after publishing.
@@ -422,6 +471,7 @@ fn run_targets(
             duration(seconds)
         ));
         records[i] = Some(record(p, estimates[i], adapter, Some(seconds), files, None));
+        checkpoint.save(&records, None)?;
     }
     overall.finish();
     // What the budget left out, and why.
@@ -459,6 +509,25 @@ fn run_targets(
         records.into_iter().flatten().collect(),
         started.elapsed().as_secs_f64(),
     ))
+}
+
+/// A run stopped by a signal (`e`): records what is complete and what is missing, and says so;
+/// returns `e` (or the error recording failed with).
+fn stopped(e: Error, checkpoint: &Checkpoint, records: &[Option<Record>]) -> Error {
+    if let Err(w) = checkpoint.save(records, Some(&e.to_string())) {
+        return w;
+    }
+    eprintln!(
+        "gibench reproduce all: {e}; {} target(s) complete are kept (staged, not published); \
+         missing: {}. Run the same command again to resume (docs/fleet.md).",
+        records
+            .iter()
+            .flatten()
+            .filter(|r| r.left_out.is_none())
+            .count(),
+        checkpoint.missing(records).join(", ")
+    );
+    e
 }
 
 /// Target `i`'s estimate for the budget: as measured, or for a GPU target measured on another
