@@ -33,7 +33,9 @@ pub fn exec(args: &MergeArgs) -> Result<()> {
     let manifest = |d: &PathBuf| d.join("reproduce-all.json").is_file();
     let record = |d: &PathBuf| d.join(RECORD).is_file();
     if args.dirs.iter().all(manifest) {
-        return crate::reproduce::all::merge(&args.dirs, &args.out);
+        let listing = crate::reproduce::all::merge(&args.dirs, &args.out)?;
+        println!("{listing}");
+        return Ok(());
     }
     if !args.dirs.is_empty() && args.dirs.iter().all(record) {
         return merge_shards(&args.dirs, &args.out);

@@ -330,10 +330,8 @@ impl ShardRecord {
     /// Reads `dir`'s record, naming the file on error.
     pub fn read(dir: &std::path::Path) -> Result<ShardRecord> {
         let path = dir.join(RECORD);
-        let bytes = std::fs::read(&path).map_err(|e| Error::Io {
-            path: path.clone(),
-            source: e,
-        })?;
+        // Bounded: a record is a few kilobytes; /dev/zero put in its place is refused.
+        let bytes = gibench_harness::error::read_bounded(&path, 16 << 20)?;
         serde_json::from_slice(&bytes).map_err(|e| {
             Error::bad_file(&path, format!("not a gibench run/sweep shard record: {e}"))
         })

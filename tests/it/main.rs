@@ -6,7 +6,8 @@
 //! Kept apart, each in its own binary because it needs its own process: `tests/compare.rs`
 //! (its end-to-end comparison judges real runs' times, which the other tests' work running
 //! beside it in the same process would disturb) and `tests/memory.rs` (it measures the
-//! process's own resident set). A new test file belongs here, as a module, unless it needs its
+//! process's own resident set), and `tests/fuzz/` (the fuzz targets: its allocator counts every
+//! allocation). A new test file belongs here, as a module, unless it needs its
 //! own process too (`layout::every_test_file_is_a_module_or_says_why_it_is_apart` checks
 //! that none is forgotten).
 

@@ -488,8 +488,30 @@ fn import_checked(
 )> {
     let bytes = crate::error::read_bounded(path, MAX_GLTF_FILE_BYTES)?;
     let invalid = |e: gltf::Error| Error::bad_file(path, format!("not a valid glTF binary: {e}"));
-    let gltf::Gltf { document, blob } = gltf::Gltf::from_slice(&bytes).map_err(invalid)?;
+    let gltf::Gltf { document, blob } =
+        gltf::Gltf::from_slice_without_validation(&bytes).map_err(invalid)?;
     drop(bytes);
+    // The gltf crate's validation (1.4) indexes the accessors by a primitive's POSITION
+    // unchecked: an index past them panics there (found by fuzzing, tests/fuzz-corpus).
+    let json = document.into_json();
+    for (m, mesh) in json.meshes.iter().enumerate() {
+        for (p, prim) in mesh.primitives.iter().enumerate() {
+            for index in prim.attributes.values() {
+                if index.value() >= json.accessors.len() {
+                    return Err(Error::bad_file(
+                        path,
+                        format!(
+                            "not a valid glTF binary: an attribute of meshes[{m}].primitives[{p}] \
+                             names accessor {} of {}",
+                            index.value(),
+                            json.accessors.len()
+                        ),
+                    ));
+                }
+            }
+        }
+    }
+    let document = gltf::Document::from_json(json).map_err(invalid)?;
     let base = path.parent().unwrap_or(Path::new("."));
     for b in document.buffers() {
         if let gltf::buffer::Source::Uri(uri) = b.source() {

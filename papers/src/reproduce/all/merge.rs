@@ -18,8 +18,9 @@ use super::manifest::{Manifest, Record};
 use super::targets::{find, TARGETS};
 use crate::files::writable_dir;
 
-/// Pools `dirs` (each with a `reproduce-all.json`) into `out`.
-pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<()> {
+/// Pools `dirs` (each with a `reproduce-all.json`) into `out`; returns the listing of what it
+/// wrote (for the command to print).
+pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<String> {
     if dirs.is_empty() {
         return Err(Error::param(
             "DIR",
@@ -148,8 +149,7 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<()> {
     merged.write(out)?;
     merged.write_index(out)?;
     set.publish()?;
-    println!("{}", merged.listing(out));
-    Ok(())
+    Ok(merged.listing(out))
 }
 
 /// Whether a record is a target this folder's run made (not left out, not carried over).
