@@ -29,6 +29,10 @@ pub enum Error {
         #[source]
         source: std::io::Error,
     },
+    /// The GPU device was lost (a driver reset, a GPU timeout, or destroyed): `what` is the
+    /// driver's word, `at` the technique, stage and frame where gibench found it.
+    #[error("the GPU device was lost ({what}){}", if at.is_empty() { String::new() } else { format!(" at {at}") })]
+    DeviceLost { what: String, at: String },
     /// SIGTERM or SIGINT arrived ([`crate::interrupt`]): the command stopped at `at`.
     #[error("stopped by {signal} at {at}")]
     Interrupted { signal: &'static str, at: String },

@@ -416,8 +416,20 @@ pub fn exec(args: &RunArgs) -> Result<()> {
     let mut ran: Vec<(String, String)> = Vec::new();
     let mut lines: Vec<String> = Vec::new();
     let mut gpu = None;
+    // A lost device ends the runs: those completed are published, the rest listed, and the
+    // command fails after publishing.
+    let mut lost = None;
     for (one, p) in &plans {
         if p.techniques.is_empty() {
+            continue;
+        }
+        if lost.is_some() {
+            for t in &p.techniques {
+                ran.push((
+                    unit(p, t),
+                    "skipped: not run: the GPU device was lost before it".into(),
+                ));
+            }
             continue;
         }
         if gpu.is_none() {
@@ -426,6 +438,7 @@ pub fn exec(args: &RunArgs) -> Result<()> {
         let g = gpu.as_ref().expect("opened above");
         let (line, skipped) = run_planned_skipping(one, p, g, &Bars::Own(args.quiet))?;
         lines.push(line);
+        lost = lost.or(gibench_harness::run::session::device_lost(&skipped));
         for t in &p.techniques {
             let why = skipped.iter().find(|s| s.technique == t.name);
             let file = match why {
@@ -445,7 +458,10 @@ pub fn exec(args: &RunArgs) -> Result<()> {
     set.publish()?;
     lines.extend(removed_note(&stale));
     eprintln!("{}", lines.join("\n"));
-    Ok(())
+    match lost {
+        Some(e) => Err(e),
+        None => Ok(()),
+    }
 }
 
 /// The files about scene `name` as a whole that a run or a merge writes only with some options
@@ -624,7 +640,10 @@ fn retune_off_the_mark(
             off.iter()
                 .any(|&(i, _)| plan.techniques[i].name == r.info.name)
         });
-        let (again, _) = execute_skipping_with_bar(bars, gpu, &spec, false)?;
+        let (again, lost) = execute_skipping_with_bar(bars, gpu, &spec, false)?;
+        if let Some(e) = gibench_harness::run::session::device_lost(&lost) {
+            return Err(e);
+        }
         for r in again {
             if let Some(old) = results.iter_mut().find(|o| o.technique == r.technique) {
                 *old = r;
@@ -689,6 +708,12 @@ fn run_planned_skipping(
         )?;
     }
     let name = &plan.desc.name;
+    if let Some(e) = (results.is_empty())
+        .then(|| gibench_harness::run::session::device_lost(&skipped))
+        .flatten()
+    {
+        return Err(e);
+    }
     if results.is_empty() {
         let reasons: Vec<String> = skipped
             .iter()

@@ -16,6 +16,7 @@ mod support;
 
 mod cli_errors;
 mod conformance;
+mod device_loss;
 mod docs_links;
 mod export;
 mod fleet;

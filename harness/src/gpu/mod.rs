@@ -53,6 +53,8 @@ pub struct GpuContext {
     /// Timestamp queries can be written between passes (`write_timestamp` on encoders).
     pub timestamps: bool,
     errors: Arc<Mutex<Vec<String>>>,
+    /// Set by the device-lost callback: the reason and the driver's message.
+    lost: Arc<Mutex<Option<String>>>,
     wait_limit: Option<Duration>,
 }
 
@@ -218,6 +220,16 @@ impl GpuContext {
                 v.push(e.to_string());
             }
         }));
+        let lost = Arc::new(Mutex::new(None));
+        let lost_sink = lost.clone();
+        device.set_device_lost_callback(move |reason, message| {
+            if let Ok(mut l) = lost_sink.lock() {
+                *l = Some(match message.is_empty() {
+                    true => format!("{reason:?}"),
+                    false => format!("{reason:?}: {message}"),
+                });
+            }
+        });
         let period = if timestamps {
             queue.get_timestamp_period()
         } else {
@@ -242,6 +254,7 @@ impl GpuContext {
             info,
             timestamps,
             errors,
+            lost,
             wait_limit,
         })
     }
@@ -269,7 +282,9 @@ impl GpuContext {
                 submission_index: index.clone(),
                 timeout: Some(WAIT_SLICE),
             };
-            match self.device.poll(poll) {
+            let polled = self.device.poll(poll);
+            self.check_lost()?;
+            match polled {
                 Ok(_) => return Ok(()),
                 Err(wgpu::PollError::Timeout) => {
                     let waited = start.elapsed();
@@ -298,8 +313,32 @@ impl GpuContext {
         }
     }
 
-    /// Turns GPU validation errors collected so far into an error.
+    /// [`Error::DeviceLost`] once the device is lost (its callback ran), without where.
+    pub fn check_lost(&self) -> Result<()> {
+        match self.lost.lock().ok().and_then(|l| l.clone()) {
+            Some(what) => Err(Error::DeviceLost {
+                what,
+                at: String::new(),
+            }),
+            None => Ok(()),
+        }
+    }
+
+    /// A test hook: `GIBENCH_TEST_LOSE_DEVICE=TECHNIQUE:FRAME` destroys the device before
+    /// TECHNIQUE's frame FRAME, as a driver reset would lose it (tests/it/device_loss.rs).
+    pub fn test_lose_device(&self, technique: &str, frame: u32) {
+        let Ok(v) = std::env::var("GIBENCH_TEST_LOSE_DEVICE") else {
+            return;
+        };
+        if v.split_once(':') == Some((technique, frame.to_string().as_str())) {
+            eprintln!("GIBENCH_TEST_LOSE_DEVICE: destroying the device before {technique}'s frame {frame} (a test hook)");
+            self.device.destroy();
+        }
+    }
+
+    /// Turns a lost device, or GPU validation errors collected so far, into an error.
     pub fn check_errors(&self) -> Result<()> {
+        self.check_lost()?;
         let mut v = self
             .errors
             .lock()

@@ -143,6 +143,8 @@ pub struct Profiler {
     /// `frame_queries` at the frame's end, so that no frame allocates a list).
     slot_queries: Vec<Vec<(usize, u32)>>,
     frame_commands: Vec<wgpu::CommandBuffer>,
+    /// The series of the GPU stage recorded last (where a lost device is reported).
+    last_stage: Option<usize>,
     in_flight: VecDeque<(wgpu::SubmissionIndex, Option<PendingSpan>)>,
     /// The GPU span of each measured frame (frame mode with timestamps).
     gpu_spans: Vec<GpuFrameSpan>,
@@ -197,6 +199,7 @@ impl Profiler {
             mode,
             recording: false,
             series: Vec::new(),
+            last_stage: None,
             counters: BTreeMap::new(),
             timestamps,
             slow: slow_stage_hook(),
@@ -278,6 +281,7 @@ impl Profiler {
         record: impl FnOnce(&mut wgpu::CommandEncoder) -> R,
     ) -> Result<R> {
         let idx = self.series_index(name, StageKind::Gpu);
+        self.last_stage = Some(idx);
         let mut enc = gpu
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(name) });
@@ -355,6 +359,11 @@ impl Profiler {
     }
 
     /// A warning for the results when the `slow_stage_hook` is set.
+    /// The GPU stage recorded last, if any.
+    pub fn last_stage(&self) -> Option<&str> {
+        self.last_stage.map(|i| self.series[i].name.as_str())
+    }
+
     pub fn test_hook_warning(&self) -> Option<String> {
         self.slow.as_ref().map(|(stage, slow)| {
             format!(

@@ -478,20 +478,23 @@ impl<'a> Harness<'a> {
             let mut profiler = self.profiler(info, mode);
             let total = config.warmup + config.frames;
             for i in 0..total {
-                crate::interrupt::check(|| {
-                    format!("{}'s frame {}", info.name, config.first_frame + i)
-                })?;
-                let frame = self.clock.frame(config.first_frame + i);
+                let f = config.first_frame + i;
+                crate::interrupt::check(|| format!("{}'s frame {f}", info.name))?;
+                self.gpu.test_lose_device(info.name, f);
+                let frame = self.clock.frame(f);
                 self.render_frame(
                     technique.as_mut(),
                     &compose,
                     &mut profiler,
                     &frame,
                     i >= config.warmup,
-                )?;
+                )
+                .map_err(|e| located(e, info.name, profiler.last_stage(), f))?;
                 progress();
             }
-            profiler.finish(self.gpu)?;
+            let last = config.first_frame + total.saturating_sub(1);
+            (profiler.finish(self.gpu))
+                .map_err(|e| located(e, info.name, profiler.last_stage(), last))?;
             if !profiler.undeclared().is_empty() {
                 return Err(Error::Invalid(format!(
                     "technique '{}' timed stage(s) {} that its TechniqueInfo.stages does not \
@@ -611,7 +614,8 @@ impl<'a> Harness<'a> {
         for f in config.first_frame..=last {
             crate::interrupt::check(|| format!("{}'s quality frame {f}", info.name))?;
             let frame = self.clock.frame(f);
-            self.render_frame(technique.as_mut(), &compose, &mut profiler, &frame, false)?;
+            self.render_frame(technique.as_mut(), &compose, &mut profiler, &frame, false)
+                .map_err(|e| located(e, info.name, profiler.last_stage(), f))?;
             if let Some(&(_, pair_end)) = targets.iter().find(|(g, _)| *g == f) {
                 profiler.finish(self.gpu)?;
                 captured.push(CapturedFrame {
@@ -714,6 +718,21 @@ static BUILD_COMMIT: std::sync::OnceLock<String> = std::sync::OnceLock::new();
 
 /// Records the commit this process's binary was built from (the root crate's build script
 /// stamps it; see [`super::commit`]). "unknown" is ignored: the run-time look-up may do better.
+/// A lost device found while rendering `technique`'s frame `frame` (`stage` the GPU stage
+/// recorded last), said where; other errors unchanged.
+fn located(e: Error, technique: &str, stage: Option<&str>, frame: u32) -> Error {
+    match e {
+        Error::DeviceLost { what, at } if at.is_empty() => Error::DeviceLost {
+            what,
+            at: format!(
+                "{technique}'s frame {frame}{}",
+                stage.map(|s| format!(", stage '{s}'")).unwrap_or_default()
+            ),
+        },
+        e => e,
+    }
+}
+
 pub fn set_build_commit(commit: &str) {
     if commit != "unknown" {
         let _ = BUILD_COMMIT.set(commit.to_string());

@@ -167,6 +167,22 @@ fn file_name(p: &Path) -> String {
 pub struct Skipped {
     pub technique: String,
     pub reason: String,
+    /// Not completed, or not run, because the GPU device was lost (the driver's word and
+    /// where it was found): the command writes the runs completed before it, lists this one,
+    /// and fails with [`Skipped::lost`].
+    pub device_lost: Option<(String, String)>,
+}
+
+impl Skipped {
+    /// The lost device's error, for a skipped run the device's loss ended.
+    pub fn lost(&self) -> Option<Error> {
+        (self.device_lost.clone()).map(|(what, at)| Error::DeviceLost { what, at })
+    }
+}
+
+/// The first lost-device error among `skipped`.
+pub fn device_lost(skipped: &[Skipped]) -> Option<Error> {
+    skipped.iter().find_map(Skipped::lost)
 }
 
 /// Runs every technique of `spec` on `gpu` and writes its files; returns the results in order.
@@ -176,7 +192,11 @@ pub fn execute(
     spec: &RunSpec,
     progress: &mut dyn FnMut(Progress),
 ) -> Result<Vec<RunResult>> {
-    execute_skipping(gpu, spec, false, progress).map(|(results, _)| results)
+    let (results, skipped) = execute_skipping(gpu, spec, false, progress)?;
+    match device_lost(&skipped) {
+        Some(e) => Err(e),
+        None => Ok(results),
+    }
 }
 
 /// [`execute`], except that with `skip_unfit` a technique whose preparation fails is left out
@@ -213,6 +233,7 @@ pub fn execute_skipping(
             Err(e) if skip_unfit => skipped.push(Skipped {
                 technique: run.info.name.to_string(),
                 reason: e.to_string(),
+                device_lost: None,
             }),
             Err(e) => return Err(e),
         }
@@ -220,15 +241,33 @@ pub fn execute_skipping(
     let mut results = Vec::with_capacity(prepared.len());
     // The shared reference images written so far (each once per set).
     let mut references_written = std::collections::HashSet::new();
-    for (run, p) in &prepared {
-        results.push(execute_one(
-            &harness,
-            spec,
-            run,
-            p,
-            &mut references_written,
-            progress,
-        )?);
+    for (i, (run, p)) in prepared.iter().enumerate() {
+        match execute_one(&harness, spec, run, p, &mut references_written, progress) {
+            Ok(r) => results.push(r),
+            // A lost device ends the runs; those completed stay, this one and the rest are
+            // listed with why (a technique's files are written only once it completes).
+            Err(e @ Error::DeviceLost { .. }) => {
+                let reason = format!("not completed: {e}");
+                let Error::DeviceLost { what, at } = e else {
+                    unreachable!("matched above")
+                };
+                let lost = Some((what, at));
+                skipped.push(Skipped {
+                    technique: run.info.name.to_string(),
+                    reason,
+                    device_lost: lost.clone(),
+                });
+                for (rest, _) in &prepared[i + 1..] {
+                    skipped.push(Skipped {
+                        technique: rest.info.name.to_string(),
+                        reason: "not run: the GPU device was lost before it".into(),
+                        device_lost: lost.clone(),
+                    });
+                }
+                break;
+            }
+            Err(e) => return Err(e),
+        }
     }
     Ok((results, skipped))
 }

@@ -12,7 +12,11 @@ pub use overall::Overall;
 
 /// Runs `spec` with a progress bar (hidden when `quiet`).
 pub fn execute_with_bar(bars: &Bars, gpu: &GpuContext, spec: &RunSpec) -> Result<Vec<RunResult>> {
-    execute_skipping_with_bar(bars, gpu, spec, false).map(|(results, _)| results)
+    let (results, skipped) = execute_skipping_with_bar(bars, gpu, spec, false)?;
+    match session::device_lost(&skipped) {
+        Some(e) => Err(e),
+        None => Ok(results),
+    }
 }
 
 /// [`execute_with_bar`] leaving out, with `skip_unfit`, the techniques that cannot take the

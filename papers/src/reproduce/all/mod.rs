@@ -141,8 +141,8 @@ pub fn reproduce(args: &ReproduceArgs) -> Result<()> {
         (&set, &checkpoint, resumed),
         args.quiet,
     ) {
-        // Stopped by a signal: the completed targets stay staged for a resume.
-        Err(e @ Error::Interrupted { .. }) => {
+        // Stopped by a signal or a lost device: the completed targets stay staged for a resume.
+        Err(e @ (Error::Interrupted { .. } | Error::DeviceLost { .. })) => {
             set.suspend();
             return Err(e);
         }
@@ -430,7 +430,9 @@ fn run_targets(
         let t = Instant::now();
         let done = match p.run(gpu, &Bars::Shared(&overall)) {
             Ok(done) => done,
-            Err(e @ Error::Interrupted { .. }) => {
+            // A signal, or a lost device (no later target could run either): the completed
+            // targets stay staged for a resume.
+            Err(e @ (Error::Interrupted { .. } | Error::DeviceLost { .. })) => {
                 overall.finish();
                 set.rollback(mark)?;
                 return Err(stopped(e, checkpoint, &records));
@@ -511,8 +513,8 @@ fn run_targets(
     ))
 }
 
-/// A run stopped by a signal (`e`): records what is complete and what is missing, and says so;
-/// returns `e` (or the error recording failed with).
+/// A run stopped by a signal or a lost device (`e`): records what is complete and what is
+/// missing, and says so; returns `e` (or the error recording failed with).
 fn stopped(e: Error, checkpoint: &Checkpoint, records: &[Option<Record>]) -> Error {
     if let Err(w) = checkpoint.save(records, Some(&e.to_string())) {
         return w;
