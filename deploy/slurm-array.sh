@@ -23,11 +23,15 @@ target/release/gibench reproduce all ${GIBENCH_QUICK:+--quick} --quiet \
 pid=$!
 # --signal=B: signals this shell only: pass SIGTERM on to gibench and wait for its status.
 stopping=
-trap 'stopping=1; kill -TERM "$pid" 2>/dev/null' TERM INT
+trap 'stopping=1; kill -TERM "$pid" 2>/dev/null || true' TERM INT
 rc=0
 wait "$pid" || rc=$?
-# A trapped signal ends the first wait early: wait again for gibench's own status.
-if [ -n "$stopping" ]; then rc=0; wait "$pid" || rc=$?; fi
+# A trapped signal ends a wait early: wait again, until one ends with gibench's own status
+# (127: it was already collected).
+while [ -n "$stopping" ]; do
+    stopping=
+    wait "$pid" && rc=0 || { r=$?; [ "$r" = 127 ] || rc=$r; }
+done
 if [ "$rc" = 75 ]; then
     scontrol requeue "$SLURM_JOB_ID"
 fi

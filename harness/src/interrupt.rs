@@ -22,7 +22,13 @@ pub const EXIT_STATUS: u8 = 75;
 #[cfg(unix)]
 extern "C" fn on_signal(signal: libc::c_int) {
     // Async-signal-safe only: an atomic swap, `write` and `_exit`.
-    if RECEIVED.swap(signal, Ordering::SeqCst) != 0 {
+    let before = RECEIVED.swap(signal, Ordering::SeqCst);
+    if before == libc::SIGTERM && signal == libc::SIGTERM {
+        // A scheduler may send SIGTERM twice (to the job and through its launcher): the stop
+        // already under way goes on.
+        return;
+    }
+    if before != 0 {
         // SAFETY: `_exit` is async-signal-safe and ends the process without unwinding.
         unsafe { libc::_exit(128 + signal) };
     }

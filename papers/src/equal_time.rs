@@ -61,6 +61,12 @@ pub fn parse_budget(s: &str) -> Result<f64> {
     }
 }
 
+/// An error that ends the whole command, not one value of a search: a signal (SIGTERM,
+/// SIGINT) or a lost device.
+fn fatal(e: &Error) -> bool {
+    matches!(e, Error::Interrupted { .. } | Error::DeviceLost { .. })
+}
+
 /// One timed step of a search: the value tried and its frame time (infinite where the run
 /// failed: `note` says why, e.g. the device cannot hold that many maps), the median of its
 /// `timings` (one, or [`REPEATS`] for a value the search was about to keep, and then one more
@@ -143,6 +149,8 @@ pub fn search_on(
                     timings: vec![ms],
                     note: None,
                 }),
+                // A signal or a lost device ends the search, not just this value.
+                Err(e) if fatal(&e) => return Err(e),
                 Err(e) => {
                     let mut r = (lo, hi);
                     narrow(&steps, v, &mut r);
@@ -186,6 +194,7 @@ pub fn search_on(
                 while s.timings.len() < REPEATS {
                     match measure(s.value) {
                         Ok(ms) => s.timings.push(ms),
+                        Err(e) if fatal(&e) => return Err(e),
                         Err(e) => {
                             s.note = Some(e.to_string());
                             s.timings.clear();
@@ -515,8 +524,12 @@ fn tune(
         ));
         Ok(ms)
     };
-    let found = search_on((min, max), start, budget, prior, &mut measure)
-        .map_err(|e| Error::Invalid(format!("{}: no {} ran: {e}", info.name, knob.param)))?;
+    let found = search_on((min, max), start, budget, prior, &mut measure).map_err(|e| {
+        if fatal(&e) {
+            return e;
+        }
+        Error::Invalid(format!("{}: no {} ran: {e}", info.name, knob.param))
+    })?;
     given.retain(|(k, _)| k != knob.param);
     given.push((knob.param.to_string(), found.value.to_string()));
     let params = info.parse_params(&given)?;

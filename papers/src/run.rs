@@ -436,7 +436,20 @@ pub fn exec(args: &RunArgs) -> Result<()> {
             gpu = Some(open_gpu(args)?);
         }
         let g = gpu.as_ref().expect("opened above");
-        let (line, skipped) = run_planned_skipping(one, p, g, &Bars::Own(args.quiet))?;
+        let (line, skipped) = match run_planned_skipping(one, p, g, &Bars::Own(args.quiet)) {
+            Ok(r) => r,
+            // Lost before any run of this scene completed: the earlier scenes' runs are
+            // still published, this scene's listed as not completed.
+            Err(e @ Error::DeviceLost { .. }) => {
+                for t in &p.techniques {
+                    ran.push((unit(p, t), format!("skipped: not completed: {e}")));
+                }
+                lines.push(format!("{}: not completed: {e}", p.desc.name));
+                lost = Some(e);
+                continue;
+            }
+            Err(e) => return Err(e),
+        };
         lines.push(line);
         lost = lost.or(gibench_harness::run::session::device_lost(&skipped));
         for t in &p.techniques {
@@ -585,7 +598,12 @@ fn skipped_file(scene: &str) -> String {
 /// The work of `gibench run` once planned and its output set is open: runs, tables, plots.
 /// Returns what it wrote, as a line for the terminal.
 pub fn run_planned(args: &RunArgs, plan: &Plan, gpu: &GpuContext, bars: &Bars) -> Result<String> {
-    run_planned_skipping(args, plan, gpu, bars).map(|(done, _)| done)
+    let (done, skipped) = run_planned_skipping(args, plan, gpu, bars)?;
+    // A target of `reproduce all` is complete only with every run: a lost device fails it.
+    match gibench_harness::run::session::device_lost(&skipped) {
+        Some(e) => Err(e),
+        None => Ok(done),
+    }
 }
 
 /// With `--equal-time`: a technique whose run measured its frame off the mark

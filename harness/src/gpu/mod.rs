@@ -282,8 +282,16 @@ impl GpuContext {
                 submission_index: index.clone(),
                 timeout: Some(WAIT_SLICE),
             };
-            let polled = self.device.poll(poll);
             self.check_lost()?;
+            // wgpu 30 panics in `poll` on a device lost while waiting (an error it cannot map
+            // to a PollError); the lost callback has run by then, so that panic is the loss.
+            let polled =
+                std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| self.device.poll(poll)));
+            self.check_lost()?;
+            let polled = match polled {
+                Ok(p) => p,
+                Err(panic) => std::panic::resume_unwind(panic),
+            };
             match polled {
                 Ok(_) => return Ok(()),
                 Err(wgpu::PollError::Timeout) => {
@@ -339,6 +347,14 @@ impl GpuContext {
     /// Turns a lost device, or GPU validation errors collected so far, into an error.
     pub fn check_errors(&self) -> Result<()> {
         self.check_lost()?;
+        if self.errors.lock().is_ok_and(|v| !v.is_empty()) {
+            // Errors from a device just lost ("device is invalid") come before its lost
+            // callback, which runs on the next poll: give it the chance to say so.
+            let _ = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                self.device.poll(wgpu::PollType::Poll)
+            }));
+            self.check_lost()?;
+        }
         let mut v = self
             .errors
             .lock()

@@ -37,6 +37,8 @@ use crate::{Error, Result};
 const LOCK: &str = ".gibench.lock";
 const STAGING: &str = ".gibench-staging";
 const JOURNAL: &str = ".gibench-publish";
+/// In the staging folder of a set opened with [`OutputSet::resume`].
+const RESUMABLE: &str = ".gibench-resumable";
 
 /// The open set's folder (absolute, lexically normalised), its staged files (relative), the
 /// subfolders it replaces and the file patterns it replaces in the folder itself.
@@ -289,9 +291,13 @@ impl OutputSet {
             created,
             lock: Some(lock),
         };
+        let resuming = keep.is_some();
         let kept = recover(dir, keep)?;
         let staging = dir.join(STAGING);
         std::fs::create_dir_all(&staging).map_err(|e| Error::io(&staging, e))?;
+        if resuming {
+            write_atomic_direct(&staging.join(RESUMABLE), b"staged by a resumable set\n")?;
+        }
         let mut active = ACTIVE
             .lock()
             .map_err(|_| fail("output state poisoned".into()))?;
@@ -461,6 +467,11 @@ impl OutputSet {
 
 impl Drop for OutputSet {
     fn drop(&mut self) {
+        // Unwinding from a panic: what was staged stays for a resume, as after a kill (the
+        // next command into the folder decides what to do with it).
+        if std::thread::panicking() {
+            self.suspended = true;
+        }
         if !self.published && !self.suspended {
             if let Ok(mut active) = ACTIVE.lock() {
                 *active = None;
@@ -631,10 +642,14 @@ fn recover(dir: &Path, keep: Option<&mut Keep>) -> Result<Vec<PathBuf>> {
     }
     let staging = dir.join(STAGING);
     let mut kept = Vec::new();
+    // Only a set opened with `resume` marks its staging folder resumable: files another
+    // command staged there (and was killed before publishing) are never taken over.
+    let resumable = staging.join(RESUMABLE).is_file();
     match keep {
-        Some(keep) if !finishing && staging.is_dir() => {
+        Some(keep) if !finishing && resumable && staging.is_dir() => {
             let mut present = Vec::new();
             files_below(&staging, Path::new(""), &mut present);
+            present.retain(|p| p != Path::new(RESUMABLE));
             let wanted = keep(&present);
             for rel in &present {
                 if !wanted.contains(rel) {

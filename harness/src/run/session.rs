@@ -230,6 +230,8 @@ pub fn execute_skipping(
         ));
         match ready {
             Ok(p) => prepared.push((run, p)),
+            // A lost device is not a technique that does not fit: nothing more can run.
+            Err(e @ Error::DeviceLost { .. }) => return Err(e),
             Err(e) if skip_unfit => skipped.push(Skipped {
                 technique: run.info.name.to_string(),
                 reason: e.to_string(),

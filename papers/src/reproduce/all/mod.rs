@@ -141,12 +141,19 @@ pub fn reproduce(args: &ReproduceArgs) -> Result<()> {
         (&set, &checkpoint, resumed),
         args.quiet,
     ) {
-        // Stopped by a signal or a lost device: the completed targets stay staged for a resume.
-        Err(e @ (Error::Interrupted { .. } | Error::DeviceLost { .. })) => {
+        // Stopped by a signal or a lost device, or failed: the completed targets stay staged
+        // for a resume (the same command again).
+        Err(e) => {
             set.suspend();
+            if !matches!(e, Error::Interrupted { .. } | Error::DeviceLost { .. }) {
+                eprintln!(
+                    "gibench reproduce all: the targets completed before this error are kept \
+                     (staged); run the same command again to resume"
+                );
+            }
             return Err(e);
         }
-        other => other?,
+        Ok(r) => r,
     };
     let estimate: Option<f64> = estimates.iter().copied().sum();
     let mut manifest = Manifest::new(

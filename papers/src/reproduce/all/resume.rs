@@ -116,11 +116,18 @@ impl Checkpoint {
         let mut resumed: Vec<Option<Record>> = self.names.iter().map(|_| None).collect();
         let mut keep = Vec::new();
         let path = self.root.join(PARTIAL);
-        let Some(partial) = gibench_harness::error::read_bounded(&path, 64 << 20)
-            .ok()
-            .and_then(|b| serde_json::from_slice::<Partial>(&b).ok())
-        else {
-            return (keep, resumed);
+        let partial = gibench_harness::error::read_bounded(&path, 64 << 20).and_then(|b| {
+            serde_json::from_slice::<Partial>(&b)
+                .map_err(|e| gibench_harness::Error::bad_file(&path, e.to_string()))
+        });
+        let partial = match partial {
+            Ok(p) => p,
+            Err(e) => {
+                if path.exists() {
+                    eprintln!("gibench reproduce all: not resuming, every target runs again: {e}");
+                }
+                return (keep, resumed);
+            }
         };
         for d in &partial.done {
             let Some(i) = self.names.iter().position(|n| *n == d.record.name) else {
