@@ -14,7 +14,7 @@ use gibench_harness::{Error, Result};
 
 use crate::page::{page_line, with_folder, write_page};
 use crate::params::assign_params;
-use crate::progress::{execute_with_bar, Bars};
+use crate::progress::{execute_skipping_with_bar, Bars};
 use crate::registry;
 use crate::run::{announcement, open_gpu, plan, settings, weigh_equally, Plan, RunArgs};
 use crate::shard::{own_units, ShardRecord};
@@ -73,14 +73,23 @@ pub fn exec(args: &SweepArgs) -> Result<()> {
         let stem = summary_stem(&first.desc.name, first.techniques[0].name, &planned.name);
         stale = replace_sweep_files(&set, &args.run.out, &stem)?;
     }
+    let mut lost = None;
     if let Some(mut record) = record {
         let mut done = "this shard has no points to run".to_string();
         if !planned.plans.is_empty() {
             let prefix = planned.point_prefix();
             let gpu = open_gpu(&args.run)?;
-            done = sweep_planned(args, &planned, &gpu, &Bars::Own(args.run.quiet))?;
-            record.ran = (planned.values.iter())
-                .map(|v| (v.clone(), format!("{prefix}{v}.json")))
+            let (line, completed, e) =
+                sweep_planned_keeping(args, &planned, &gpu, &Bars::Own(args.run.quiet))?;
+            (done, lost) = (line, e);
+            record.ran = (planned.values.iter().enumerate())
+                .map(|(i, v)| match i < completed {
+                    true => (v.clone(), format!("{prefix}{v}.json")),
+                    false => (
+                        v.clone(),
+                        "skipped: not completed: the GPU device was lost".into(),
+                    ),
+                })
                 .collect();
         }
         record.write(&args.run.out)?;
@@ -89,16 +98,16 @@ pub fn exec(args: &SweepArgs) -> Result<()> {
         if let Some(note) = crate::run::removed_note(&stale) {
             eprintln!("{note}");
         }
-        return Ok(());
+        return lost.map_or(Ok(()), Err);
     }
     let gpu = open_gpu(&args.run)?;
-    let done = sweep_planned(args, &planned, &gpu, &Bars::Own(args.run.quiet))?;
+    let (done, _, lost) = sweep_planned_keeping(args, &planned, &gpu, &Bars::Own(args.run.quiet))?;
     set.publish()?;
     eprintln!("{done}");
     if let Some(note) = crate::run::removed_note(&stale) {
         eprintln!("{note}");
     }
-    Ok(())
+    lost.map_or(Ok(()), Err)
 }
 
 /// A sweep checked before it runs: the parameter, its values and one plan per value.
@@ -268,13 +277,27 @@ fn check_distinct_values(info: &TechniqueInfo, name: &str, values: &[String]) ->
 }
 
 /// The work of `gibench sweep` once planned and its output set is open. Returns what it
-/// wrote, as a line for the terminal.
+/// wrote, as a line for the terminal; a lost device fails it (a target of `reproduce all` is
+/// complete only with every point).
 pub fn sweep_planned(
     args: &SweepArgs,
     planned: &SweepPlan,
     gpu: &GpuContext,
     bars: &Bars,
 ) -> Result<String> {
+    let (done, _, lost) = sweep_planned_keeping(args, planned, gpu, bars)?;
+    lost.map_or(Ok(done), Err)
+}
+
+/// [`sweep_planned`], keeping the points completed before a lost device: their files and a
+/// table of them are written; returns the line, how many points completed (the first ones),
+/// and the lost device's error for the command to fail with once it has published them.
+pub fn sweep_planned_keeping(
+    args: &SweepArgs,
+    planned: &SweepPlan,
+    gpu: &GpuContext,
+    bars: &Bars,
+) -> Result<(String, usize, Option<Error>)> {
     let SweepPlan {
         name,
         values,
@@ -285,7 +308,14 @@ pub fn sweep_planned(
     let info = first.techniques[0];
     let spec = planned.spec(args);
     bars.note(&announcement(first, gpu));
-    let runs = execute_with_bar(bars, gpu, &spec)?;
+    let (runs, skipped) = execute_skipping_with_bar(bars, gpu, &spec, false)?;
+    let lost = gibench_harness::run::session::device_lost(&skipped);
+    if runs.is_empty() {
+        if let Some(e) = lost {
+            return Err(e);
+        }
+    }
+    let completed = runs.len();
     let points: Vec<(String, RunResult)> = values.iter().cloned().zip(runs).collect();
     let (table, figures, stem) = write_summary(
         &points,
@@ -319,7 +349,13 @@ pub fn sweep_planned(
         )?;
         done.push_str(&page_line(&page));
     }
-    Ok(done)
+    if let Some(e) = &lost {
+        done.push_str(&format!(
+            "\nnot completed: {name}={} ({e}); the table holds the points before it",
+            values[completed..].join(",")
+        ));
+    }
+    Ok((done, completed, lost))
 }
 
 /// The table and plots of a sweep of `technique` on `scene` over `name` from its `points`

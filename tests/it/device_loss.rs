@@ -1,8 +1,8 @@
 //! A lost GPU device (a driver reset, a GPU timeout) mid-run, on every portable backend
 //! present: the device is destroyed on purpose (`GIBENCH_TEST_LOSE_DEVICE=TECHNIQUE:FRAME`).
 //! The command fails with an error naming the technique, the frame and the stage, writes the
-//! runs completed before it and lists the one that did not complete; `reproduce all` keeps its
-//! completed targets for a resume. No panic, no hang.
+//! runs (or a sweep's points) completed before it and lists the one that did not complete;
+//! `reproduce all` keeps its completed targets for a resume. No panic, no hang.
 
 use std::path::Path;
 use std::process::Output;
@@ -38,11 +38,17 @@ fn lost_run(lose: &str, args: &[&str], out: &Path) -> Output {
 /// success reported after a loss.
 #[test]
 fn a_lost_device_names_where_and_keeps_the_completed_runs() {
-    for backend in gibench_test_support::gpu::backends_for("device_loss") {
+    let backends = gibench_test_support::gpu::backends_for("device_loss");
+    // Lost in the stage-timing pass (each stage waited for) and in the frame-timing pass
+    // (frames in flight, found at a timestamp readback).
+    for (backend, lose) in backends
+        .iter()
+        .flat_map(|b| [(*b, "keller-full:4"), (*b, "keller-full:4:2")])
+    {
         let tmp = tempfile::tempdir().unwrap();
         let out = tmp.path().join("run");
         let o = lost_run(
-            "keller-full:4",
+            lose,
             &[
                 "run",
                 "--technique",
@@ -57,12 +63,12 @@ fn a_lost_device_names_where_and_keeps_the_completed_runs() {
             &out,
         );
         let err = String::from_utf8_lossy(&o.stderr);
-        assert_eq!(o.status.code(), Some(1), "{backend}:\n{err}");
-        assert!(!err.contains("panicked"), "{backend}:\n{err}");
+        assert_eq!(o.status.code(), Some(1), "{backend} {lose}:\n{err}");
+        assert!(!err.contains("panicked"), "{backend} {lose}:\n{err}");
         assert!(
             err.contains("error: the GPU device was lost")
                 && err.contains("at keller-full's frame 4, stage '"),
-            "{backend}: the error does not say where:\n{err}"
+            "{backend} {lose}: the error does not say where:\n{err}"
         );
         assert!(
             out.join("cornell-direct.json").is_file(),
@@ -76,6 +82,42 @@ fn a_lost_device_names_where_and_keeps_the_completed_runs() {
         let summary = std::fs::read_to_string(out.join("cornell-summary.md")).unwrap();
         assert!(summary.contains("keller-full") && summary.contains("device was lost"));
     }
+}
+
+/// Catches: a sweep that loses its completed points with the device (nothing written), or
+/// writes the lost point's, or reports success.
+#[test]
+fn a_sweep_keeps_the_points_before_a_lost_device() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("sweep");
+    let o = lost_run(
+        "keller-full:4:2",
+        &[
+            "sweep",
+            "--technique",
+            "keller-full",
+            "--sweep",
+            "vpls=16,32,64",
+            "--timing",
+            "stages",
+            "--frames",
+            "3",
+            "--resolution",
+            "64x48",
+        ],
+        &out,
+    );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("at keller-full's frame 4, stage '"), "{err}");
+    assert!(err.contains("not completed: vpls=32,64"), "{err}");
+    assert!(
+        out.join("cornell-keller-full-vpls-16.json").is_file(),
+        "{err}"
+    );
+    assert!(!out.join("cornell-keller-full-vpls-32.json").exists());
+    let table = std::fs::read_to_string(out.join("cornell-keller-full-sweep-vpls.md")).unwrap();
+    assert!(table.contains("16") && !table.contains("| 64 "), "{table}");
 }
 
 /// Catches: `reproduce all` that drops its completed targets on a lost device (the rerun

@@ -43,9 +43,7 @@ pub fn read_texture(gpu: &GpuContext, texture: &wgpu::Texture) -> Result<Vec<u8>
     let slice = buffer.slice(..);
     slice.map_async(wgpu::MapMode::Read, |_| {});
     gpu.flush()?;
-    let mapped = slice
-        .get_mapped_range()
-        .map_err(|e| Error::Gpu(format!("mapping a readback buffer failed: {e}")))?;
+    let mapped = gpu.mapped(&slice, "a readback buffer")?;
     let mut out = Vec::with_capacity((row * h) as usize);
     for y in 0..h {
         let start = (y * padded) as usize;
@@ -71,10 +69,7 @@ pub fn read_buffer(gpu: &GpuContext, buffer: &wgpu::Buffer) -> Result<Vec<u8>> {
     let slice = staging.slice(..);
     slice.map_async(wgpu::MapMode::Read, |_| {});
     gpu.flush()?;
-    let bytes = slice
-        .get_mapped_range()
-        .map_err(|e| Error::Gpu(format!("mapping a readback buffer failed: {e}")))?
-        .to_vec();
+    let bytes = gpu.mapped(&slice, "a readback buffer")?.to_vec();
     staging.unmap();
     Ok(bytes)
 }

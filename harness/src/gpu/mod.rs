@@ -332,16 +332,43 @@ impl GpuContext {
         }
     }
 
-    /// A test hook: `GIBENCH_TEST_LOSE_DEVICE=TECHNIQUE:FRAME` destroys the device before
-    /// TECHNIQUE's frame FRAME, as a driver reset would lose it (tests/it/device_loss.rs).
+    /// A test hook: `GIBENCH_TEST_LOSE_DEVICE=TECHNIQUE:FRAME[:NTH]` destroys the device before
+    /// TECHNIQUE's frame FRAME (the NTH time it comes, 1 by default: a sweep's second point),
+    /// as a driver reset would lose it (tests/it/device_loss.rs).
     pub fn test_lose_device(&self, technique: &str, frame: u32) {
+        static SEEN: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
         let Ok(v) = std::env::var("GIBENCH_TEST_LOSE_DEVICE") else {
             return;
         };
-        if v.split_once(':') == Some((technique, frame.to_string().as_str())) {
+        let mut parts = v.split(':');
+        let (t, f) = (parts.next(), parts.next());
+        let nth: u32 = parts.next().and_then(|n| n.parse().ok()).unwrap_or(1);
+        if t == Some(technique)
+            && f == Some(frame.to_string().as_str())
+            && SEEN.fetch_add(1, std::sync::atomic::Ordering::SeqCst) + 1 == nth
+        {
             eprintln!("GIBENCH_TEST_LOSE_DEVICE: destroying the device before {technique}'s frame {frame} (a test hook)");
             self.device.destroy();
         }
+    }
+
+    /// The mapped contents of `slice` (mapped with `map_async` and waited for); a failure is
+    /// the lost device's error where the device is lost (its callback runs on a poll), else
+    /// one naming `what` was read back.
+    pub fn mapped(&self, slice: &wgpu::BufferSlice<'_>, what: &str) -> Result<wgpu::BufferView> {
+        slice.get_mapped_range().map_err(|e| {
+            // A destroyed device says so once its queue has drained: wait for that (bounded).
+            let _ = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                self.device.poll(wgpu::PollType::Wait {
+                    submission_index: None,
+                    timeout: Some(WAIT_SLICE),
+                })
+            }));
+            match self.check_errors() {
+                Err(first) => first,
+                Ok(()) => Error::Gpu(format!("mapping {what} failed: {e}")),
+            }
+        })
     }
 
     /// Turns a lost device, or GPU validation errors collected so far, into an error.

@@ -488,9 +488,7 @@ impl Profiler {
                 slice.map_async(wgpu::MapMode::Read, |_| {});
                 gpu.flush()?;
                 let ticks: Vec<u64> = bytemuck::pod_collect_to_vec(
-                    &slice.get_mapped_range().map_err(|e| {
-                        crate::Error::Gpu(format!("mapping a readback buffer failed: {e}"))
-                    })?[..],
+                    &gpu.mapped(&slice, "a timestamp readback buffer")?[..],
                 );
                 ts.readback[0].unmap();
                 if self.recording {
@@ -557,9 +555,7 @@ impl Profiler {
         slice.map_async(wgpu::MapMode::Read, |_| {});
         gpu.wait_for(done)?;
         let span = {
-            let mapped = slice.get_mapped_range().map_err(|e| {
-                crate::Error::Gpu(format!("mapping a timestamp readback buffer failed: {e}"))
-            })?;
+            let mapped = gpu.mapped(&slice, "a timestamp readback buffer")?;
             let ticks: &[u64] = bytemuck::cast_slice(&mapped[..]);
             GpuFrameSpan::of(
                 queries

@@ -328,11 +328,8 @@ impl BoundKernels {
         let slice = readback.slice(..);
         slice.map_async(wgpu::MapMode::Read, |_| {});
         gpu.flush()?;
-        let ticks: Vec<u64> = bytemuck::pod_collect_to_vec(
-            &slice
-                .get_mapped_range()
-                .map_err(|e| Error::Gpu(format!("mapping a readback buffer failed: {e}")))?[..],
-        );
+        let ticks: Vec<u64> =
+            bytemuck::pod_collect_to_vec(&gpu.mapped(&slice, "a readback buffer")?[..]);
         readback.unmap();
         let ms = ticks[1].saturating_sub(ticks[0]) as f64 * period_ns * 1e-6;
         Ok(Timed { ms, wall_ms })

@@ -305,12 +305,8 @@ impl GBuffer {
         let slice = readback.slice(..);
         slice.map_async(wgpu::MapMode::Read, |_| {});
         gpu.flush()?;
-        let data: Vec<f32> = bytemuck::pod_collect_to_vec(
-            &slice
-                .get_mapped_range()
-                .map_err(|e| crate::Error::Gpu(format!("mapping a readback buffer failed: {e}")))?
-                [..],
-        );
+        let data: Vec<f32> =
+            bytemuck::pod_collect_to_vec(&gpu.mapped(&slice, "a readback buffer")?[..]);
         readback.unmap();
         if data.len() != (w * h * 12) as usize {
             return Err(Error::Gpu("G-buffer export returned the wrong size".into()));
