@@ -9,6 +9,7 @@
 #   bash results/regenerate.sh barczak-scenes  # only barczak on Sibenik, Sponza, Maze and the conference room
 #   bash results/regenerate.sh roofline        # only the stage-efficiency runs (docs/roofline.md)
 #   bash results/regenerate.sh lean            # only the lean stages' before/after (results/lean)
+#   bash results/regenerate.sh fuzz            # only the fuzz campaign (results/fuzz)
 #
 # Paper-size runs (`gibench reproduce all` without --quick) are for a GPU and are not part of
 # this script.
@@ -62,6 +63,7 @@ elif [ "$only" != baseline ]; then
   case "results/roofline/" in "results/$only"*) scenes_only=1 ;; esac
   case "results/ism/vpl-counts" in "results/$only"*) scenes_only=1 ;; esac
   case "results/lean/" in "results/$only"*) scenes_only=1 ;; esac
+  case "results/fuzz/" in "results/$only"*) scenes_only=1 ;; esac
   if [ -n "$targets" ]; then
     reproduce "$targets"
   elif [ "$transfer_only" = 0 ] && [ "$scenes_only" = 0 ]; then
@@ -112,5 +114,19 @@ if [ -z "$only" ] || case "results/lean/" in "results/$only"*) true ;; *) false 
       --technique keller-full,keller-incremental,laine,ism,ism-classic,barczak --backend vulkan \
       --resolution "$res" --frames 10 --warmup 3 --no-images
   done
+fi
+# The fuzz campaign (docs/output.md, "Fuzzing"): 200,000 inputs a target, 40,000 for the
+# manifests (each pooled by a merge that writes files), about 15 minutes on 2 cores.
+if [ -z "$only" ] || case "results/fuzz/" in "results/$only"*) true ;; *) false ;; esac; then
+  echo "== GIBENCH_FUZZ_CASES=200000 cargo test --release --test fuzz"
+  mkdir -p results/fuzz
+  {
+    echo "# fuzz campaign: gibench $(git rev-parse --short HEAD), $(date -u +%Y-%m-%d), $(nproc) cores, 2 test threads"
+    echo "# GIBENCH_FUZZ_CASES=200000 cargo test --release --test fuzz -- --nocapture --test-threads 2 --skip manifest"
+    GIBENCH_FUZZ_CASES=200000 cargo test --release --quiet --test fuzz -- --nocapture --test-threads 2 --skip manifest | grep '^fuzz '
+    echo "# GIBENCH_FUZZ_CASES=40000 cargo test --release --test fuzz -- --nocapture manifest"
+    GIBENCH_FUZZ_CASES=40000 cargo test --release --quiet --test fuzz -- --nocapture manifest | grep '^fuzz '
+  } > results/fuzz/campaign.txt.new
+  mv results/fuzz/campaign.txt.new results/fuzz/campaign.txt
 fi
 echo "regenerate.sh: done"
