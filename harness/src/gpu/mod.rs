@@ -56,6 +56,9 @@ pub struct GpuContext {
     /// Set by the device-lost callback: the reason and the driver's message.
     lost: Arc<Mutex<Option<String>>>,
     wait_limit: Option<Duration>,
+    /// `GIBENCH_TEST_LOSE_DEVICE`, parsed once ([`GpuContext::test_lose_device`]): technique,
+    /// frame, which occurrence, and the occurrences seen.
+    lose_hook: Option<(String, u32, u32, std::sync::atomic::AtomicU32)>,
 }
 
 /// The environment variable the command line reads `--backend` from when it is not given.
@@ -256,6 +259,15 @@ impl GpuContext {
             errors,
             lost,
             wait_limit,
+            lose_hook: std::env::var("GIBENCH_TEST_LOSE_DEVICE")
+                .ok()
+                .and_then(|v| {
+                    let mut parts = v.split(':');
+                    let technique = parts.next()?.to_string();
+                    let frame = parts.next()?.parse().ok()?;
+                    let nth = parts.next().and_then(|n| n.parse().ok()).unwrap_or(1);
+                    Some((technique, frame, nth, Default::default()))
+                }),
         })
     }
 
@@ -336,16 +348,12 @@ impl GpuContext {
     /// TECHNIQUE's frame FRAME (the NTH time it comes, 1 by default: a sweep's second point),
     /// as a driver reset would lose it (tests/it/device_loss.rs).
     pub fn test_lose_device(&self, technique: &str, frame: u32) {
-        static SEEN: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
-        let Ok(v) = std::env::var("GIBENCH_TEST_LOSE_DEVICE") else {
+        let Some((t, f, nth, seen)) = &self.lose_hook else {
             return;
         };
-        let mut parts = v.split(':');
-        let (t, f) = (parts.next(), parts.next());
-        let nth: u32 = parts.next().and_then(|n| n.parse().ok()).unwrap_or(1);
-        if t == Some(technique)
-            && f == Some(frame.to_string().as_str())
-            && SEEN.fetch_add(1, std::sync::atomic::Ordering::SeqCst) + 1 == nth
+        if t == technique
+            && *f == frame
+            && seen.fetch_add(1, std::sync::atomic::Ordering::SeqCst) + 1 == *nth
         {
             eprintln!("GIBENCH_TEST_LOSE_DEVICE: destroying the device before {technique}'s frame {frame} (a test hook)");
             self.device.destroy();
