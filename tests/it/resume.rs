@@ -6,6 +6,8 @@ use std::collections::BTreeSet;
 use std::io::Read;
 use std::path::Path;
 use std::process::Child;
+use std::sync::{Arc, Mutex};
+use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 use crate::fleet::{assert_same_tables, manifest, start};
@@ -45,24 +47,58 @@ fn wait_beyond(child: &mut Child, out: &Path, n: usize) {
     }
 }
 
-/// Ends `child` with `signal` (9 or 15) and returns its standard error and its status.
-fn stop(mut child: Child, signal: i32) -> (String, std::process::ExitStatus) {
-    let pid = child.id().to_string();
-    let ok = std::process::Command::new("kill")
-        .args([format!("-{signal}"), pid])
-        .status()
-        .unwrap()
-        .success();
-    assert!(ok, "kill -{signal} failed");
-    let status = child.wait().unwrap();
-    let mut err = String::new();
-    child
-        .stderr
-        .take()
-        .unwrap()
-        .read_to_string(&mut err)
-        .unwrap();
-    (err, status)
+/// A run whose standard error is read as it is written.
+struct Running {
+    child: Child,
+    err: Arc<Mutex<String>>,
+    reader: JoinHandle<()>,
+}
+
+impl Running {
+    fn new(mut child: Child) -> Self {
+        let mut pipe = child.stderr.take().unwrap();
+        let err = Arc::new(Mutex::new(String::new()));
+        let sink = Arc::clone(&err);
+        let reader = std::thread::spawn(move || {
+            let mut buf = [0u8; 4096];
+            while let Ok(n @ 1..) = pipe.read(&mut buf) {
+                sink.lock()
+                    .unwrap()
+                    .push_str(&String::from_utf8_lossy(&buf[..n]));
+            }
+        });
+        Self { child, err, reader }
+    }
+
+    /// Waits until the run has printed `text`; panics if it ends first.
+    fn wait_for(&mut self, text: &str) {
+        let began = Instant::now();
+        while !self.err.lock().unwrap().contains(text) {
+            if let Some(status) = self.child.try_wait().unwrap() {
+                panic!("the run ended ({status}) before it printed {text:?}");
+            }
+            assert!(
+                began.elapsed() < Duration::from_secs(600),
+                "no {text:?} in 10 minutes"
+            );
+            std::thread::sleep(Duration::from_millis(5));
+        }
+    }
+
+    /// Ends the run with `signal` (9 or 15) and returns its standard error and its status.
+    fn stop(mut self, signal: i32) -> (String, std::process::ExitStatus) {
+        let pid = self.child.id().to_string();
+        let ok = std::process::Command::new("kill")
+            .args([format!("-{signal}"), pid])
+            .status()
+            .unwrap()
+            .success();
+        assert!(ok, "kill -{signal} failed");
+        let status = self.child.wait().unwrap();
+        self.reader.join().unwrap();
+        let err = self.err.lock().unwrap().clone();
+        (err, status)
+    }
 }
 
 /// The targets a run's standard error says it ran to the end.
@@ -90,16 +126,17 @@ fn killed_and_stopped_runs_resume_to_the_uninterrupted_tables() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 
     let mut reports = Vec::new();
-    // SIGKILL once a target is complete, SIGKILL while starting (nothing new complete),
-    // SIGKILL just after the next target completes, then SIGTERM likewise.
+    // SIGKILL once a target is complete, SIGKILL while starting (once the completed targets
+    // are taken over: a slow machine may take seconds to get there), SIGKILL just after the
+    // next target completes, then SIGTERM likewise.
     for (signal, after) in [(9, Some(0)), (9, None), (9, Some(1)), (15, Some(2))] {
         let before = complete(&out);
-        let mut child = start(ONLY, &out, &[]);
+        let mut run = Running::new(start(ONLY, &out, &[]));
         match after {
-            Some(n) => wait_beyond(&mut child, &out, n.max(before.len())),
-            None => std::thread::sleep(Duration::from_millis(300)),
+            Some(n) => wait_beyond(&mut run.child, &out, n.max(before.len())),
+            None => run.wait_for("complete there are kept"),
         }
-        let (err, status) = stop(child, signal);
+        let (err, status) = run.stop(signal);
         assert!(
             !status.success(),
             "the run ended before it was stopped:\n{err}"
