@@ -42,6 +42,11 @@ pub enum Error {
 pub type Result<T> = std::result::Result<T, Error>;
 
 impl Error {
+    /// Whether the error ends the whole command, not one run, value or target: a signal
+    /// (SIGTERM, SIGINT) or a lost device, after which nothing more can run.
+    pub fn stops_everything(&self) -> bool {
+        matches!(self, Error::Interrupted { .. } | Error::DeviceLost { .. })
+    }
     /// Shorthand for [`Error::BadFile`].
     pub fn bad_file(path: impl Into<PathBuf>, message: impl Into<String>) -> Self {
         Error::BadFile {

@@ -61,12 +61,6 @@ pub fn parse_budget(s: &str) -> Result<f64> {
     }
 }
 
-/// An error that ends the whole command, not one value of a search: a signal (SIGTERM,
-/// SIGINT) or a lost device.
-fn fatal(e: &Error) -> bool {
-    matches!(e, Error::Interrupted { .. } | Error::DeviceLost { .. })
-}
-
 /// One timed step of a search: the value tried and its frame time (infinite where the run
 /// failed: `note` says why, e.g. the device cannot hold that many maps), the median of its
 /// `timings` (one, or [`REPEATS`] for a value the search was about to keep, and then one more
@@ -150,7 +144,7 @@ pub fn search_on(
                     note: None,
                 }),
                 // A signal or a lost device ends the search, not just this value.
-                Err(e) if fatal(&e) => return Err(e),
+                Err(e) if e.stops_everything() => return Err(e),
                 Err(e) => {
                     let mut r = (lo, hi);
                     narrow(&steps, v, &mut r);
@@ -194,7 +188,7 @@ pub fn search_on(
                 while s.timings.len() < REPEATS {
                     match measure(s.value) {
                         Ok(ms) => s.timings.push(ms),
-                        Err(e) if fatal(&e) => return Err(e),
+                        Err(e) if e.stops_everything() => return Err(e),
                         Err(e) => {
                             s.note = Some(e.to_string());
                             s.timings.clear();
@@ -525,7 +519,7 @@ fn tune(
         Ok(ms)
     };
     let found = search_on((min, max), start, budget, prior, &mut measure).map_err(|e| {
-        if fatal(&e) {
+        if e.stops_everything() {
             return e;
         }
         Error::Invalid(format!("{}: no {} ran: {e}", info.name, knob.param))

@@ -145,7 +145,7 @@ pub fn reproduce(args: &ReproduceArgs) -> Result<()> {
         // for a resume (the same command again).
         Err(e) => {
             set.suspend();
-            if !matches!(e, Error::Interrupted { .. } | Error::DeviceLost { .. }) {
+            if !e.stops_everything() {
                 eprintln!(
                     "gibench reproduce all: the targets completed before this error are kept \
                      (staged); run the same command again to resume"
@@ -439,7 +439,7 @@ fn run_targets(
             Ok(done) => done,
             // A signal, or a lost device (no later target could run either): the completed
             // targets stay staged for a resume.
-            Err(e @ (Error::Interrupted { .. } | Error::DeviceLost { .. })) => {
+            Err(e) if e.stops_everything() => {
                 overall.finish();
                 set.rollback(mark)?;
                 return Err(stopped(e, checkpoint, &records));
