@@ -9,6 +9,7 @@
 #   bash results/regenerate.sh barczak-scenes  # only barczak on Sibenik, Sponza, Maze and the conference room
 #   bash results/regenerate.sh roofline        # only the stage-efficiency runs (docs/roofline.md)
 #   bash results/regenerate.sh lean            # only the lean stages' before/after (results/lean)
+#   bash results/regenerate.sh lean/rejected   # only the changes measured and not taken (results/lean/rejected)
 #   bash results/regenerate.sh fuzz            # only the fuzz campaign (results/fuzz)
 #
 # Paper-size runs (`gibench reproduce all` without --quick) are for a GPU and are not part of
@@ -113,6 +114,30 @@ if [ -z "$only" ] || case "results/lean/" in "results/$only"*) true ;; *) false 
     bash scripts/ab.sh 264d5f0 HEAD "results/lean/$res" --ignore-param submission -- \
       --technique keller-full,keller-incremental,laine,ism,ism-classic,barczak --backend vulkan \
       --resolution "$res" --frames 10 --warmup 3 --no-images
+  done
+fi
+# Changes measured and not taken (docs/roofline.md): each patch in results/lean/rejected is
+# applied to this commit and committed in a worktree of its own, then timed against this commit
+# by scripts/ab.sh (`ism`, five alternating repeats at 256x192 and 512x384).
+if [ -z "$only" ] || case "results/lean/rejected/" in "results/$only"*) true ;; *) false ;; esac; then
+  for patch in results/lean/rejected/*.patch; do
+    name=$(basename "$patch" .patch)
+    tree="${CARGO_TARGET_DIR:-target}/ab/rejected-$name"
+    git worktree remove --force "$tree" 2>/dev/null || rm -rf "$tree"
+    git worktree add --quiet --detach "$tree" HEAD
+    git -C "$tree" apply "$PWD/$patch" ||
+      { echo "regenerate.sh: $patch does not apply to $(git rev-parse --short HEAD)" >&2; exit 1; }
+    git -C "$tree" add -A
+    git -C "$tree" -c user.name=regenerate.sh -c user.email=regenerate.sh@localhost \
+      commit --quiet -m "rejected: $name (results/lean/rejected/$name.patch on $(git rev-parse --short HEAD))"
+    commit=$(git -C "$tree" rev-parse HEAD)
+    git worktree remove --force "$tree"
+    for res in 256x192 512x384; do
+      echo "== bash scripts/ab.sh HEAD $commit results/lean/rejected/$name/$res"
+      rm -rf "results/lean/rejected/$name/$res"
+      bash scripts/ab.sh HEAD "$commit" "results/lean/rejected/$name/$res" -- \
+        --technique ism --backend vulkan --resolution "$res" --frames 10 --warmup 3 --no-images
+    done
   done
 fi
 # The fuzz campaign (docs/output.md, "Fuzzing"): 200,000 inputs a target, 40,000 for the
