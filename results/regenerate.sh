@@ -64,6 +64,7 @@ elif [ "$only" != baseline ]; then
   case "results/roofline/" in "results/$only"*) scenes_only=1 ;; esac
   case "results/ism/vpl-counts" in "results/$only"*) scenes_only=1 ;; esac
   case "results/lean/" in "results/$only"*) scenes_only=1 ;; esac
+  case "results/lean/rejected/" in "results/$only"*) scenes_only=1 ;; esac
   case "results/fuzz/" in "results/$only"*) scenes_only=1 ;; esac
   if [ -n "$targets" ]; then
     reproduce "$targets"
