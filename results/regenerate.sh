@@ -22,6 +22,8 @@ if [ -n "$(git status --porcelain --untracked-files=no -- . ':(exclude)results')
   exit 1
 fi
 cargo build --release --quiet
+# The commit every step measures, resolved once (a commit made while this runs changes nothing).
+head=$(git rev-parse HEAD)
 g="${CARGO_TARGET_DIR:-target}/release/gibench"
 run() { # run OUTPUT_DIR command... (OUTPUT_DIR is emptied first: no stale files)
   local out="$1"; shift
@@ -110,9 +112,9 @@ run results/roofline/sibenik run --scene sibenik --technique gaitatzes --frames 
 # worktree of its own (scripts/ab.sh). `submission` is barczak's parameter that work added.
 if [ -z "$only" ] || case "results/lean/" in "results/$only"*) true ;; *) false ;; esac; then
   for res in 256x192 512x384; do
-    echo "== bash scripts/ab.sh 264d5f0 HEAD results/lean/$res"
+    echo "== bash scripts/ab.sh 264d5f0 ${head:0:12} results/lean/$res"
     rm -rf "results/lean/$res"
-    bash scripts/ab.sh 264d5f0 HEAD "results/lean/$res" --ignore-param submission -- \
+    bash scripts/ab.sh 264d5f0 "$head" "results/lean/$res" --ignore-param submission -- \
       --technique keller-full,keller-incremental,laine,ism,ism-classic,barczak --backend vulkan \
       --resolution "$res" --frames 10 --warmup 3 --no-images
   done
@@ -125,18 +127,18 @@ if [ -z "$only" ] || case "results/lean/rejected/" in "results/$only"*) true ;; 
     name=$(basename "$patch" .patch)
     tree="${CARGO_TARGET_DIR:-target}/ab/rejected-$name"
     git worktree remove --force "$tree" 2>/dev/null || rm -rf "$tree"
-    git worktree add --quiet --detach "$tree" HEAD
+    git worktree add --quiet --detach "$tree" "$head"
     git -C "$tree" apply "$PWD/$patch" ||
-      { echo "regenerate.sh: $patch does not apply to $(git rev-parse --short HEAD)" >&2; exit 1; }
+      { echo "regenerate.sh: $patch does not apply to ${head:0:12}" >&2; exit 1; }
     git -C "$tree" add -A
     git -C "$tree" -c user.name=regenerate.sh -c user.email=regenerate.sh@localhost \
-      commit --quiet -m "rejected: $name (results/lean/rejected/$name.patch on $(git rev-parse --short HEAD))"
+      commit --quiet -m "rejected: $name (results/lean/rejected/$name.patch on ${head:0:12})"
     commit=$(git -C "$tree" rev-parse HEAD)
     git worktree remove --force "$tree"
     for res in 256x192 512x384; do
-      echo "== bash scripts/ab.sh HEAD $commit results/lean/rejected/$name/$res"
+      echo "== bash scripts/ab.sh ${head:0:12} ${commit:0:12} results/lean/rejected/$name/$res"
       rm -rf "results/lean/rejected/$name/$res"
-      bash scripts/ab.sh HEAD "$commit" "results/lean/rejected/$name/$res" -- \
+      bash scripts/ab.sh "$head" "$commit" "results/lean/rejected/$name/$res" -- \
         --technique ism --backend vulkan --resolution "$res" --frames 10 --warmup 3 --no-images
     done
   done
@@ -147,7 +149,7 @@ if [ -z "$only" ] || case "results/fuzz/" in "results/$only"*) true ;; *) false 
   echo "== GIBENCH_FUZZ_CASES=200000 cargo test --release --test fuzz"
   mkdir -p results/fuzz
   {
-    echo "# fuzz campaign: gibench $(git rev-parse --short HEAD), $(date -u +%Y-%m-%d), $(nproc) cores, 2 test threads"
+    echo "# fuzz campaign: gibench $(git rev-parse --short "$head"), $(date -u +%Y-%m-%d), $(nproc) cores, 2 test threads"
     echo "# GIBENCH_FUZZ_CASES=200000 cargo test --release --test fuzz -- --nocapture --test-threads 2 --skip manifest"
     GIBENCH_FUZZ_CASES=200000 cargo test --release --quiet --test fuzz -- --nocapture --test-threads 2 --skip manifest | grep '^fuzz '
     echo "# GIBENCH_FUZZ_CASES=40000 cargo test --release --test fuzz -- --nocapture manifest"
