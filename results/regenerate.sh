@@ -21,6 +21,14 @@ if [ -n "$(git status --porcelain --untracked-files=no -- . ':(exclude)results')
   echo "regenerate.sh: the checkout has uncommitted changes outside results/; results would record a -dirty commit" >&2
   exit 1
 fi
+# The rejected lean changes (below) are patches to this commit: each must apply, checked before
+# any step runs rather than after an hour of them.
+if [ -z "$only" ] || case "results/lean/rejected/" in "results/$only"*) true ;; *) false ;; esac; then
+  for patch in results/lean/rejected/*.patch; do
+    git apply --check "$patch" ||
+      { echo "regenerate.sh: $patch does not apply to this commit: make it again on it, or drop it" >&2; exit 1; }
+  done
+fi
 cargo build --release --quiet
 # The commit every step measures, resolved once (a commit made while this runs changes nothing).
 head=$(git rev-parse HEAD)
