@@ -1,6 +1,7 @@
 //! The imperfect-shadow-map kit parts (Ritschel et al. 2008) on the GPU, on every portable
-//! backend present: pull-push (both modes) fills a synthetic hole pattern without changing any
-//! texel a point landed on and leaves regions beyond its reach empty; the depth-aware one
+//! backend present: pull-push (both modes) agrees with a CPU model of itself, fills a
+//! synthetic hole pattern without changing any texel a point landed on and leaves regions
+//! beyond its reach empty; the depth-aware one
 //! closes a near surface's holes where a far one shows through; splatting a dense point set of
 //! a plane and pulling-pushing reproduces the plane's exact (classic) paraboloid depth map.
 
@@ -11,7 +12,7 @@ use gibench_harness::cpu::vpl::{frame_from_normal, Vpl};
 use gibench_harness::glam::Vec3;
 use gibench_harness::gpu::GpuContext;
 use gibench_harness::kit::ir::atlas::{AtlasFormat, AtlasSettings, MapKind, ShadowAtlas};
-use gibench_harness::kit::ir::pullpush::{PullPush, PullPushMode, PullPushSettings};
+use gibench_harness::kit::ir::pullpush::{PullPush, PullPushMode, PullPushSettings, SLANT_TAN};
 use gibench_harness::kit::ir::splat::PointSplat;
 use gibench_harness::kit::ir::store::VplStore;
 use gibench_harness::scene::{Mesh, SceneExtent};
@@ -232,6 +233,136 @@ fn pull_push_fills_holes_and_never_changes_a_valid_texel() {
                 let within = x / 8 == lone.0 / 8 && y / 8 == lone.1 / 8;
                 let want = if within { lone.2 } else { 0.0 };
                 assert_eq!(got, want, "{backend} {mode:?}: slot 1 texel ({x}, {y})");
+            }
+        }
+    }
+}
+
+/// The pull-push on the CPU, as the module docs of `pullpush.rs` define it, level by level:
+/// `level0` of `slots` maps of `SIZE`² (reversed depth bits, 0 = empty) in, each map's level 0
+/// after the push out (0 where empty). Level k's intervals are level 0's times 2^k.
+fn pull_push_model(slots: u32, level0: &[u32], s: PullPushSettings) -> Vec<f32> {
+    type Texel = [f32; 2];
+    let aware = s.mode == PullPushMode::DepthAware;
+    let texel = 4.0 / SIZE as f32;
+    let scale = |level: u32| (1u32 << level) as f32;
+    let interval = |front: f32, level: u32| {
+        (s.interval * scale(level)).max(SLANT_TAN * texel * scale(level) * (1.0 - front))
+    };
+    let filled_from = |t: Texel, parent: Texel, level: u32| {
+        let covered = s.interval >= texel * scale(level) * (1.0 - parent[0]);
+        parent[1] > 0.0
+            && (t[1] <= 0.0 || (covered && t[0] < parent[0] - interval(parent[0], level)))
+    };
+    let pushed = |t: Texel, parent: Texel, level: u32| -> Texel {
+        if aware {
+            if filled_from(t, parent, level) {
+                return [parent[0], 1.0];
+            }
+        } else if t[1] < 1.0 && parent[1] > 0.0 {
+            return [t[0] * t[1] + parent[0] * (1.0 - t[1]), 1.0];
+        }
+        t
+    };
+    let mut levels: Vec<Vec<Texel>> = vec![level0
+        .iter()
+        .map(|&b| {
+            let v = f32::from_bits(b);
+            if v > 0.0 {
+                [v, 1.0]
+            } else {
+                [0.0, 0.0]
+            }
+        })
+        .collect()];
+    let at = |edge: u32, slot: u32, x: u32, y: u32| ((slot * edge + y) * edge + x) as usize;
+    for k in 1..=s.levels {
+        let (edge, below) = (SIZE >> k, &levels[k as usize - 1]);
+        let mut level = vec![[0.0f32; 2]; (slots * edge * edge) as usize];
+        for slot in 0..slots {
+            for y in 0..edge {
+                for x in 0..edge {
+                    let children = [(0, 0), (1, 0), (0, 1), (1, 1)]
+                        .map(|(i, j)| below[at(2 * edge, slot, 2 * x + i, 2 * y + j)]);
+                    let front = children
+                        .iter()
+                        .filter(|c| c[1] > 0.0)
+                        .fold(0.0f32, |m, c| m.max(c[0]));
+                    let behind = interval(front, k - 1);
+                    let mut sum = [0.0f32; 2];
+                    for c in children.iter().filter(|c| !aware || c[0] >= front - behind) {
+                        sum = [sum[0] + c[0] * c[1], sum[1] + c[1]];
+                    }
+                    if sum[1] > 0.0 {
+                        level[at(edge, slot, x, y)] = [sum[0] / sum[1], sum[1].min(1.0)];
+                    }
+                }
+            }
+        }
+        levels.push(level);
+    }
+    for k in (0..s.levels).rev() {
+        let edge = SIZE >> k;
+        for slot in 0..slots {
+            for y in 0..edge {
+                for x in 0..edge {
+                    let parent = levels[k as usize + 1][at(edge / 2, slot, x / 2, y / 2)];
+                    let t = levels[k as usize][at(edge, slot, x, y)];
+                    levels[k as usize][at(edge, slot, x, y)] = pushed(t, parent, k);
+                }
+            }
+        }
+    }
+    levels.swap_remove(0).iter().map(|t| t[0]).collect()
+}
+
+/// The pull-push's atlas agrees with [`pull_push_model`] within 1e-5 relative (every empty
+/// texel empty) for both modes and 0 to 5 levels, over three maps of two surfaces (a near one
+/// over a far one, each a ramp) with holes of every size from one texel to a 4x4 block. Any
+/// restructuring of the passes (fused levels, another dispatch layout) must keep this; it
+/// catches a child, parent or level read from the wrong place, a push out of order and an
+/// interval of the wrong level (tried: the pull's interval scaled by the written level, and
+/// the push reading an unpushed parent, both fail).
+#[test]
+fn pull_push_matches_its_cpu_model() {
+    const SLOTS: u32 = 3;
+    let mut level0 = vec![0u32; (SLOTS * SIZE * SIZE) as usize];
+    for slot in 0..SLOTS {
+        for y in 0..SIZE {
+            for x in 0..SIZE {
+                let h = (x * 73 + y * 151 + slot * 199).wrapping_mul(2654435761) >> 27;
+                let hole = h < 12 || (x / 4 + y / 4 + slot) % 7 == 0;
+                let near = (x + slot * 5) % 16 < 7 && y > 6;
+                let depth = if near {
+                    0.75 + 0.002 * x as f32
+                } else {
+                    0.25 + 0.004 * y as f32 + 0.001 * x as f32
+                };
+                if !hole {
+                    level0[((slot * SIZE + y) * SIZE + x) as usize] = depth.to_bits();
+                }
+            }
+        }
+    }
+    for backend in backends_for("ism_kit") {
+        let gpu = backend_context(backend);
+        for mode in [PullPushMode::DepthAware, PullPushMode::Average] {
+            for levels in 0..=5 {
+                let s = settings(levels, mode);
+                let want = pull_push_model(SLOTS, &level0, s);
+                let atlas = pull_push_of(&gpu, SLOTS, &level0, s);
+                for slot in 0..SLOTS {
+                    let got = read_map(&gpu, &atlas, slot);
+                    for (i, &g) in got.iter().enumerate() {
+                        let w = want[(slot * SIZE * SIZE) as usize + i];
+                        assert!(
+                            (g == 0.0) == (w == 0.0) && (g - w).abs() <= 1e-5 * w.abs(),
+                            "{backend} {mode:?} {levels} levels: slot {slot} texel ({}, {}) is {g}, the model {w}",
+                            i as u32 % SIZE,
+                            i as u32 / SIZE
+                        );
+                    }
+                }
             }
         }
     }

@@ -145,7 +145,7 @@ const NO_SOURCE: u32 = u32::MAX;
 /// in the depth-aware mode: a texel of a paraboloid map of `size`² spans at most 4 / `size`
 /// radians (at the centre), over which a surface at distance D tilted θ from the view ray
 /// changes distance by about D · (4 / size) · tan θ.
-const SLANT_TAN: f32 = 3.73;
+pub const SLANT_TAN: f32 = 3.73;
 
 impl PullPush {
     /// The passes over `splat`'s depth buffer into `atlas` (a float atlas of the same slots
