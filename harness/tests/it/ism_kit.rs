@@ -1,9 +1,9 @@
 //! The imperfect-shadow-map kit parts (Ritschel et al. 2008) on the GPU, on every portable
 //! backend present: pull-push (both modes) agrees with a CPU model of itself, fills a
 //! synthetic hole pattern without changing any texel a point landed on and leaves regions
-//! beyond its reach empty; the depth-aware one
-//! closes a near surface's holes where a far one shows through; splatting a dense point set of
-//! a plane and pulling-pushing reproduces the plane's exact (classic) paraboloid depth map.
+//! beyond its reach empty; the depth-aware one closes a near surface's holes where a far one
+//! shows through; splatting a dense point set of a plane and pulling-pushing reproduces the
+//! plane's exact (classic) paraboloid depth map.
 
 use gibench_test_support::readback::read_bytes as read_buffer;
 use gibench_test_support::scene as support;
